@@ -1,0 +1,282 @@
+#include "backends/cpu/cpu_backend.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <vector>
+
+#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/thread_pool.hpp"
+
+namespace pyrseg::cpu {
+namespace {
+
+using std::size_t;
+using std::uint32_t;
+
+constexpr size_t kColumnBlock = 64;  // columns swept together, row by row, so column sweeps stay cache-friendly
+
+class CpuExecutor final : public core::PassExecutor {
+public:
+    explicit CpuExecutor(const core::Plan& plan)
+        : plan_(plan),
+          quant_(plan.pixel_count()),
+          mask_(plan.total_texels),
+          labels_(plan.total_texels),
+          lut_(size_t(plan.max_label) + 1) {}
+
+    void bind_cloud(const CloudView& cloud) override {
+        cloud_ = cloud;
+        if (cloud_.row_stride == 0) cloud_.row_stride = size_t(cloud_.width);
+        normals_estimated_ = false;
+        from_mask_ = false;
+    }
+
+    void bind_mask(const MaskView& mask) override {
+        from_mask_ = true;
+        const size_t w = size_t(plan_.width);
+        const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
+        std::uint8_t* full = mask_.data() + plan_.full().offset;
+        rows(size_t(plan_.height), [&](size_t y) {
+            for (size_t x = 0; x < w; ++x) {
+                full[y * w + x] = mask.fillable[y * stride + x] != 0 ? 1 : 0;
+                quant_[y * w + x].valid = (mask.valid == nullptr || mask.valid[y * stride + x] != 0) ? 1 : 0;
+            }
+        });
+    }
+
+    void estimate_normals() override {
+        const size_t w = size_t(plan_.width);
+        if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
+        const PassContext c = context();
+        const auto radius = uint32_t(plan_.params.normal_radius);
+        rows(size_t(plan_.height), [&](size_t y) {
+            for (size_t x = 0; x < w; ++x) {
+                const PyrIVec3 q = kernels::pyr_normal_q(c, uint32_t(w), uint32_t(plan_.height), uint32_t(x),
+                                                         uint32_t(y), radius);
+                float* n = normals_.data() + 3 * (y * w + x);
+                n[0] = float(q.x) * PYR_NORMAL_UNIT;
+                n[1] = float(q.y) * PYR_NORMAL_UNIT;
+                n[2] = float(q.z) * PYR_NORMAL_UNIT;
+            }
+        });
+        normals_estimated_ = true;
+    }
+
+    void quantize() override {
+        const size_t w = size_t(plan_.width);
+        rows(size_t(plan_.height), [&](size_t y) {
+            for (size_t x = 0; x < w; ++x) {
+                const float* p = point(x, y);
+                const float* n = normal(x, y);
+                const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                QuantPixel& out = quant_[y * w + x];
+                out.q[0] = std::int16_t(q.qx);
+                out.q[1] = std::int16_t(q.qy);
+                out.q[2] = std::int16_t(q.qz);
+                out.valid = std::uint16_t(q.valid);
+                out.z = p[2];
+            }
+        });
+    }
+
+    void metric() override {
+        const PassContext c = context();
+        const PyrLevel full = plan_.full();
+        const core::Thresholds t = plan_.thresholds;
+        rows(full.height, [&](size_t y) {
+            std::uint8_t* out = mask_.data() + full.offset + y * full.width;
+            for (uint32_t x = 0; x < full.width; ++x) {
+                out[x] = std::uint8_t(
+                    kernels::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y), t.curvature, t.depth));
+            }
+        });
+    }
+
+    void mip(int parent_level) override {
+        const PassContext c = context();
+        const PyrLevel parent = plan_.level(parent_level);
+        const PyrLevel child = plan_.level(parent_level + 1);
+        rows(parent.height, [&](size_t y) {
+            std::uint8_t* out = mask_.data() + parent.offset + y * parent.width;
+            for (uint32_t x = 0; x < parent.width; ++x) out[x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, uint32_t(y)));
+        });
+    }
+
+    void init_labels(int level, uint32_t mode) override {
+        const PassContext c = context();
+        const PyrLevel lv = plan_.level(level);
+        const PyrLevel parent = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
+        rows(lv.height, [&](size_t y) {
+            uint32_t* out = labels_.data() + lv.offset + y * lv.width;
+            for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, uint32_t(y), mode);
+        });
+    }
+
+    void fill_to_fixed_point(int level, uint32_t anchor_max) override {
+        while (sweep(plan_.level(level), anchor_max, false)) {
+        }
+    }
+
+    void fill_once(int level) override { sweep(plan_.level(level), 0, true); }
+
+    void label_edges() override {
+        const PassContext c = context();
+        const PyrLevel full = plan_.full();
+        rows(full.height, [&](size_t y) {
+            for (uint32_t x = 0; x < full.width; ++x) {
+                const uint32_t i = full.offset + uint32_t(y) * full.width + x;
+                // Only edge pixels change, and no other pixel reads them: writing only changes keeps rows
+                // free of races on the fillable labels they read.
+                const uint32_t l = kernels::pyr_edge_label(c, full, x, uint32_t(y));
+                if (l != labels_[i]) labels_[i] = l;
+            }
+        });
+    }
+
+    uint32_t compact(bool apply) override {
+        std::fill(lut_.begin(), lut_.end(), 0u);
+        const uint32_t* full = labels_.data() + plan_.full().offset;
+        const size_t w = size_t(plan_.width);
+        rows(size_t(plan_.height), [&](size_t y) {
+            for (size_t x = 0; x < w; ++x) {
+                const uint32_t l = full[y * w + x];
+                if (l != 0) std::atomic_ref<uint32_t>(lut_[l]).store(1u, std::memory_order_relaxed);
+            }
+        });
+        uint32_t count = 0;
+        for (uint32_t& entry : lut_) {
+            if (entry != 0) entry = ++count;
+        }
+        segment_count_ = count;
+        compacted_ = apply;
+        return count;
+    }
+
+    void read_back(Result& out, const Outputs& outputs) override {
+        const size_t pixels = plan_.pixel_count();
+        const uint32_t* raw = labels_.data() + plan_.full().offset;
+        out.width = plan_.width;
+        out.height = plan_.height;
+        out.segment_count = segment_count_;
+        out.labels.resize(pixels);
+        const PassContext c = context();
+        rows(size_t(plan_.height), [&](size_t y) {
+            const size_t w = size_t(plan_.width);
+            for (size_t i = y * w; i < (y + 1) * w; ++i) out.labels[i] = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
+        });
+        if (outputs.raw_labels) {
+            out.raw_labels.assign(raw, raw + pixels);
+        } else {
+            out.raw_labels.clear();
+        }
+        if (outputs.fillable_mask) {
+            const std::uint8_t* m = mask_.data() + plan_.full().offset;
+            out.fillable_mask.assign(m, m + pixels);
+        } else {
+            out.fillable_mask.clear();
+        }
+        out.normals.clear();
+        if (outputs.normals && !from_mask_) {
+            out.normals.resize(3 * pixels);
+            const size_t w = size_t(plan_.width);
+            for (size_t y = 0; y < size_t(plan_.height); ++y) {
+                for (size_t x = 0; x < w; ++x) std::copy_n(normal(x, y), 3, out.normals.data() + 3 * (y * w + x));
+            }
+        }
+    }
+
+private:
+    template <class RowBody>
+    void rows(size_t count, const RowBody& body) {
+        const size_t grain = std::max<size_t>(1, count / (size_t(pool_.size()) * 8));
+        pool_.parallel_for(count, grain, [&](size_t begin, size_t end) {
+            for (size_t y = begin; y < end; ++y) body(y);
+        });
+    }
+
+    [[nodiscard]] PassContext context() {
+        PassContext c;
+        c.points = cloud_.points;
+        c.row_stride = cloud_.row_stride;
+        c.point_stride = size_t(cloud_.point_stride);
+        c.quant = quant_.data();
+        c.mask = mask_.data();
+        c.labels = labels_.data();
+        c.lut = lut_.data();
+        return c;
+    }
+
+    [[nodiscard]] const float* point(size_t x, size_t y) const {
+        return cloud_.points + (y * cloud_.row_stride + x) * size_t(cloud_.point_stride);
+    }
+    [[nodiscard]] const float* normal(size_t x, size_t y) const {
+        if (normals_estimated_) return normals_.data() + 3 * (y * size_t(plan_.width) + x);
+        return cloud_.normals + (y * cloud_.row_stride + x) * size_t(cloud_.point_stride);
+    }
+
+    // One round of the four directional sweeps (rows left-right then right-left, then columns top-down then
+    // bottom-up). Rows are independent, and so are columns: each runs in parallel. Returns whether a label changed.
+    bool sweep(const PyrLevel& lv, uint32_t anchor_max, bool once) {
+        const PassContext c = context();
+        const uint32_t onceu = once ? 1u : 0u;
+        std::atomic<bool> changed{false};
+        rows(lv.height, [&](size_t y) {
+            const uint32_t start = lv.offset + uint32_t(y) * lv.width;
+            uint32_t ch = kernels::pyr_sweep_line(c, start, 1u, lv.width, anchor_max, onceu);
+            ch |= kernels::pyr_sweep_line(c, start + lv.width - 1u, ~0u, lv.width, anchor_max, onceu);
+            if (ch != 0u) changed.store(true, std::memory_order_relaxed);
+        });
+        const size_t blocks = (size_t(lv.width) + kColumnBlock - 1) / kColumnBlock;
+        pool_.parallel_for(blocks, 1, [&](size_t b0, size_t b1) {
+            const uint32_t x0 = uint32_t(b0 * kColumnBlock);
+            const uint32_t x1 = uint32_t(std::min(size_t(lv.width), b1 * kColumnBlock));
+            bool ch = false;
+            // Row by row, each column's sequential order is kept: row y reads row y -/+ 1 already updated.
+            for (uint32_t y = 1; y < lv.height; ++y) ch |= column_step(c, lv, y, y - 1, x0, x1, anchor_max, once);
+            for (uint32_t y = lv.height - 1; y-- > 0;) ch |= column_step(c, lv, y, y + 1, x0, x1, anchor_max, once);
+            if (ch) changed.store(true, std::memory_order_relaxed);
+        });
+        return changed.load();
+    }
+
+    bool column_step(const PassContext& c, const PyrLevel& lv, uint32_t y, uint32_t from_y, uint32_t x0, uint32_t x1,
+                     uint32_t anchor_max, bool once) {
+        const uint32_t row = lv.offset + y * lv.width;
+        const uint32_t from = lv.offset + from_y * lv.width;
+        const std::uint8_t* m = c.mask;
+        uint32_t* l = c.labels;
+        bool ch = false;
+        for (uint32_t x = x0; x < x1; ++x) {
+            if (m[row + x] == 0) continue;
+            const uint32_t cur = l[row + x];
+            const uint32_t next = once ? kernels::pyr_fill_once(cur, l[from + x], m[from + x])
+                                       : kernels::pyr_fill_relax(cur, l[from + x], m[from + x], anchor_max);
+            if (next != cur) {
+                l[row + x] = next;
+                ch = true;
+            }
+        }
+        return ch;
+    }
+
+    const core::Plan& plan_;
+    ThreadPool pool_;
+    CloudView cloud_{};
+    std::vector<float> normals_;  // estimated, packed
+    std::vector<QuantPixel> quant_;
+    std::vector<std::uint8_t> mask_;   // all levels
+    std::vector<uint32_t> labels_;     // all levels
+    std::vector<uint32_t> lut_;        // raw label -> compacted label
+    uint32_t segment_count_ = 0;
+    bool compacted_ = false;
+    bool normals_estimated_ = false;
+    bool from_mask_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
+    return std::make_unique<CpuExecutor>(plan);
+}
+
+}  // namespace pyrseg::cpu

@@ -1,0 +1,51 @@
+#pragma once
+// The shared pass functions (shaders/) compiled as C++ for the CPU backend, with the accessor macros reading
+// the backend's buffers through a PassContext. They live in their own namespace so that another backend's
+// host-compiled copy with other accessors can never collide with them.
+#include <cstddef>
+#include <cstdint>
+
+#include "shaders/pyr_types.h"
+
+namespace pyrseg::cpu {
+
+struct QuantPixel {
+    std::int16_t q[3];  // qn, |q| <= 8192
+    std::uint16_t valid;
+    float z;
+};
+
+struct PassContext {
+    const float* points = nullptr;  // the caller's cloud, strided
+    std::size_t row_stride = 0;     // in points
+    std::size_t point_stride = 3;   // in floats
+    const QuantPixel* quant = nullptr;
+    std::uint8_t* mask = nullptr;      // all levels
+    std::uint32_t* labels = nullptr;   // all levels
+    const std::uint32_t* lut = nullptr;
+};
+
+}  // namespace pyrseg::cpu
+
+#define PYR_CTX_PARAM const ::pyrseg::cpu::PassContext& ctx
+#define PYR_CTX_ARG ctx
+#define PYR_PT(x, y, c) (ctx.points[(static_cast<std::size_t>(y) * ctx.row_stride + (x)) * ctx.point_stride + (c)])
+#define PYR_Q_VALID(i) static_cast<std::uint32_t>(ctx.quant[i].valid)
+#define PYR_QN(i, c) static_cast<std::int32_t>(ctx.quant[i].q[c])
+#define PYR_QZ(i) (ctx.quant[i].z)
+#define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
+#define PYR_LABEL(i) (ctx.labels[i])
+#define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
+#define PYR_VALID(p) static_cast<std::uint32_t>(ctx.quant[p].valid)
+#define PYR_LUT(l) (ctx.lut[l])
+
+namespace pyrseg::cpu::kernels {
+#include "shaders/pyr_compact.h"
+#include "shaders/pyr_edges.h"
+#include "shaders/pyr_fill.h"
+#include "shaders/pyr_labels.h"
+#include "shaders/pyr_metric.h"
+#include "shaders/pyr_mip.h"
+#include "shaders/pyr_normals.h"
+#include "shaders/pyr_quantize.h"
+}  // namespace pyrseg::cpu::kernels

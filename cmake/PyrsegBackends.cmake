@@ -1,0 +1,57 @@
+# Backend options: ON (required), OFF, or AUTO (built when the toolchain is found). One line per backend at
+# configure time says what is built and why the others are not.
+set(PYRSEG_WITH_CUDA AUTO CACHE STRING "Build the CUDA backend (ON/OFF/AUTO)")
+set(PYRSEG_WITH_VULKAN AUTO CACHE STRING "Build the Vulkan backend (ON/OFF/AUTO)")
+set(PYRSEG_WITH_OPENCL AUTO CACHE STRING "Build the OpenCL backend (ON/OFF/AUTO)")
+foreach(opt PYRSEG_WITH_CUDA PYRSEG_WITH_VULKAN PYRSEG_WITH_OPENCL)
+  set_property(CACHE ${opt} PROPERTY STRINGS ON OFF AUTO)
+endforeach()
+
+# _pyrseg_backend(NAME OPTION FOUND TOOLCHAIN_TEXT IMPLEMENTED NOT_IMPLEMENTED_TEXT)
+function(_pyrseg_backend name opt found toolchain implemented pending)
+  set(value "${${opt}}")
+  string(TOUPPER "${value}" value)
+  set(build OFF)
+  if(value STREQUAL "OFF")
+    set(why "disabled (${opt}=OFF)")
+  elseif(NOT found)
+    set(why "not built: ${toolchain} not found")
+    if(value STREQUAL "ON")
+      message(FATAL_ERROR "pyrseg: ${opt}=ON but ${toolchain} was not found")
+    endif()
+  elseif(NOT implemented)
+    set(why "not built: ${pending}")
+    if(value STREQUAL "ON")
+      message(FATAL_ERROR "pyrseg: ${opt}=ON but ${pending}")
+    endif()
+  else()
+    set(build ON)
+    set(why "built (${toolchain} found)")
+  endif()
+  message(STATUS "pyrseg backend ${name}: ${why}")
+  set(PYRSEG_BUILD_${name} ${build} PARENT_SCOPE)
+  set(PYRSEG_WHY_${name} "${why}" PARENT_SCOPE)
+endfunction()
+
+message(STATUS "pyrseg backend cpu: built (always)")
+
+include(CheckLanguage)
+check_language(CUDA)
+set(_cuda_found OFF)
+if(CMAKE_CUDA_COMPILER)
+  set(_cuda_found ON)
+endif()
+_pyrseg_backend(cuda PYRSEG_WITH_CUDA ${_cuda_found} "a CUDA compiler (nvcc)" OFF
+                "the CUDA backend is not implemented in this version (issue #5)")
+
+find_package(Vulkan QUIET COMPONENTS glslangValidator)
+set(_vk_found OFF)
+if(Vulkan_FOUND AND Vulkan_glslangValidator_FOUND)
+  set(_vk_found ON)
+endif()
+_pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and glslangValidator" OFF
+                "the Vulkan backend is not implemented in this version (issue #4)")
+
+find_package(OpenCL QUIET)
+_pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" OFF
+                "the OpenCL backend is not implemented in this version (issue #3)")

@@ -1,0 +1,13 @@
+# Compiler flags for pyrseg's own targets: warnings (errors by default), no float contraction, sanitizers.
+add_library(pyrseg_build_flags INTERFACE)
+target_compile_options(pyrseg_build_flags INTERFACE
+  $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
+                            -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough -ffp-contract=off>)
+if(PYRSEG_WERROR)
+  target_compile_options(pyrseg_build_flags INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Werror>)
+endif()
+if(PYRSEG_SANITIZE)
+  target_compile_options(pyrseg_build_flags INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  target_link_options(pyrseg_build_flags INTERFACE -fsanitize=address,undefined)
+endif()

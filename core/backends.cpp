@@ -1,0 +1,57 @@
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include "core/backends_config.hpp"
+#include "pyrseg/backend.hpp"
+#include "pyrseg/error.hpp"
+
+
+namespace pyrseg {
+
+std::vector<BackendInfo> list_backends() {
+    std::vector<BackendInfo> all;
+    // Preference order for "auto": GPUs first, the CPU always last and always there.
+    all.push_back({"cuda", false, kWhyCuda, {}});
+    all.push_back({"vulkan", false, kWhyVulkan, {}});
+    all.push_back({"opencl", false, kWhyOpencl, {}});
+    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    all.push_back({"cpu", true, "", {"host CPU, " + std::to_string(threads) + " hardware threads"}});
+    return all;
+}
+
+std::string resolve_backend_name(std::string_view requested) {
+    std::string name(requested);
+    std::string origin = "requested";
+    if (name.empty()) {
+        if (const char* env = std::getenv("PYRSEG_BACKEND"); env != nullptr && *env != '\0') {
+            name = env;
+            origin = "PYRSEG_BACKEND";
+        } else {
+            name = "auto";
+        }
+    }
+    const std::vector<BackendInfo> all = list_backends();
+    if (name == "auto") {
+        for (const BackendInfo& b : all) {
+            if (b.available) return b.name;
+        }
+        throw Error(ErrorCode::internal, "no backend is available, not even the CPU");
+    }
+    std::string known;
+    for (const BackendInfo& b : all) {
+        if (b.name == name) {
+            if (!b.available) {
+                throw Error(ErrorCode::backend_unavailable,
+                            "backend '" + name + "' (" + origin + ") is unavailable: " + b.reason);
+            }
+            return b.name;
+        }
+        known += (known.empty() ? "" : ", ") + b.name;
+    }
+    throw Error(ErrorCode::backend_unavailable,
+                "unknown backend '" + name + "' (" + origin + "); known backends: " + known + ", auto");
+}
+
+}  // namespace pyrseg

@@ -1,0 +1,67 @@
+// The pass order of the contract (docs/algorithm.md section 5), written once for every backend.
+#include "core/pipeline.hpp"
+
+#include <chrono>
+#include <cstring>
+
+namespace pyrseg::core {
+namespace {
+
+class PassClock {
+public:
+    explicit PassClock(std::vector<PassTiming>& timings) : timings_(timings) { timings_.clear(); }
+
+    template <class F>
+    void run(const char* pass, F&& body) {
+        const auto start = std::chrono::steady_clock::now();
+        body();
+        const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
+        for (PassTiming& t : timings_) {
+            if (std::strcmp(t.pass, pass) == 0) {
+                t.milliseconds += elapsed.count();
+                return;
+            }
+        }
+        timings_.push_back(PassTiming{pass, elapsed.count()});
+    }
+
+private:
+    std::vector<PassTiming>& timings_;
+};
+
+}  // namespace
+
+void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vector<PassTiming>& timings) {
+    PassClock clock(timings);
+    const int n = plan.level_count;
+    if (input != InputKind::mask) {
+        if (input == InputKind::cloud_without_normals) clock.run("normals", [&] { ex.estimate_normals(); });
+        clock.run("quantize", [&] { ex.quantize(); });
+        clock.run("metric", [&] { ex.metric(); });
+    }
+    if (plan.small_image) {
+        // The contract's fallback: plain 4-connected components of B, each labelled 1 + its smallest index,
+        // which is the fixed point of the step-2 fill from pixel-index labels.
+        clock.run("labels", [&] { ex.init_labels(n, PYR_INIT_PIXEL_INDEX); });
+        clock.run("fill", [&] { ex.fill_to_fixed_point(n, 0); });
+    } else {
+        const int m = plan.bridge_level;
+        clock.run("mip", [&] {
+            for (int k = n - 1; k >= 1; --k) ex.mip(k);
+        });
+        clock.run("labels", [&] {
+            for (int k = 1; k <= m; ++k) ex.init_labels(k, PYR_INIT_NEW);  // step 1
+        });
+        clock.run("fill", [&] { ex.fill_to_fixed_point(m, 0); });  // step 2
+        clock.run("labels", [&] {
+            for (int k = m + 1; k <= n - 1; ++k) ex.init_labels(k, PYR_INIT_INHERIT);  // step 3
+        });
+        clock.run("fill", [&] { ex.fill_to_fixed_point(n - 1, plan.old_label_max); });  // step 4
+        clock.run("labels", [&] { ex.init_labels(n, PYR_INIT_INHERIT); });           // step 5
+        clock.run("final_fill", [&] { ex.fill_once(n); });                           // step 6 a, b
+        if (plan.params.label_edges) clock.run("edges", [&] { ex.label_edges(); });  // step 6 c
+    }
+    clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7
+}
+
+}  // namespace pyrseg::core

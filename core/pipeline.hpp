@@ -1,0 +1,15 @@
+#pragma once
+#include <vector>
+
+#include "core/executor.hpp"
+#include "core/plan.hpp"
+#include "pyrseg/segmenter.hpp"
+
+namespace pyrseg::core {
+
+enum class InputKind { cloud_with_normals, cloud_without_normals, mask };
+
+// Runs the contract's passes in order on `executor`; times each pass (host wall time) into `timings`.
+void run_pipeline(const Plan& plan, InputKind input, PassExecutor& executor, std::vector<PassTiming>& timings);
+
+}  // namespace pyrseg::core

@@ -1,0 +1,120 @@
+#include "core/plan.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "pyrseg/error.hpp"
+
+namespace pyrseg::core {
+namespace {
+
+constexpr std::uint64_t kMax32 = std::numeric_limits<std::uint32_t>::max();
+// Largest normals radius accepted: beyond this the tangents span most of any real frame.
+constexpr int kMaxNormalRadius = 1024;
+
+[[noreturn]] void bad_parameter(const std::string& what) { throw Error(ErrorCode::invalid_parameter, what); }
+
+int ceil_log2(std::uint64_t v) {
+    int n = 0;
+    while ((std::uint64_t{1} << n) < v) ++n;
+    return n;
+}
+
+}  // namespace
+
+Thresholds compute_thresholds(const Params& params) {
+    if (!std::isfinite(params.ct) || params.ct < 0.0) {
+        bad_parameter("ct (curvature threshold) must be a finite angle >= 0 radians, got " +
+                      std::to_string(params.ct));
+    }
+    if (std::isnan(params.dt) || params.dt < 0.0) {
+        bad_parameter("dt (depth threshold) must be >= 0 millimetres (or +inf), got " + std::to_string(params.dt));
+    }
+    if (!std::isfinite(params.unit_mm) || params.unit_mm <= 0.0) {
+        bad_parameter("unit_mm must be a finite number of millimetres > 0, got " + std::to_string(params.unit_mm));
+    }
+    Thresholds t{};
+    // For ct >= pi the curvature test must always pass: -2^28 is below any k * (mean dot) >= k * -3 * 2^26, and
+    // k * -2^28 still fits int32 for k <= 8.
+    t.curvature = params.ct >= std::numbers::pi
+                      ? -(std::int32_t{1} << 28)
+                      : static_cast<std::int32_t>(std::floor(std::cos(params.ct) * 67108864.0));  // 2^26
+    t.depth = static_cast<float>(params.dt / params.unit_mm);
+    return t;
+}
+
+Plan make_plan(int width, int height, const Params& params) {
+    if (width < 1 || height < 1) {
+        throw Error(ErrorCode::invalid_argument,
+                    "image size " + std::to_string(width) + " x " + std::to_string(height) + " is empty");
+    }
+    Plan plan;
+    plan.width = width;
+    plan.height = height;
+    plan.params = params;
+    plan.thresholds = compute_thresholds(params);
+    if (params.normal_radius < 1 || params.normal_radius > kMaxNormalRadius) {
+        bad_parameter("normal_radius must be in 1.." + std::to_string(kMaxNormalRadius) + ", got " +
+                      std::to_string(params.normal_radius));
+    }
+    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+    if (pixels > kMax32) {
+        throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                    " has more pixels than 32-bit labels can address");
+    }
+
+    const int n = 1 + ceil_log2(std::uint64_t(std::max(width, height)));
+    plan.level_count = n;
+    plan.levels.resize(static_cast<std::size_t>(n));
+    std::uint64_t w = std::uint64_t(width);
+    std::uint64_t h = std::uint64_t(height);
+    for (int k = n; k >= 1; --k) {
+        plan.levels[static_cast<std::size_t>(k - 1)] = PyrLevel{std::uint32_t(w), std::uint32_t(h), 0};
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+    std::uint64_t offset = 0;
+    std::vector<std::uint64_t> offsets(static_cast<std::size_t>(n) + 2, 0);  // offsets[k] = offset_k
+    for (int k = 1; k <= n; ++k) {
+        offsets[std::size_t(k)] = offset;
+        const PyrLevel& lv = plan.levels[std::size_t(k - 1)];
+        offset += std::uint64_t(lv.width) * lv.height;
+    }
+    offsets[std::size_t(n) + 1] = offset;
+    plan.total_texels = offset;
+    // Every backend indexes the all-levels buffers with 32-bit integers.
+    if (plan.total_texels > kMax32) {
+        throw Error(ErrorCode::image_too_large,
+                    "image " + std::to_string(width) + " x " + std::to_string(height) + " needs " +
+                        std::to_string(plan.total_texels) + " pyramid texels, more than 32-bit indices address");
+    }
+    for (int k = 1; k <= n; ++k) plan.levels[std::size_t(k - 1)].offset = std::uint32_t(offsets[std::size_t(k)]);
+
+    const bool explicit_bg = params.bridge_levels.has_value() || params.unjoinable_gap.has_value();
+    const int b = params.bridge_levels.value_or(kDefaultBridgeLevels);
+    const int g = params.unjoinable_gap.value_or(kDefaultUnjoinableGap);
+    if (b < 1) bad_parameter("bridge_levels must be >= 1, got " + std::to_string(b));
+    if (g < 1) bad_parameter("unjoinable_gap must be >= 1, got " + std::to_string(g));
+    const int m = n - b;
+    const int u = m - g;
+    if (u < 1) {
+        if (explicit_bg) {
+            bad_parameter("bridge_levels " + std::to_string(b) + " and unjoinable_gap " + std::to_string(g) +
+                          " do not fit a " + std::to_string(width) + " x " + std::to_string(height) +
+                          " image: its pyramid has " + std::to_string(n) + " levels and needs " +
+                          "levels - bridge_levels - unjoinable_gap >= 1");
+        }
+        plan.small_image = true;
+        plan.max_label = std::uint32_t(pixels);
+        return plan;
+    }
+    plan.bridge_level = m;
+    plan.unjoinable_level = u;
+    plan.old_label_max = std::uint32_t(offsets[std::size_t(u) + 1]);
+    plan.max_label = std::uint32_t(offsets[std::size_t(m) + 1]);  // fits: total_texels does
+    return plan;
+}
+
+}  // namespace pyrseg::core

@@ -1,0 +1,105 @@
+#include "pyrseg/segmenter.hpp"
+
+#include <limits>
+#include <string>
+
+#include "backends/cpu/cpu_backend.hpp"
+#include "core/backend_registry.hpp"
+#include "core/pipeline.hpp"
+#include "core/plan.hpp"
+#include "pyrseg/backend.hpp"
+#include "pyrseg/error.hpp"
+
+namespace pyrseg {
+
+namespace core {
+std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
+    if (backend == "cpu") return cpu::make_executor(plan);
+    throw Error(ErrorCode::backend_unavailable, "backend '" + std::string(backend) + "' is not built in");
+}
+}  // namespace core
+
+namespace {
+
+void check_frame_size(const char* what, int width, int height, const core::Plan& plan) {
+    if (width != plan.width || height != plan.height) {
+        throw Error(ErrorCode::size_mismatch, std::string(what) + " is " + std::to_string(width) + " x " +
+                                                  std::to_string(height) + " but the Segmenter was created for " +
+                                                  std::to_string(plan.width) + " x " + std::to_string(plan.height));
+    }
+}
+
+void check_layout(const char* what, std::size_t row_stride, int point_stride, int width, int height) {
+    if (row_stride != 0 && row_stride < std::size_t(width)) {
+        throw Error(ErrorCode::invalid_argument, std::string(what) + " row_stride " + std::to_string(row_stride) +
+                                                     " is smaller than the width " + std::to_string(width));
+    }
+    // The last element read must be addressable: ((height - 1) * stride + width) * point_stride floats.
+    const std::size_t stride = row_stride == 0 ? std::size_t(width) : row_stride;
+    const std::size_t limit = std::numeric_limits<std::size_t>::max() / sizeof(float) / std::size_t(point_stride);
+    if (stride > (limit - std::size_t(width)) / std::size_t(height)) {
+        throw Error(ErrorCode::invalid_argument, std::string(what) + " row_stride " + std::to_string(row_stride) +
+                                                     " is too large to address");
+    }
+}
+
+}  // namespace
+
+struct Segmenter::Impl {
+    core::Plan plan;
+    std::string backend;
+    Outputs outputs;
+    std::unique_ptr<core::PassExecutor> executor;
+    std::vector<PassTiming> timings;
+};
+
+Segmenter::Segmenter(int width, int height, const Params& params, std::string_view backend, const Outputs& outputs)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->plan = core::make_plan(width, height, params);
+    impl_->backend = resolve_backend_name(backend);
+    impl_->outputs = outputs;
+    impl_->executor = core::make_executor(impl_->backend, impl_->plan);
+    impl_->timings.reserve(16);
+}
+
+Segmenter::~Segmenter() = default;
+Segmenter::Segmenter(Segmenter&&) noexcept = default;
+Segmenter& Segmenter::operator=(Segmenter&&) noexcept = default;
+
+void Segmenter::segment(const CloudView& cloud, Result& out) {
+    if (cloud.points == nullptr) throw Error(ErrorCode::invalid_argument, "cloud.points is null");
+    check_frame_size("the cloud", cloud.width, cloud.height, impl_->plan);
+    if (cloud.point_stride < 3) {
+        throw Error(ErrorCode::invalid_argument,
+                    "cloud.point_stride " + std::to_string(cloud.point_stride) + " is smaller than 3 floats");
+    }
+    check_layout("the cloud's", cloud.row_stride, cloud.point_stride, cloud.width, cloud.height);
+    impl_->executor->bind_cloud(cloud);
+    const auto input =
+        cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
+    core::run_pipeline(impl_->plan, input, *impl_->executor, impl_->timings);
+    impl_->executor->read_back(out, impl_->outputs);
+}
+
+Result Segmenter::segment(const CloudView& cloud) {
+    Result out;
+    segment(cloud, out);
+    return out;
+}
+
+void Segmenter::segment_mask(const MaskView& mask, Result& out) {
+    if (mask.fillable == nullptr) throw Error(ErrorCode::invalid_argument, "mask.fillable is null");
+    check_frame_size("the mask", mask.width, mask.height, impl_->plan);
+    check_layout("the mask's", mask.row_stride, 1, mask.width, mask.height);
+    impl_->executor->bind_mask(mask);
+    core::run_pipeline(impl_->plan, core::InputKind::mask, *impl_->executor, impl_->timings);
+    impl_->executor->read_back(out, impl_->outputs);
+}
+
+int Segmenter::width() const noexcept { return impl_->plan.width; }
+int Segmenter::height() const noexcept { return impl_->plan.height; }
+const Params& Segmenter::params() const noexcept { return impl_->plan.params; }
+const std::string& Segmenter::backend_name() const noexcept { return impl_->backend; }
+const std::vector<PassTiming>& Segmenter::last_timings() const noexcept { return impl_->timings; }
+
+}  // namespace pyrseg

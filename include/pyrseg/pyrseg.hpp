@@ -1,0 +1,9 @@
+#pragma once
+// pyrseg: fast bridgeless pyramid segmentation of organized point clouds.
+#include "pyrseg/backend.hpp"
+#include "pyrseg/cloud.hpp"
+#include "pyrseg/error.hpp"
+#include "pyrseg/params.hpp"
+#include "pyrseg/result.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/version.hpp"

@@ -1,0 +1,51 @@
+#pragma once
+// A Segmenter is created once for a backend and a resolution, then segments frame after frame without
+// allocating (after the first frame has sized the Result it is given).
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pyrseg/cloud.hpp"
+#include "pyrseg/params.hpp"
+#include "pyrseg/result.hpp"
+
+namespace pyrseg {
+
+struct PassTiming {
+    const char* pass;  // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact"
+    double milliseconds;
+};
+
+class Segmenter {
+public:
+    // backend: "cpu", "cuda", "vulkan", "opencl", "auto", or empty for $PYRSEG_BACKEND (else "auto").
+    // Throws pyrseg::Error for invalid parameters, sizes that do not fit, or an unavailable backend.
+    Segmenter(int width, int height, const Params& params = {}, std::string_view backend = {},
+              const Outputs& outputs = {});
+    ~Segmenter();
+    Segmenter(Segmenter&&) noexcept;
+    Segmenter& operator=(Segmenter&&) noexcept;
+    Segmenter(const Segmenter&) = delete;
+    Segmenter& operator=(const Segmenter&) = delete;
+
+    // Segments one frame into `out`. The frame must have the Segmenter's size.
+    void segment(const CloudView& cloud, Result& out);
+    [[nodiscard]] Result segment(const CloudView& cloud);
+    // Labels a caller-made fillable mask (the pyramid without the normals and metric passes).
+    void segment_mask(const MaskView& mask, Result& out);
+
+    [[nodiscard]] int width() const noexcept;
+    [[nodiscard]] int height() const noexcept;
+    [[nodiscard]] const Params& params() const noexcept;
+    [[nodiscard]] const std::string& backend_name() const noexcept;
+    // Host wall time of each pass of the last frame, in pass order (accumulated per pass name).
+    [[nodiscard]] const std::vector<PassTiming>& last_timings() const noexcept;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pyrseg

@@ -1,0 +1,88 @@
+/* The shared dialect. The per-pixel code of every pass (shaders/pyr_*.h) compiles as C++, CUDA, OpenCL C and
+ * GLSL through this header. Rules for shared code, so that it stays within what all four accept:
+ *  - no pointers or references: memory goes through accessor macros the including entry point defines
+ *    (PYR_PT, PYR_Q_VALID, PYR_QN, PYR_QZ, PYR_MASK, PYR_LABEL, PYR_STORE_LABEL, PYR_VALID) and the context
+ *    parameter PYR_CTX_PARAM / argument PYR_CTX_ARG that carries whatever those macros need;
+ *  - casts only through PYR_I32 / PYR_U32 / PYR_F32, structs only through PYR_STRUCT / PYR_STRUCT_END;
+ *  - no bool in structs, no recursion, no overloading, integer literals with a u suffix where unsigned;
+ *  - float expressions that decide a result are PYR_PRECISE (GLSL `precise`; contraction is off elsewhere).
+ */
+#ifndef PYR_SHIM_H
+#define PYR_SHIM_H
+
+#if defined(PYR_GLSL)
+#define PYR_FN
+#define pyr_i32 int
+#define pyr_u32 uint
+#define pyr_f32 float
+#define PYR_I32(x) int(x)
+#define PYR_U32(x) uint(x)
+#define PYR_F32(x) float(x)
+#define PYR_FLOAT_BITS(f) floatBitsToInt(f)
+#define PYR_RINT(f) roundEven(f)
+#define PYR_FABS(f) abs(f)
+#define PYR_MSB(u) findMSB(u)
+#define PYR_PRECISE precise
+#define PYR_STRUCT(name) struct name
+#define PYR_STRUCT_END(name) ;
+
+#elif defined(__OPENCL_VERSION__)
+#pragma OPENCL FP_CONTRACT OFF
+#define PYR_FN static inline
+#define pyr_i32 int
+#define pyr_u32 uint
+#define pyr_f32 float
+#define PYR_I32(x) ((int)(x))
+#define PYR_U32(x) ((uint)(x))
+#define PYR_F32(x) ((float)(x))
+#define PYR_FLOAT_BITS(f) as_int(f)
+#define PYR_RINT(f) rint(f)
+#define PYR_FABS(f) fabs(f)
+#define PYR_MSB(u) (31 - (int)clz((uint)(u)))
+#define PYR_PRECISE
+#define PYR_STRUCT(name) typedef struct name
+#define PYR_STRUCT_END(name) name;
+
+#elif defined(__CUDACC__)
+#define PYR_FN static __host__ __device__ __forceinline__
+#define pyr_i32 int
+#define pyr_u32 unsigned int
+#define pyr_f32 float
+#define PYR_I32(x) static_cast<int>(x)
+#define PYR_U32(x) static_cast<unsigned int>(x)
+#define PYR_F32(x) static_cast<float>(x)
+#ifdef __CUDA_ARCH__
+#define PYR_FLOAT_BITS(f) __float_as_int(f)
+#define PYR_MSB(u) (31 - __clz(static_cast<int>(u)))
+#else
+#include <bit>
+#define PYR_FLOAT_BITS(f) std::bit_cast<int>(f)
+#define PYR_MSB(u) (static_cast<int>(std::bit_width(static_cast<unsigned int>(u))) - 1)
+#endif
+#define PYR_RINT(f) rintf(f)
+#define PYR_FABS(f) fabsf(f)
+#define PYR_PRECISE
+#define PYR_STRUCT(name) struct name
+#define PYR_STRUCT_END(name) ;
+
+#else /* C++ (CPU backend, host code) */
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#define PYR_FN inline
+#define pyr_i32 std::int32_t
+#define pyr_u32 std::uint32_t
+#define pyr_f32 float
+#define PYR_I32(x) static_cast<std::int32_t>(x)
+#define PYR_U32(x) static_cast<std::uint32_t>(x)
+#define PYR_F32(x) static_cast<float>(x)
+#define PYR_FLOAT_BITS(f) std::bit_cast<std::int32_t>(static_cast<float>(f))
+#define PYR_RINT(f) std::nearbyint(f)
+#define PYR_FABS(f) std::fabs(f)
+#define PYR_MSB(u) (static_cast<std::int32_t>(std::bit_width(static_cast<std::uint32_t>(u))) - 1)
+#define PYR_PRECISE
+#define PYR_STRUCT(name) struct name
+#define PYR_STRUCT_END(name) ;
+#endif
+
+#endif /* PYR_SHIM_H */

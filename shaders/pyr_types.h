@@ -1,0 +1,37 @@
+/* Types and constants shared by host code (core/) and every pass. */
+#ifndef PYR_TYPES_H
+#define PYR_TYPES_H
+#include "pyr_shim.h"
+
+/* One pyramid level: its size and where its texels start in the all-levels buffers. A new label for the texel
+ * at buffer index i is i + 1 (contract section 4), since the buffers use the labels' offsets. */
+PYR_STRUCT(PyrLevel) {
+    pyr_u32 width;
+    pyr_u32 height;
+    pyr_u32 offset;
+} PYR_STRUCT_END(PyrLevel)
+
+PYR_STRUCT(PyrIVec3) {
+    pyr_i32 x;
+    pyr_i32 y;
+    pyr_i32 z;
+} PYR_STRUCT_END(PyrIVec3)
+
+/* A quantized pixel: validity and qn (contract section 2). */
+PYR_STRUCT(PyrQuant) {
+    pyr_i32 qx;
+    pyr_i32 qy;
+    pyr_i32 qz;
+    pyr_u32 valid;
+} PYR_STRUCT_END(PyrQuant)
+
+/* Normals are quantized to multiples of 2^-13. */
+#define PYR_NORMAL_SCALE 8192.0f
+#define PYR_NORMAL_UNIT 0.0001220703125f /* 2^-13, exact */
+
+/* Label init modes (contract section 5). */
+#define PYR_INIT_NEW 0u         /* steps 1: parent's label, else a new one */
+#define PYR_INIT_INHERIT 1u     /* steps 3 and 5: parent's label, maybe 0 */
+#define PYR_INIT_PIXEL_INDEX 2u /* tiny-image fallback: 1 + the pixel's own index */
+
+#endif /* PYR_TYPES_H */

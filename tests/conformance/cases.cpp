@@ -1,0 +1,89 @@
+#include "conformance/cases.hpp"
+
+#include <cstdint>
+#include <limits>
+
+namespace pyrseg::test {
+namespace {
+
+// A tiny deterministic generator so that the case list is the same on every platform.
+class CaseRng {
+public:
+    explicit CaseRng(std::uint64_t seed) : state_(seed) {}
+    std::uint64_t next() {
+        state_ += 0x9E3779B97F4A7C15ull;
+        std::uint64_t z = state_;
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    int range(int lo, int hi) { return lo + int(next() % std::uint64_t(hi - lo + 1)); }
+    bool chance(int percent) { return range(1, 100) <= percent; }
+    template <class T, std::size_t N>
+    T pick(const T (&values)[N]) {
+        return values[next() % N];
+    }
+
+private:
+    std::uint64_t state_;
+};
+
+constexpr int kCaseCount = 200;
+
+ConformanceCase make_case(int index, int width, int height, CaseRng& rng, bool vary_params) {
+    ConformanceCase c;
+    c.scene.width = width;
+    c.scene.height = height;
+    c.scene.seed = std::uint64_t(1000 + index);
+    c.scene.object_count = rng.range(0, 16);
+    c.scene.noise_mm = rng.pick({0.0, 0.05, 0.1, 0.3, 1.0});
+    c.scene.hole_fraction = rng.pick({0.0, 0.0, 0.01, 0.05, 0.2});
+    c.scene.touching = rng.chance(75);
+    c.scene.bin = rng.chance(70);
+    c.given_normals = rng.chance(40);
+    if (vary_params) {
+        c.params.ct = rng.pick({0.1, 0.25, 0.25, 0.4, 1.0, 3.5});
+        c.params.dt = rng.pick({0.5, 4.0, 10.0, 10.0, 50.0, std::numeric_limits<double>::infinity()});
+        if (rng.chance(30)) c.params.bridge_levels = rng.range(1, 4);
+        if (rng.chance(30)) c.params.unjoinable_gap = rng.range(1, 3);
+        c.params.label_edges = rng.chance(70);
+        c.params.compact = rng.chance(80);
+        c.params.normal_radius = rng.pick({1, 1, 2, 3});
+    }
+    c.name = "case" + std::to_string(index) + "_" + std::to_string(width) + "x" + std::to_string(height) +
+             (c.given_normals ? "_given_normals" : "_estimated_normals");
+    return c;
+}
+
+std::vector<ConformanceCase> build_cases() {
+    std::vector<ConformanceCase> cases;
+    CaseRng rng(20261122);
+    // The sizes that matter: degenerate strips, the fallback boundary (8 vs 9), odd sizes, camera frames.
+    const int fixed[][2] = {{1, 1},   {1, 7},   {7, 1},     {8, 8},    {9, 9},     {33, 17},  {640, 480},
+                            {640, 480}, {1031, 772}, {2064, 1544}, {2, 2},  {16, 1},  {1, 16},  {17, 9}};
+    for (const auto& size : fixed) {
+        const bool vary = int(cases.size()) % 2 == 1;
+        cases.push_back(make_case(int(cases.size()), size[0], size[1], rng, vary));
+    }
+    // Some camera-like frames with varied parameters.
+    const int frames[][2] = {{320, 240}, {160, 120}, {400, 300}, {256, 212}};
+    for (int i = 0; i < 12; ++i) {
+        const auto& size = frames[i % 4];
+        cases.push_back(make_case(int(cases.size()), size[0], size[1], rng, true));
+    }
+    while (int(cases.size()) < kCaseCount) {
+        const int w = rng.chance(20) ? rng.range(1, 12) : rng.range(9, 160);
+        const int h = rng.chance(20) ? rng.range(1, 12) : rng.range(9, 120);
+        cases.push_back(make_case(int(cases.size()), w, h, rng, rng.chance(60)));
+    }
+    return cases;
+}
+
+}  // namespace
+
+const std::vector<ConformanceCase>& conformance_cases() {
+    static const std::vector<ConformanceCase> cases = build_cases();
+    return cases;
+}
+
+}  // namespace pyrseg::test

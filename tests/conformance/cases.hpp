@@ -1,0 +1,21 @@
+#pragma once
+// The conformance scenes: 200 seeded synthetic scenes of many sizes, noise levels, hole fractions and
+// parameters, the same list for every backend.
+#include <string>
+#include <vector>
+
+#include "pyrseg/params.hpp"
+#include "pyrseg/synthetic.hpp"
+
+namespace pyrseg::test {
+
+struct ConformanceCase {
+    std::string name;  // a gtest-safe name: index, size, normals source
+    synthetic::SceneOptions scene;
+    Params params;
+    bool given_normals = false;  // the scene's exact normals; otherwise the normals pass estimates them
+};
+
+[[nodiscard]] const std::vector<ConformanceCase>& conformance_cases();
+
+}  // namespace pyrseg::test

@@ -1,0 +1,109 @@
+// The conformance suite: every backend's labels, raw labels, fillable mask and normals are byte-identical to
+// the independent reference (tests/reference) on the same scenes. Unavailable backends are skipped with the
+// reason the backend gives.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <tuple>
+
+#include "conformance/cases.hpp"
+#include "pyrseg/error.hpp"
+#include "pyrseg/io.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "support/oracle.hpp"
+
+namespace pyrseg::test {
+namespace {
+
+Outputs everything() {
+    Outputs o;
+    o.raw_labels = true;
+    o.fillable_mask = true;
+    o.normals = true;
+    return o;
+}
+
+// Segments `points` with `backend` and compares every output with the reference.
+void expect_conformance(const std::string& backend, const float* points, const float* normals, int width,
+                        int height, const Params& params, const float* warmup_points = nullptr) {
+    const pyrseg_ref::Output ref = pyrseg_ref::segment(points, normals, width, height, to_reference(params));
+    if (!ref.ok) {
+        EXPECT_THROW(Segmenter(width, height, params, backend, everything()), pyrseg::Error)
+            << "the reference rejects these parameters (" << ref.error << ") but the backend accepts them";
+        return;
+    }
+    Segmenter segmenter(width, height, params, backend, everything());
+    Result result;
+    CloudView view;
+    view.width = width;
+    view.height = height;
+    if (warmup_points != nullptr) {  // a different frame first: nothing may leak from one frame to the next
+        view.points = warmup_points;
+        segmenter.segment(view, result);
+    }
+    view.points = points;
+    view.normals = normals;
+    segmenter.segment(view, result);
+    EXPECT_TRUE(same_bytes("fillable mask", result.fillable_mask, ref.fillable, width));
+    EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, width, 3));
+    EXPECT_TRUE(same_bytes("raw labels", result.raw_labels, ref.raw_labels, width));
+    EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, width));
+    EXPECT_EQ(result.segment_count, ref.segment_count);
+}
+
+class SyntheticScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(SyntheticScenes, MatchesReference) {
+    const auto& [backend, index] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const ConformanceCase& c = conformance_cases()[std::size_t(index)];
+    const synthetic::Scene scene = synthetic::generate(c.scene);
+    const bool small = std::size_t(c.scene.width) * std::size_t(c.scene.height) <= 640u * 480u;
+    synthetic::Scene other;
+    if (small) {
+        synthetic::SceneOptions o = c.scene;
+        o.seed += 7777;
+        other = synthetic::generate(o);
+    }
+    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr,
+                       scene.width, scene.height, c.params, small ? other.points.data() : nullptr);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Backends, SyntheticScenes,
+    ::testing::Combine(::testing::ValuesIn(all_backend_names()),
+                       ::testing::Range(0, int(conformance_cases().size()))),
+    [](const ::testing::TestParamInfo<SyntheticScenes::ParamType>& info) {
+        return std::get<0>(info.param) + "_" + conformance_cases()[std::size_t(std::get<1>(info.param))].name;
+    });
+
+class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+TEST_P(RealScans, MatchesReference) {
+    const auto& [backend, file] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const std::filesystem::path path = std::filesystem::path(shared_data_dir()) / file;
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "sample scan not present: " << path.string();
+    const io::PointCloud cloud = io::read_pcd(path);
+    ASSERT_TRUE(cloud.normals.empty()) << "the shared scans carry no normals; they are estimated";
+    Params params;
+    params.unit_mm = 1000.0;  // the scans are in metres
+    expect_conformance(backend, cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+    params.normal_radius = 2;
+    params.bridge_levels = 3;
+    expect_conformance(backend, cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RealScans,
+                         ::testing::Combine(::testing::ValuesIn(all_backend_names()),
+                                            ::testing::Values("table_scene_mug_stereo_textured.pcd",
+                                                              "milk_cartoon_all_small_clorox.pcd")),
+                         [](const ::testing::TestParamInfo<RealScans::ParamType>& info) {
+                             std::string file = std::get<1>(info.param);
+                             file = file.substr(0, file.find('.'));
+                             return std::get<0>(info.param) + "_" + file;
+                         });
+
+}  // namespace
+}  // namespace pyrseg::test

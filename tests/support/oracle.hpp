@@ -1,0 +1,84 @@
+#pragma once
+// Glue between the library and the independent oracle (tests/reference): parameter mapping and byte-exact
+// comparison that names the first differing pixel.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pyrseg/backend.hpp"
+#include "pyrseg/params.hpp"
+#include "reference/reference.hpp"
+
+namespace pyrseg::test {
+
+inline pyrseg_ref::Params to_reference(const Params& p) {
+    pyrseg_ref::Params r;
+    r.ct = p.ct;
+    r.dt = p.dt;
+    r.unit_mm = p.unit_mm;
+    r.bridge_levels = p.bridge_levels.value_or(kDefaultBridgeLevels);
+    r.unjoinable_gap = p.unjoinable_gap.value_or(kDefaultUnjoinableGap);
+    r.bg_explicit = p.bridge_levels.has_value() || p.unjoinable_gap.has_value();
+    r.label_edges = p.label_edges;
+    r.compact = p.compact;
+    r.normal_radius = p.normal_radius;
+    return r;
+}
+
+// Byte-for-byte equality; on failure, the first differing element with its pixel coordinates.
+template <class T>
+::testing::AssertionResult same_bytes(const char* what, const std::vector<T>& actual, const std::vector<T>& expected,
+                                      int width, int channels = 1) {
+    if (actual.size() != expected.size()) {
+        return ::testing::AssertionFailure()
+               << what << ": size " << actual.size() << " but the reference has " << expected.size();
+    }
+    if (actual.empty() || std::memcmp(actual.data(), expected.data(), actual.size() * sizeof(T)) == 0) {
+        return ::testing::AssertionSuccess();
+    }
+    std::size_t differing = 0;
+    std::size_t first = actual.size();
+    for (std::size_t i = 0; i < actual.size(); ++i) {
+        if (std::memcmp(&actual[i], &expected[i], sizeof(T)) != 0) {
+            if (first == actual.size()) first = i;
+            ++differing;
+        }
+    }
+    const std::size_t pixel = first / std::size_t(channels);
+    std::ostringstream s;
+    s << what << ": " << differing << " element(s) differ; first at pixel (" << pixel % std::size_t(width) << ", "
+      << pixel / std::size_t(width) << ") channel " << first % std::size_t(channels) << ": " << +actual[first]
+      << " vs reference " << +expected[first];
+    return ::testing::AssertionFailure() << s.str();
+}
+
+// Skips the current test, with the backend's own reason, when the backend cannot run here.
+inline bool skip_unavailable(const std::string& backend, std::string* reason) {
+    for (const BackendInfo& b : list_backends()) {
+        if (b.name == backend) {
+            if (!b.available) *reason = backend + " unavailable: " + b.reason;
+            return !b.available;
+        }
+    }
+    *reason = "unknown backend " + backend;
+    return true;
+}
+
+#define PYRSEG_SKIP_IF_UNAVAILABLE(backend)                                                     \
+    do {                                                                                        \
+        std::string skip_reason_;                                                               \
+        if (::pyrseg::test::skip_unavailable(backend, &skip_reason_)) GTEST_SKIP() << skip_reason_; \
+    } while (0)
+
+inline const std::vector<std::string>& all_backend_names() {
+    static const std::vector<std::string> names = {"cpu", "opencl", "vulkan", "cuda"};
+    return names;
+}
+
+inline std::string shared_data_dir() { return PYRSEG_SHARED_DATA_DIR; }
+
+}  // namespace pyrseg::test

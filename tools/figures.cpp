@@ -1,0 +1,117 @@
+#include "tools/figures.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <queue>
+
+#include "pyrseg/io.hpp"
+#include "tools/font5x7.hpp"
+
+namespace pyrseg::cli {
+namespace {
+
+constexpr std::uint8_t kBackground = 24;
+constexpr int kGap = 8;
+
+const Glyph* find_glyph(char c) {
+    const char upper = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    for (const Glyph& g : kFont) {
+        if (g.c == upper) return &g;
+    }
+    return nullptr;  // blank (space and anything the font lacks)
+}
+
+void draw_text(RgbImage& img, int x0, int y0, int scale, const std::string& text) {
+    int x = x0;
+    for (char c : text) {
+        if (const Glyph* g = find_glyph(c)) {
+            for (int row = 0; row < 7; ++row) {
+                for (int col = 0; col < 5; ++col) {
+                    if ((g->rows[std::size_t(row)] & (0x10 >> col)) == 0) continue;
+                    for (int dy = 0; dy < scale; ++dy) {
+                        for (int dx = 0; dx < scale; ++dx) {
+                            const int px = x + col * scale + dx;
+                            const int py = y0 + row * scale + dy;
+                            if (px < 0 || py < 0 || px >= img.width || py >= img.height) continue;
+                            std::fill_n(img.rgb.begin() + 3 * (std::ptrdiff_t(py) * img.width + px), 3, 235);
+                        }
+                    }
+                }
+            }
+        }
+        x += 6 * scale;
+    }
+}
+
+}  // namespace
+
+RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int height) {
+    return RgbImage{width, height, io::colorize_labels(labels.data(), width, height)};
+}
+
+RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height) {
+    RgbImage img{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 3)};
+    for (std::size_t i = 0; i < fillable.size(); ++i) std::fill_n(img.rgb.begin() + std::ptrdiff_t(3 * i), 3, fillable[i] ? 255 : 0);
+    return img;
+}
+
+std::vector<std::uint32_t> connected_components(const std::vector<std::uint8_t>& fillable, int width, int height,
+                                                std::uint32_t* count) {
+    const std::size_t w = std::size_t(width);
+    const std::size_t h = std::size_t(height);
+    std::vector<std::uint32_t> labels(w * h, 0);
+    std::uint32_t next = 0;
+    std::queue<std::size_t> queue;
+    for (std::size_t start = 0; start < w * h; ++start) {
+        if (!fillable[start] || labels[start] != 0) continue;
+        labels[start] = ++next;
+        queue.push(start);
+        while (!queue.empty()) {
+            const std::size_t i = queue.front();
+            queue.pop();
+            const std::size_t x = i % w;
+            const std::size_t y = i / w;
+            const auto visit = [&](std::size_t j) {
+                if (fillable[j] && labels[j] == 0) {
+                    labels[j] = next;
+                    queue.push(j);
+                }
+            };
+            if (x > 0) visit(i - 1);
+            if (x + 1 < w) visit(i + 1);
+            if (y > 0) visit(i - w);
+            if (y + 1 < h) visit(i + w);
+        }
+    }
+    if (count != nullptr) *count = next;
+    return labels;
+}
+
+RgbImage side_by_side(const std::vector<Panel>& panels) {
+    if (panels.empty()) return {};
+    const int pw = panels.front().image.width;
+    const int ph = panels.front().image.height;
+    const int scale = std::max(1, pw / 320);
+    const int caption_h = 7 * scale + 2 * kGap;
+    RgbImage out;
+    out.width = int(panels.size()) * pw + (int(panels.size()) + 1) * kGap;
+    out.height = ph + caption_h + kGap;
+    out.rgb.assign(std::size_t(out.width) * std::size_t(out.height) * 3, kBackground);
+    for (std::size_t p = 0; p < panels.size(); ++p) {
+        const int x0 = kGap + int(p) * (pw + kGap);
+        draw_text(out, x0, kGap, scale, panels[p].caption);
+        const RgbImage& img = panels[p].image;
+        for (int y = 0; y < std::min(ph, img.height); ++y) {
+            const auto src = img.rgb.begin() + 3 * std::ptrdiff_t(y) * img.width;
+            std::copy(src, src + 3 * std::min(pw, img.width),
+                      out.rgb.begin() + 3 * (std::ptrdiff_t(y + caption_h) * out.width + x0));
+        }
+    }
+    return out;
+}
+
+void write_png(const std::string& path, const RgbImage& image) {
+    io::write_png_rgb(path, image.rgb.data(), image.width, image.height);
+}
+
+}  // namespace pyrseg::cli

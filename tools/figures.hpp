@@ -1,0 +1,33 @@
+#pragma once
+// Pictures for people: coloured labels, the fillable mask, plain connected components for comparison, and
+// captioned side-by-side figures (like the paper's Figure 3).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pyrseg::cli {
+
+struct RgbImage {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgb;  // 3 bytes per pixel
+};
+
+[[nodiscard]] RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int height);
+[[nodiscard]] RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height);
+
+// Plain 4-connected components of the fillable mask (no pyramid): what bridges do to ordinary labelling.
+// Labels are 1..count in row-major order of first appearance.
+[[nodiscard]] std::vector<std::uint32_t> connected_components(const std::vector<std::uint8_t>& fillable, int width,
+                                                              int height, std::uint32_t* count);
+
+struct Panel {
+    std::string caption;
+    RgbImage image;
+};
+// Panels side by side (all the same size), each under its caption, on a dark background.
+[[nodiscard]] RgbImage side_by_side(const std::vector<Panel>& panels);
+
+void write_png(const std::string& path, const RgbImage& image);
+
+}  // namespace pyrseg::cli

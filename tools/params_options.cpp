@@ -1,0 +1,39 @@
+#include <set>
+#include <string>
+
+#include "tools/commands.hpp"
+
+namespace pyrseg::cli {
+
+const char* const kParameterHelp =
+    "Segmentation parameters (defaults from the algorithm contract, docs/algorithm.md):\n"
+    "  --ct RADIANS          curvature threshold: neighbouring normals more than this angle apart (on average)\n"
+    "                        make an edge. Default 0.25; >= 3.1416 disables curvature edges.\n"
+    "  --dt MM               depth threshold in millimetres: a spread of neighbour depth differences above this\n"
+    "                        makes an edge. Default 10.\n"
+    "  --unit-mm U           millimetres per input unit: 1 for millimetres (default), 1000 for metres.\n"
+    "  --bridge-levels B     pyramid levels below full resolution at which seeds stop being created (default 2;\n"
+    "                        3 for scenes with many bridges).\n"
+    "  --unjoinable-gap G    levels between the seeding level and the level whose regions never merge (default 2).\n"
+    "  --normal-radius R     neighbour distance in pixels for estimated normals (default 1); larger smooths noise.\n"
+    "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
+    "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
+
+const std::set<std::string> kParameterValueOptions = {"ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap",
+                                                      "normal-radius"};
+const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
+
+Params parse_params(const Args& args) {
+    Params p;
+    if (auto v = args.number("ct")) p.ct = *v;
+    if (auto v = args.number("dt")) p.dt = *v;
+    if (auto v = args.number("unit-mm")) p.unit_mm = *v;
+    if (auto v = args.integer("bridge-levels")) p.bridge_levels = *v;
+    if (auto v = args.integer("unjoinable-gap")) p.unjoinable_gap = *v;
+    if (auto v = args.integer("normal-radius")) p.normal_radius = *v;
+    p.label_edges = !args.flag("no-label-edges");
+    p.compact = !args.flag("raw");
+    return p;
+}
+
+}  // namespace pyrseg::cli
