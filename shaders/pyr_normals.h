@@ -43,21 +43,13 @@ PYR_FN pyr_i32 pyr_shift_magnitude(pyr_i32 v, pyr_i32 s) {
     return v < 0 ? -m : m;
 }
 
-/* floor(sqrt(n)), exact. */
+/* floor(sqrt(n)), exact for n < 3 * 2^30: a float estimate (whatever the device's sqrt accuracy) corrected with
+ * integer comparisons; (r + 1)^2 stays below 2^32 in this range. */
 PYR_FN pyr_u32 pyr_isqrt(pyr_u32 n) {
-    pyr_u32 root = 0u;
-    pyr_u32 bit = 1u << 30;
-    while (bit > n) bit >>= 2;
-    while (bit != 0u) {
-        if (n >= root + bit) {
-            n -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-        bit >>= 2;
-    }
-    return root;
+    pyr_u32 r = PYR_U32(PYR_SQRT(PYR_F32(n)));
+    while (r * r > n) --r;
+    while ((r + 1u) * (r + 1u) <= n) ++r;
+    return r;
 }
 
 /* |d| * 8192 / len rounded half up, sign kept; len >= |d| so the magnitude is at most 8192. */

@@ -21,6 +21,7 @@
 #define PYR_FLOAT_BITS(f) floatBitsToInt(f)
 #define PYR_RINT(f) roundEven(f)
 #define PYR_FABS(f) abs(f)
+#define PYR_SQRT(f) sqrt(f)
 #define PYR_MSB(u) findMSB(u)
 #define PYR_PRECISE precise
 #define PYR_STRUCT(name) struct name
@@ -38,6 +39,7 @@
 #define PYR_FLOAT_BITS(f) as_int(f)
 #define PYR_RINT(f) rint(f)
 #define PYR_FABS(f) fabs(f)
+#define PYR_SQRT(f) sqrt(f)
 #define PYR_MSB(u) (31 - (int)clz((uint)(u)))
 #define PYR_PRECISE
 #define PYR_STRUCT(name) typedef struct name
@@ -61,6 +63,7 @@
 #endif
 #define PYR_RINT(f) rintf(f)
 #define PYR_FABS(f) fabsf(f)
+#define PYR_SQRT(f) sqrtf(f)
 #define PYR_PRECISE
 #define PYR_STRUCT(name) struct name
 #define PYR_STRUCT_END(name) ;
@@ -79,6 +82,7 @@
 #define PYR_FLOAT_BITS(f) std::bit_cast<std::int32_t>(static_cast<float>(f))
 #define PYR_RINT(f) std::nearbyint(f)
 #define PYR_FABS(f) std::fabs(f)
+#define PYR_SQRT(f) std::sqrt(f)
 #define PYR_MSB(u) (static_cast<std::int32_t>(std::bit_width(static_cast<std::uint32_t>(u))) - 1)
 #define PYR_PRECISE
 #define PYR_STRUCT(name) struct name

@@ -79,6 +79,16 @@ inline const std::vector<std::string>& all_backend_names() {
     return names;
 }
 
+// The backends that can run here: the suites are instantiated for these. Each unavailable one is reported once,
+// as a skipped Availability test carrying the reason (tests/conformance/test_availability.cpp).
+inline std::vector<std::string> available_backend_names() {
+    std::vector<std::string> names;
+    for (const BackendInfo& b : list_backends()) {
+        if (b.available) names.push_back(b.name);
+    }
+    return names;
+}
+
 inline std::string shared_data_dir() { return PYRSEG_SHARED_DATA_DIR; }
 
 }  // namespace pyrseg::test
