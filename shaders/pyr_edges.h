@@ -6,7 +6,7 @@
 #include "pyr_types.h"
 
 PYR_FN pyr_u32 pyr_edge_candidate(PYR_CTX_PARAM, pyr_u32 j, pyr_u32 best) {
-    pyr_u32 label = PYR_MASK(j) != 0u ? PYR_LABEL(j) : 0u;
+    pyr_u32 label = (PYR_MASK(j) & PYR_MASK_FILLABLE) != 0u ? PYR_LABEL(j) : 0u;
     return (label != 0u && (best == 0u || label < best)) ? label : best;
 }
 
@@ -14,7 +14,7 @@ PYR_FN pyr_u32 pyr_edge_label(PYR_CTX_PARAM, PyrLevel level, pyr_u32 x, pyr_u32 
     pyr_u32 local = y * level.width + x;
     pyr_u32 i = level.offset + local;
     pyr_u32 own = PYR_LABEL(i);
-    if (PYR_MASK(i) != 0u || own != 0u || PYR_VALID(local) == 0u) return own;
+    if ((PYR_MASK(i) & PYR_MASK_FILLABLE) != 0u || own != 0u || PYR_VALID(local) == 0u) return own;
     pyr_u32 best = 0u;
     if (x > 0u) best = pyr_edge_candidate(PYR_CTX_ARG, i - 1u, best);
     if (x + 1u < level.width) best = pyr_edge_candidate(PYR_CTX_ARG, i + 1u, best);

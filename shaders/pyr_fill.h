@@ -6,33 +6,39 @@
 #define PYR_FILL_H
 #include "pyr_types.h"
 
-/* anchor_max: labels 1..anchor_max are old and their texels anchored (0 in step 2: nothing is anchored). */
-PYR_FN pyr_u32 pyr_fill_relax(pyr_u32 self_label, pyr_u32 nb_label, pyr_u32 nb_fillable, pyr_u32 anchor_max) {
-    if (nb_fillable == 0u || nb_label == 0u) return self_label;
-    if (self_label != 0u && self_label <= anchor_max) return self_label;
+/* Step 4 anchors are fixed by the labels after step 3, not by labels adopted during the fill (a texel that has
+ * just taken an old label must still take a smaller one): a fillable texel whose label is old (1..anchor_max) gets
+ * PYR_MASK_ANCHORED in its mask before the fill starts. Returns the texel's new mask value. */
+PYR_FN pyr_u32 pyr_anchor_mask(pyr_u32 mask, pyr_u32 label, pyr_u32 anchor_max) {
+    return ((mask & PYR_MASK_FILLABLE) != 0u && label != 0u && label <= anchor_max) ? (mask | PYR_MASK_ANCHORED)
+                                                                                    : mask;
+}
+
+PYR_FN pyr_u32 pyr_fill_relax(pyr_u32 self_label, pyr_u32 self_mask, pyr_u32 nb_label, pyr_u32 nb_mask) {
+    if ((self_mask & PYR_MASK_ANCHORED) != 0u) return self_label;
+    if ((nb_mask & PYR_MASK_FILLABLE) == 0u || nb_label == 0u) return self_label;
     return (self_label == 0u || nb_label < self_label) ? nb_label : self_label;
 }
 
-PYR_FN pyr_u32 pyr_fill_once(pyr_u32 self_label, pyr_u32 nb_label, pyr_u32 nb_fillable) {
-    return (self_label == 0u && nb_fillable != 0u) ? nb_label : self_label;
+PYR_FN pyr_u32 pyr_fill_once(pyr_u32 self_label, pyr_u32 nb_label, pyr_u32 nb_mask) {
+    return (self_label == 0u && (nb_mask & PYR_MASK_FILLABLE) != 0u) ? nb_label : self_label;
 }
 
 /* One sweep along a line of `count` texels starting at buffer index `start`, `step` apart (step may be the
  * two's-complement of a negative stride: unsigned arithmetic wraps). Each update is visible to the next texel.
  * Needs PYR_MASK, PYR_LABEL, PYR_STORE_LABEL. Returns 1 when a label changed. once != 0 selects step 6. */
-PYR_FN pyr_u32 pyr_sweep_line(PYR_CTX_PARAM, pyr_u32 start, pyr_u32 step, pyr_u32 count, pyr_u32 anchor_max,
-                              pyr_u32 once) {
+PYR_FN pyr_u32 pyr_sweep_line(PYR_CTX_PARAM, pyr_u32 start, pyr_u32 step, pyr_u32 count, pyr_u32 once) {
     pyr_u32 changed = 0u;
     pyr_u32 prev = start;
     pyr_u32 prev_label = PYR_LABEL(prev);
-    pyr_u32 prev_fillable = PYR_MASK(prev);
+    pyr_u32 prev_mask = PYR_MASK(prev);
     for (pyr_u32 n = 1u; n < count; ++n) {
         pyr_u32 i = prev + step;
-        pyr_u32 fillable = PYR_MASK(i);
+        pyr_u32 mask = PYR_MASK(i);
         pyr_u32 label = PYR_LABEL(i);
-        if (fillable != 0u) {
-            pyr_u32 next = once != 0u ? pyr_fill_once(label, prev_label, prev_fillable)
-                                      : pyr_fill_relax(label, prev_label, prev_fillable, anchor_max);
+        if ((mask & PYR_MASK_FILLABLE) != 0u) {
+            pyr_u32 next = once != 0u ? pyr_fill_once(label, prev_label, prev_mask)
+                                      : pyr_fill_relax(label, mask, prev_label, prev_mask);
             if (next != label) {
                 PYR_STORE_LABEL(i, next);
                 label = next;
@@ -41,7 +47,7 @@ PYR_FN pyr_u32 pyr_sweep_line(PYR_CTX_PARAM, pyr_u32 start, pyr_u32 step, pyr_u3
         }
         prev = i;
         prev_label = label;
-        prev_fillable = fillable;
+        prev_mask = mask;
     }
     return changed;
 }

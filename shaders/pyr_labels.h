@@ -8,7 +8,7 @@ PYR_FN pyr_u32 pyr_label_init_texel(PYR_CTX_PARAM, PyrLevel level, PyrLevel pare
                                     pyr_u32 mode) {
     pyr_u32 local = y * level.width + x;
     pyr_u32 i = level.offset + local;
-    if (PYR_MASK(i) == 0u) return 0u;
+    if ((PYR_MASK(i) & PYR_MASK_FILLABLE) == 0u) return 0u;
     if (mode == PYR_INIT_PIXEL_INDEX) return local + 1u;
     pyr_u32 inherited = 0u;
     if (parent.width != 0u) inherited = PYR_LABEL(parent.offset + (y >> 1) * parent.width + (x >> 1));

@@ -10,7 +10,7 @@ PYR_FN pyr_u32 pyr_mip_texel(PYR_CTX_PARAM, PyrLevel child, pyr_u32 x, pyr_u32 y
     if (cx + 1u >= child.width || cy + 1u >= child.height) return 0u;
     pyr_u32 top = child.offset + cy * child.width + cx;
     pyr_u32 bottom = top + child.width;
-    return PYR_MASK(top) & PYR_MASK(top + 1u) & PYR_MASK(bottom) & PYR_MASK(bottom + 1u);
+    return PYR_MASK(top) & PYR_MASK(top + 1u) & PYR_MASK(bottom) & PYR_MASK(bottom + 1u) & PYR_MASK_FILLABLE;
 }
 
 #endif /* PYR_MIP_H */

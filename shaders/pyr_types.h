@@ -29,6 +29,10 @@ PYR_STRUCT(PyrQuant) {
 #define PYR_NORMAL_SCALE 8192.0f
 #define PYR_NORMAL_UNIT 0.0001220703125f /* 2^-13, exact */
 
+/* Mask bits of a texel. Only the fill at level N-1 (step 4) sets the anchor bit. */
+#define PYR_MASK_FILLABLE 1u
+#define PYR_MASK_ANCHORED 2u
+
 /* Label init modes (contract section 5). */
 #define PYR_INIT_NEW 0u         /* steps 1: parent's label, else a new one */
 #define PYR_INIT_INHERIT 1u     /* steps 3 and 5: parent's label, maybe 0 */

@@ -113,11 +113,20 @@ public:
     }
 
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
-        while (sweep(plan_.level(level), anchor_max, false)) {
+        const PyrLevel lv = plan_.level(level);
+        if (anchor_max != 0) {
+            rows(lv.height, [&](size_t y) {
+                const size_t row = lv.offset + y * lv.width;
+                for (size_t i = row; i < row + lv.width; ++i) {
+                    mask_[i] = std::uint8_t(kernels::pyr_anchor_mask(mask_[i], labels_[i], anchor_max));
+                }
+            });
+        }
+        while (sweep(lv, false)) {
         }
     }
 
-    void fill_once(int level) override { sweep(plan_.level(level), 0, true); }
+    void fill_once(int level) override { sweep(plan_.level(level), true); }
 
     void label_edges() override {
         const PassContext c = context();
@@ -216,14 +225,14 @@ private:
 
     // One round of the four directional sweeps (rows left-right then right-left, then columns top-down then
     // bottom-up). Rows are independent, and so are columns: each runs in parallel. Returns whether a label changed.
-    bool sweep(const PyrLevel& lv, uint32_t anchor_max, bool once) {
+    bool sweep(const PyrLevel& lv, bool once) {
         const PassContext c = context();
         const uint32_t onceu = once ? 1u : 0u;
         std::atomic<bool> changed{false};
         rows(lv.height, [&](size_t y) {
             const uint32_t start = lv.offset + uint32_t(y) * lv.width;
-            uint32_t ch = kernels::pyr_sweep_line(c, start, 1u, lv.width, anchor_max, onceu);
-            ch |= kernels::pyr_sweep_line(c, start + lv.width - 1u, ~0u, lv.width, anchor_max, onceu);
+            uint32_t ch = kernels::pyr_sweep_line(c, start, 1u, lv.width, onceu);
+            ch |= kernels::pyr_sweep_line(c, start + lv.width - 1u, ~0u, lv.width, onceu);
             if (ch != 0u) changed.store(true, std::memory_order_relaxed);
         });
         const size_t blocks = (size_t(lv.width) + kColumnBlock - 1) / kColumnBlock;
@@ -232,25 +241,25 @@ private:
             const uint32_t x1 = uint32_t(std::min(size_t(lv.width), b1 * kColumnBlock));
             bool ch = false;
             // Row by row, each column's sequential order is kept: row y reads row y -/+ 1 already updated.
-            for (uint32_t y = 1; y < lv.height; ++y) ch |= column_step(c, lv, y, y - 1, x0, x1, anchor_max, once);
-            for (uint32_t y = lv.height - 1; y-- > 0;) ch |= column_step(c, lv, y, y + 1, x0, x1, anchor_max, once);
+            for (uint32_t y = 1; y < lv.height; ++y) ch |= column_step(c, lv, y, y - 1, x0, x1, once);
+            for (uint32_t y = lv.height - 1; y-- > 0;) ch |= column_step(c, lv, y, y + 1, x0, x1, once);
             if (ch) changed.store(true, std::memory_order_relaxed);
         });
         return changed.load();
     }
 
     bool column_step(const PassContext& c, const PyrLevel& lv, uint32_t y, uint32_t from_y, uint32_t x0, uint32_t x1,
-                     uint32_t anchor_max, bool once) {
+                     bool once) {
         const uint32_t row = lv.offset + y * lv.width;
         const uint32_t from = lv.offset + from_y * lv.width;
         const std::uint8_t* m = c.mask;
         uint32_t* l = c.labels;
         bool ch = false;
         for (uint32_t x = x0; x < x1; ++x) {
-            if (m[row + x] == 0) continue;
+            if ((m[row + x] & PYR_MASK_FILLABLE) == 0) continue;
             const uint32_t cur = l[row + x];
             const uint32_t next = once ? kernels::pyr_fill_once(cur, l[from + x], m[from + x])
-                                       : kernels::pyr_fill_relax(cur, l[from + x], m[from + x], anchor_max);
+                                       : kernels::pyr_fill_relax(cur, m[row + x], l[from + x], m[from + x]);
             if (next != cur) {
                 l[row + x] = next;
                 ch = true;

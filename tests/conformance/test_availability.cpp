@@ -17,7 +17,7 @@ TEST_P(Availability, BackendRunsHereOrSaysWhyNot) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Availability, ::testing::ValuesIn(all_backend_names()),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace pyrseg::test

@@ -74,8 +74,8 @@ INSTANTIATE_TEST_SUITE_P(
     Backends, SyntheticScenes,
     ::testing::Combine(::testing::ValuesIn(available_backend_names()),
                        ::testing::Range(0, int(conformance_cases().size()))),
-    [](const ::testing::TestParamInfo<SyntheticScenes::ParamType>& info) {
-        return std::get<0>(info.param) + "_" + conformance_cases()[std::size_t(std::get<1>(info.param))].name;
+    [](const ::testing::TestParamInfo<SyntheticScenes::ParamType>& param_info) {
+        return std::get<0>(param_info.param) + "_" + conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
     });
 
 class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
@@ -99,10 +99,10 @@ INSTANTIATE_TEST_SUITE_P(Backends, RealScans,
                          ::testing::Combine(::testing::ValuesIn(available_backend_names()),
                                             ::testing::Values("table_scene_mug_stereo_textured.pcd",
                                                               "milk_cartoon_all_small_clorox.pcd")),
-                         [](const ::testing::TestParamInfo<RealScans::ParamType>& info) {
-                             std::string file = std::get<1>(info.param);
+                         [](const ::testing::TestParamInfo<RealScans::ParamType>& param_info) {
+                             std::string file = std::get<1>(param_info.param);
                              file = file.substr(0, file.find('.'));
-                             return std::get<0>(info.param) + "_" + file;
+                             return std::get<0>(param_info.param) + "_" + file;
                          });
 
 }  // namespace

@@ -126,6 +126,21 @@ TEST_P(HandCases, YoungRegionBetweenTwoOldOnesJoinsTheSmallerLabel) {
     EXPECT_EQ(r.segment_count, 2u);
 }
 
+// Anchors are the texels whose label is old after step 3, not texels that adopt an old label during the fill:
+// a corridor reached first (left to right) by the larger old label must still end with the smaller one.
+TEST_P(HandCases, AnchorsAreFixedBeforeTheFillStarts) {
+    Mask m(128, 64);
+    m.fill_rect(0, 16, 47, 63);   // B: its first level-U texel is in the second texel row
+    m.fill_rect(80, 0, 127, 47);  // A: starts in the first texel row, so its label is smaller
+    m.fill_rect(48, 30, 79, 31);  // a 2-pixel corridor, visible at level N-1 only
+    const Result r = run(m);
+    const std::uint32_t a = r.raw_labels[m.at(100, 10)];
+    const std::uint32_t b = r.raw_labels[m.at(10, 50)];
+    ASSERT_LT(a, b);
+    EXPECT_EQ(r.raw_labels[m.at(50, 30)], a) << "the corridor kept the larger label it met first";
+    EXPECT_EQ(r.raw_labels[m.at(78, 31)], a);
+}
+
 // Step 6 is one iteration in a fixed order: rows (left-right, right-left), then columns (down, up). Thin
 // full-resolution-only paths show the order: a pixel needing a column move before a row move stays unlabelled.
 TEST_P(HandCases, FinalFillFollowsTheRowThenColumnSchedule) {
@@ -225,7 +240,7 @@ TEST_P(HandCases, AnEmptyMaskHasNoSegments) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, HandCases, ::testing::ValuesIn(available_backend_names()),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace pyrseg::test
