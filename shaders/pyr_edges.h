@@ -11,10 +11,10 @@ PYR_FN pyr_u32 pyr_edge_candidate(PYR_CTX_PARAM, pyr_u32 j, pyr_u32 best) {
 }
 
 PYR_FN pyr_u32 pyr_edge_label(PYR_CTX_PARAM, PyrLevel level, pyr_u32 x, pyr_u32 y) {
-    pyr_u32 local = y * level.width + x;
-    pyr_u32 i = level.offset + local;
+    pyr_u32 pixel = y * level.width + x;
+    pyr_u32 i = level.offset + pixel;
     pyr_u32 own = PYR_LABEL(i);
-    if ((PYR_MASK(i) & PYR_MASK_FILLABLE) != 0u || own != 0u || PYR_VALID(local) == 0u) return own;
+    if ((PYR_MASK(i) & PYR_MASK_FILLABLE) != 0u || own != 0u || PYR_VALID(pixel) == 0u) return own;
     pyr_u32 best = 0u;
     if (x > 0u) best = pyr_edge_candidate(PYR_CTX_ARG, i - 1u, best);
     if (x + 1u < level.width) best = pyr_edge_candidate(PYR_CTX_ARG, i + 1u, best);

@@ -6,10 +6,10 @@
 
 PYR_FN pyr_u32 pyr_label_init_texel(PYR_CTX_PARAM, PyrLevel level, PyrLevel parent, pyr_u32 x, pyr_u32 y,
                                     pyr_u32 mode) {
-    pyr_u32 local = y * level.width + x;
-    pyr_u32 i = level.offset + local;
+    pyr_u32 pixel = y * level.width + x;
+    pyr_u32 i = level.offset + pixel;
     if ((PYR_MASK(i) & PYR_MASK_FILLABLE) == 0u) return 0u;
-    if (mode == PYR_INIT_PIXEL_INDEX) return local + 1u;
+    if (mode == PYR_INIT_PIXEL_INDEX) return pixel + 1u;
     pyr_u32 inherited = 0u;
     if (parent.width != 0u) inherited = PYR_LABEL(parent.offset + (y >> 1) * parent.width + (x >> 1));
     if (inherited != 0u || mode == PYR_INIT_INHERIT) return inherited;

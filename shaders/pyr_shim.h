@@ -4,6 +4,9 @@
  *    (PYR_PT, PYR_Q_VALID, PYR_QN, PYR_QZ, PYR_MASK, PYR_LABEL, PYR_STORE_LABEL, PYR_VALID) and the context
  *    parameter PYR_CTX_PARAM / argument PYR_CTX_ARG that carries whatever those macros need;
  *  - casts only through PYR_I32 / PYR_U32 / PYR_F32, structs only through PYR_STRUCT / PYR_STRUCT_END;
+ *  - entry points name their buffers pyr_buf_* (a prefix shared code never uses), so that no local variable of
+ *    shared code can shadow a buffer an accessor macro refers to; shared code avoids the keywords of all four
+ *    languages (OpenCL C: local, global, constant, private, kernel; GLSL: input, output, sample, filter, ...);
  *  - no bool in structs, no recursion, no overloading, integer literals with a u suffix where unsigned;
  *  - float expressions that decide a result are PYR_PRECISE (GLSL `precise`; contraction is off elsewhere).
  */
@@ -27,7 +30,7 @@
 #define PYR_STRUCT(name) struct name
 #define PYR_STRUCT_END(name) ;
 
-#elif defined(__OPENCL_VERSION__)
+#elif defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)
 #pragma OPENCL FP_CONTRACT OFF
 #define PYR_FN static inline
 #define pyr_i32 int

@@ -1,0 +1,50 @@
+#version 450
+// Compiles every shared pass function as GLSL (glslangValidator -> SPIR-V, then spirv-val), with accessors over
+// storage buffers, to keep shaders/ within the dialect. Not a backend: Vulkan entry points come with issue #4.
+#extension GL_GOOGLE_include_directive : require
+#define PYR_GLSL 1
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 0) readonly buffer Points { float pyr_buf_points[]; };
+layout(std430, binding = 1) readonly buffer Quant { int pyr_buf_quant[]; };
+layout(std430, binding = 2) buffer Mask { uint pyr_buf_mask[]; };
+layout(std430, binding = 3) buffer Labels { uint pyr_buf_labels[]; };
+layout(std430, binding = 4) readonly buffer Lut { uint pyr_buf_lut[]; };
+layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
+#define PYR_CTX_PARAM uint pyr_ctx_unused
+#define PYR_CTX_ARG 0u
+#define PYR_PT(x, y, c) pyr_buf_points[((y) * 64u + (x)) * 3u + (c)]
+#define PYR_Q_VALID(i) uint(pyr_buf_quant[(i) * 4u + 3u])
+#define PYR_QN(i, c) pyr_buf_quant[(i) * 4u + (c)]
+#define PYR_QZ(i) pyr_buf_points[(i) * 3u + 2u]
+#define PYR_MASK(i) pyr_buf_mask[i]
+#define PYR_LABEL(i) pyr_buf_labels[i]
+#define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
+#define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
+#define PYR_LUT(l) pyr_buf_lut[l]
+#include "pyr_compact.h"
+#include "pyr_edges.h"
+#include "pyr_fill.h"
+#include "pyr_labels.h"
+#include "pyr_metric.h"
+#include "pyr_mip.h"
+#include "pyr_normals.h"
+#include "pyr_quantize.h"
+
+void main() {
+    uint x = gl_GlobalInvocationID.x;
+    uint y = gl_GlobalInvocationID.y;
+    PyrLevel lv;
+    lv.width = 64u;
+    lv.height = 64u;
+    lv.offset = 0u;
+    PyrIVec3 q = pyr_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 1u);
+    PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
+    uint r = pyr_metric_fillable(PYR_CTX_ARG, 64u, 64u, x, y, 100, 1.0f);
+    r += pyr_mip_texel(PYR_CTX_ARG, lv, x, y);
+    r += pyr_label_init_texel(PYR_CTX_ARG, lv, lv, x, y, PYR_INIT_NEW);
+    r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);
+    r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
+    r += pyr_edge_label(PYR_CTX_ARG, lv, x, y);
+    r += pyr_compact_label(PYR_CTX_ARG, 3u);
+    outv[y * 64u + x] = q.x + qu.qz + int(r);
+}

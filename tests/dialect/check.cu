@@ -1,0 +1,44 @@
+// Compiles every shared pass function as CUDA device code (nvcc), with accessors over device pointers, to keep
+// shaders/ within the dialect. Not a backend: the CUDA kernels come with issue #5.
+struct Ctx {
+    const float* pts;
+    const int* quant;
+    unsigned* mask;
+    unsigned* labels;
+    const unsigned* lut;
+};
+#define PYR_CTX_PARAM const Ctx& ctx
+#define PYR_CTX_ARG ctx
+#define PYR_PT(x, y, c) ctx.pts[((y) * 64u + (x)) * 3u + (c)]
+#define PYR_Q_VALID(i) static_cast<unsigned>(ctx.quant[(i) * 4u + 3u])
+#define PYR_QN(i, c) ctx.quant[(i) * 4u + (c)]
+#define PYR_QZ(i) ctx.pts[(i) * 3u + 2u]
+#define PYR_MASK(i) ctx.mask[i]
+#define PYR_LABEL(i) ctx.labels[i]
+#define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
+#define PYR_VALID(p) static_cast<unsigned>(ctx.quant[(p) * 4u + 3u])
+#define PYR_LUT(l) ctx.lut[l]
+#include "pyr_compact.h"
+#include "pyr_edges.h"
+#include "pyr_fill.h"
+#include "pyr_labels.h"
+#include "pyr_metric.h"
+#include "pyr_mip.h"
+#include "pyr_normals.h"
+#include "pyr_quantize.h"
+
+__global__ void all_passes(Ctx ctx, int* out) {
+    const unsigned x = blockIdx.x * blockDim.x + threadIdx.x;
+    const unsigned y = blockIdx.y * blockDim.y + threadIdx.y;
+    PyrLevel lv{64u, 64u, 0u};
+    const PyrIVec3 q = pyr_normal_q(ctx, 64u, 64u, x, y, 1u);
+    const PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
+    unsigned r = pyr_metric_fillable(ctx, 64u, 64u, x, y, 100, 1.0f);
+    r += pyr_mip_texel(ctx, lv, x, y);
+    r += pyr_label_init_texel(ctx, lv, lv, x, y, PYR_INIT_NEW);
+    r += pyr_sweep_line(ctx, y * 64u, 1u, 64u, 0u);
+    r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
+    r += pyr_edge_label(ctx, lv, x, y);
+    r += pyr_compact_label(ctx, 3u);
+    out[y * 64u + x] = q.x + qu.qz + static_cast<int>(r);
+}

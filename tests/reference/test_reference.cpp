@@ -1,0 +1,1046 @@
+// Tests of the oracle itself. Every expected value here was derived by hand from the algorithm contract and
+// docs/algorithm.md (the derivations are sketched in the comments) and is written as a literal, never computed by the
+// oracle, so a mistake in the oracle cannot hide behind itself.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <queue>
+#include <string>
+#include <vector>
+
+#include "reference/reference.hpp"
+
+namespace {
+
+using pyrseg_ref::Output;
+using pyrseg_ref::Params;
+
+// A picture: one string per row, '#' fillable, anything else not.
+std::vector<std::uint8_t> mask_of(const std::vector<std::string>& rows) {
+    std::vector<std::uint8_t> out;
+    for (const std::string& row : rows) {
+        for (char c : row) out.push_back(c == '#' ? 1 : 0);
+    }
+    return out;
+}
+
+// Expected labels as a picture: '.' is 0, every other character is looked up in the legend.
+std::vector<std::uint32_t> labels_of(const std::vector<std::string>& rows,
+                                     const std::map<char, std::uint32_t>& legend) {
+    std::vector<std::uint32_t> out;
+    for (const std::string& row : rows) {
+        for (char c : row) out.push_back(c == '.' ? 0u : legend.at(c));
+    }
+    return out;
+}
+
+std::string grid(const std::vector<std::uint32_t>& v, int width) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        s += std::to_string(v[i]);
+        s += (static_cast<int>(i % static_cast<std::size_t>(width)) == width - 1) ? "\n" : " ";
+    }
+    return s;
+}
+
+#define EXPECT_LABELS(actual, expected, width) \
+    EXPECT_EQ(actual, expected) << "actual:\n" << grid(actual, width) << "expected:\n" << grid(expected, width)
+
+int width_of(const std::vector<std::string>& rows) {
+    return static_cast<int>(rows.front().size());
+}
+int height_of(const std::vector<std::string>& rows) {
+    return static_cast<int>(rows.size());
+}
+
+// Number of 4-connected components of a mask: only to show that plain connected-component labelling would merge.
+int plain_components(const std::vector<std::uint8_t>& mask, int w, int h) {
+    std::vector<std::uint8_t> seen(mask.size(), 0);
+    int count = 0;
+    for (std::size_t s = 0; s < mask.size(); ++s) {
+        if (mask[s] == 0 || seen[s] != 0) continue;
+        ++count;
+        std::queue<std::size_t> todo;
+        todo.push(s);
+        seen[s] = 1;
+        while (!todo.empty()) {
+            const std::size_t t = todo.front();
+            todo.pop();
+            const int x = static_cast<int>(t % static_cast<std::size_t>(w));
+            const int y = static_cast<int>(t / static_cast<std::size_t>(w));
+            const int nx[4] = {x - 1, x + 1, x, x};
+            const int ny[4] = {y, y, y - 1, y + 1};
+            for (int k = 0; k < 4; ++k) {
+                if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
+                const auto n = static_cast<std::size_t>(ny[k] * w + nx[k]);
+                if (mask[n] != 0 && seen[n] == 0) {
+                    seen[n] = 1;
+                    todo.push(n);
+                }
+            }
+        }
+    }
+    return count;
+}
+
+Output run_mask(const std::vector<std::string>& rows, const Params& p,
+                const std::vector<std::uint8_t>* valid = nullptr) {
+    const std::vector<std::uint8_t> mask = mask_of(rows);
+    return pyrseg_ref::segment_mask(mask.data(), valid != nullptr ? valid->data() : nullptr, width_of(rows),
+                                    height_of(rows), p);
+}
+
+Params explicit_bg(int b, int g) {
+    Params p;
+    p.bridge_levels = b;
+    p.unjoinable_gap = g;
+    p.bg_explicit = true;
+    return p;
+}
+
+// Points (x, y, z) on a grid; z from a function of the pixel.
+template <typename Fn>
+std::vector<float> grid_points(int w, int h, Fn z_of) {
+    std::vector<float> pts;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            pts.push_back(static_cast<float>(x));
+            pts.push_back(static_cast<float>(y));
+            pts.push_back(z_of(x, y));
+        }
+    }
+    return pts;
+}
+
+std::vector<float> constant_normals(int count, float nx, float ny, float nz) {
+    std::vector<float> n;
+    for (int i = 0; i < count; ++i) {
+        n.push_back(nx);
+        n.push_back(ny);
+        n.push_back(nz);
+    }
+    return n;
+}
+
+std::vector<float> normal_at(const std::vector<float>& normals, int w, int x, int y) {
+    const auto i = static_cast<std::size_t>(3 * (y * w + x));
+    return {normals[i], normals[i + 1], normals[i + 2]};
+}
+
+std::vector<float> q13(int qx, int qy, int qz) {
+    return {static_cast<float>(qx) / 8192.0f, static_cast<float>(qy) / 8192.0f, static_cast<float>(qz) / 8192.0f};
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Small-image fallback: plain 4-connected components labelled 1 + smallest row-major index, no edge labelling.
+
+TEST(ReferenceFallback, OneByOne) {
+    const Params p;
+    Output on = run_mask({"#"}, p);
+    ASSERT_TRUE(on.ok) << on.error;
+    EXPECT_EQ(on.raw_labels, (std::vector<std::uint32_t>{1}));
+    EXPECT_EQ(on.labels, (std::vector<std::uint32_t>{1}));
+    EXPECT_EQ(on.segment_count, 1u);
+
+    Output off = run_mask({"."}, p);
+    ASSERT_TRUE(off.ok) << off.error;
+    EXPECT_EQ(off.labels, (std::vector<std::uint32_t>{0}));
+    EXPECT_EQ(off.segment_count, 0u);
+
+    // Through the metric: a lone pixel has no valid 8-neighbour (k = 0), so it is never fillable.
+    const float pt[3] = {0.0f, 0.0f, 1000.0f};
+    const float nrm[3] = {0.0f, 0.0f, -1.0f};
+    Output seg = pyrseg_ref::segment(pt, nrm, 1, 1, p);
+    ASSERT_TRUE(seg.ok) << seg.error;
+    EXPECT_EQ(seg.fillable, (std::vector<std::uint8_t>{0}));
+    EXPECT_EQ(seg.labels, (std::vector<std::uint32_t>{0}));
+    EXPECT_EQ(seg.segment_count, 0u);
+}
+
+TEST(ReferenceFallback, OneBySevenAndSevenByOne) {
+    const Params p;
+    // 1 x 7 (a column): components {0}, {2, 3}, {6} -> raw 1, 3, 7.
+    Output col = run_mask({"#", ".", "#", "#", ".", ".", "#"}, p);
+    ASSERT_TRUE(col.ok) << col.error;
+    EXPECT_EQ(col.raw_labels, (std::vector<std::uint32_t>{1, 0, 3, 3, 0, 0, 7}));
+    EXPECT_EQ(col.labels, (std::vector<std::uint32_t>{1, 0, 2, 2, 0, 0, 3}));
+    EXPECT_EQ(col.segment_count, 3u);
+
+    // 7 x 1 (a row): components {0, 1}, {3}, {5, 6} -> raw 1, 4, 6.
+    Output row = run_mask({"##.#.##"}, p);
+    ASSERT_TRUE(row.ok) << row.error;
+    EXPECT_EQ(row.raw_labels, (std::vector<std::uint32_t>{1, 1, 0, 4, 0, 6, 6}));
+    EXPECT_EQ(row.labels, (std::vector<std::uint32_t>{1, 1, 0, 2, 0, 3, 3}));
+
+    // Through the metric with given normals: every pixel of a flat row/column has a valid neighbour -> one segment.
+    const std::vector<float> pts = grid_points(1, 7, [](int, int) { return 500.0f; });
+    const std::vector<float> nrm = constant_normals(7, 0.0f, 0.0f, -1.0f);
+    Output seg = pyrseg_ref::segment(pts.data(), nrm.data(), 1, 7, p);
+    ASSERT_TRUE(seg.ok) << seg.error;
+    EXPECT_EQ(seg.raw_labels, (std::vector<std::uint32_t>(7, 1)));
+    const std::vector<float> pts_row = grid_points(7, 1, [](int, int) { return 500.0f; });
+    Output seg_row = pyrseg_ref::segment(pts_row.data(), nrm.data(), 7, 1, p);
+    ASSERT_TRUE(seg_row.ok) << seg_row.error;
+    EXPECT_EQ(seg_row.raw_labels, (std::vector<std::uint32_t>(7, 1)));
+}
+
+TEST(ReferenceFallback, EightByEightHasNoEdgeLabelling) {
+    // N = 4, so U = 4 - 2 - 2 = 0 < 1 with the defaults: the fallback. Components and their smallest indices:
+    // {0,1,8,9} -> 0; {4,12,20} -> 4; {24,25,26,34,42} -> 24; {38,39,46} -> 38; {56}; {63}.
+    const std::vector<std::string> mask = {
+        "##..#...",  //
+        "##..#...",  //
+        "....#...",  //
+        "###.....",  //
+        "..#...##",  //
+        "..#...#.",  //
+        "........",  //
+        "#......#",  //
+    };
+    Params p;
+    ASSERT_TRUE(p.label_edges);
+    Output out = run_mask(mask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    const std::vector<std::string> raw_pic = {
+        "aa..b...",  //
+        "aa..b...",  //
+        "....b...",  //
+        "ccc.....",  //
+        "..c...dd",  //
+        "..c...d.",  //
+        "........",  //
+        "e......f",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(raw_pic, {{'a', 1}, {'b', 5}, {'c', 25}, {'d', 39}, {'e', 57}, {'f', 64}}),
+                  8);
+    EXPECT_LABELS(out.labels, labels_of(raw_pic, {{'a', 1}, {'b', 2}, {'c', 3}, {'d', 4}, {'e', 5}, {'f', 6}}), 8);
+    EXPECT_EQ(out.segment_count, 6u);
+
+    p.compact = false;
+    Output raw = run_mask(mask, p);
+    EXPECT_EQ(raw.labels, out.raw_labels);
+}
+
+TEST(ReferenceFallback, ExplicitParametersThatDoNotFitAreRejected) {
+    const std::vector<std::string> mask(8, std::string(8, '#'));
+    Output bad = run_mask(mask, explicit_bg(2, 2));  // U = 0
+    EXPECT_FALSE(bad.ok);
+    EXPECT_FALSE(bad.error.empty());
+    EXPECT_TRUE(bad.labels.empty());
+
+    // b = g = 1 fit an 8x8 image (U = 2). All fillable -> the 1x1 level is fillable -> label 1 everywhere.
+    Output good = run_mask(mask, explicit_bg(1, 1));
+    ASSERT_TRUE(good.ok) << good.error;
+    EXPECT_EQ(good.raw_labels, (std::vector<std::uint32_t>(64, 1)));
+
+    // Huge b and g must not overflow N - b - g.
+    Output huge = run_mask(mask, explicit_bg(std::numeric_limits<int>::max(), std::numeric_limits<int>::max()));
+    EXPECT_FALSE(huge.ok);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Pyramid shape: sizes, missing children.
+
+TEST(ReferencePyramid, NineByNineMissingChildrenFilledByStepSix) {
+    // N = 5 (U = 1, no fallback). Level 4 is 5x5 but its last column/row has a missing child, so only 4x4 texels
+    // are fillable; level 3 (3x3): 2x2; level 2 (2x2): only (0,0) -> new label offset_2 + 1 = 2; level 1 not fillable.
+    // Level 5 pixels x = 8 or y = 8 have non-fillable parents (label 0) and get label 2 in step 6 (rows, then the
+    // last row by the column sweep).
+    const std::vector<std::string> mask(9, std::string(9, '#'));
+    Output out = run_mask(mask, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(81, 2)));
+    EXPECT_EQ(out.labels, (std::vector<std::uint32_t>(81, 1)));
+    EXPECT_EQ(out.segment_count, 1u);
+}
+
+TEST(ReferencePyramid, NineByOneHasNoLabelsAtAll) {
+    // max(W, H) = 9 -> N = 5, U = 1: no fallback. With H = 1 every texel of level 4 has missing children (row 1),
+    // so no coarser level has a fillable texel, no label is ever created and step 6 has nothing to spread.
+    Output out = run_mask({"#########"}, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(9, 0)));
+    EXPECT_EQ(out.segment_count, 0u);
+    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>(9, 1)));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Bridges.
+
+// 24 x 16, b = 2, g = 1: N = 6, M = 4, U = 3. Levels: 6: 24x16, 5: 12x8, 4: 6x4, 3: 3x2, 2: 2x1, 1: 1x1.
+// offsets: 0, 1, 3, 9, 33, 129. Old labels: <= offset_4 = 9.
+TEST(ReferenceBridges, OneAndTwoPixelBridgesDoNotMerge) {
+    // Two 8x8 squares (level-3 texels (0,0) -> label 4 and (2,0) -> label 6, both old) joined by a 1-px bridge (row 1)
+    // and a 2-px bridge (rows 4-5). The 2-px bridge appears on level 5 as texels (4..7, 2) with label 0 after step 3;
+    // step 4 gives that component min(4, 6) = 4. The 1-px bridge exists only at level 6 and is filled by the row
+    // sweep from the left square (label 4).
+    const std::vector<std::string> mask = {
+        "########........########",  //
+        "########################",  //
+        "########........########",  //
+        "########........########",  //
+        "########################",  //
+        "########################",  //
+        "########........########",  //
+        "########........########",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+    };
+    ASSERT_EQ(width_of(mask), 24);
+    ASSERT_EQ(plain_components(mask_of(mask), 24, 16), 1);  // plain CCL would merge the two squares
+
+    Params p = explicit_bg(2, 1);
+    p.label_edges = false;
+    Output out = run_mask(mask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    const std::vector<std::string> expected = {
+        "aaaaaaaa........bbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaa........bbbbbbbb",  //
+        "aaaaaaaa........bbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaa........bbbbbbbb",  //
+        "aaaaaaaa........bbbbbbbb",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'a', 4}, {'b', 6}}), 24);
+    EXPECT_LABELS(out.labels, labels_of(expected, {{'a', 1}, {'b', 2}}), 24);
+    EXPECT_EQ(out.segment_count, 2u);
+
+    // With edge labelling: each valid non-fillable pixel takes the smallest labelled fillable 4-neighbour.
+    p.label_edges = true;
+    Output edges = run_mask(mask, p);
+    ASSERT_TRUE(edges.ok) << edges.error;
+    const std::vector<std::string> expected_edges = {
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaaaaaaaaabbbbbbbb",  //
+        "aaaaaaaaa......bbbbbbbbb",  //
+        "aaaaaaaa........bbbbbbbb",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+    };
+    EXPECT_LABELS(edges.raw_labels, labels_of(expected_edges, {{'a', 4}, {'b', 6}}), 24);
+    EXPECT_EQ(edges.segment_count, 2u);
+}
+
+// Same geometry as above. A (x 16..23, y 0..7) is level-3 texel (2,0): label 6. B (x 0..7, y 8..15) is level-3 texel
+// (0,1): label 3 + 3 + 0 + 1 = 7. Y (x 8..11, y 4..7) is level-4 texel (2,1): young label 9 + 6 + 2 + 1 = 18.
+// Level-5 bridges: Y->A texels (6,3), (7,3) (pixels x 12..15, y 6..7); Y->B texel (4,4) (pixels x 8..9, y 8..9).
+TEST(ReferenceBridges, YoungRegionJoinsTheSmallerOldRegion) {
+    Params p = explicit_bg(2, 1);
+    p.label_edges = false;
+    const std::map<char, std::uint32_t> raw = {{'A', 6}, {'B', 7}, {'Y', 18}};
+
+    const std::vector<std::string> both = {
+        "................########",  //
+        "................########",  //
+        "................########",  //
+        "................########",  //
+        "........####....########",  //
+        "........####....########",  //
+        "........################",  //
+        "........################",  //
+        "##########..............",  //
+        "##########..............",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+    };
+    Output out = run_mask(both, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    // The non-anchored component {Y, both bridges} touches anchors 6 and 7: min(18, 6, 7) = 6. A and B stay apart.
+    const std::vector<std::string> expected_both = {
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "........AAAA....AAAAAAAA",  //
+        "........AAAA....AAAAAAAA",  //
+        "........AAAAAAAAAAAAAAAA",  //
+        "........AAAAAAAAAAAAAAAA",  //
+        "BBBBBBBBAA..............",  //
+        "BBBBBBBBAA..............",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(expected_both, raw), 24);
+    EXPECT_EQ(out.segment_count, 2u);
+
+    // Without the Y->A bridge, Y touches only B.
+    std::vector<std::string> only_b = both;
+    only_b[6] = "........####....########";
+    only_b[7] = "........####....########";
+    Output ob = run_mask(only_b, p);
+    ASSERT_TRUE(ob.ok) << ob.error;
+    const std::vector<std::string> expected_only_b = {
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "........BBBB....AAAAAAAA",  //
+        "........BBBB....AAAAAAAA",  //
+        "........BBBB....AAAAAAAA",  //
+        "........BBBB....AAAAAAAA",  //
+        "BBBBBBBBBB..............",  //
+        "BBBBBBBBBB..............",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+    };
+    EXPECT_LABELS(ob.raw_labels, labels_of(expected_only_b, raw), 24);
+}
+
+TEST(ReferenceBridges, WideBridgeMergesAtLevelM) {
+    // A 4-px bridge (x 8..15, y 0..3) is seen on level 4 (= M) as texels (2,0), (3,0) with new labels 12, 13. Step 2
+    // joins the whole level-4 component to min(4, 6, 12, 13) = 4 before anything is anchored: one segment.
+    Params p = explicit_bg(2, 1);
+    p.label_edges = false;
+    const std::vector<std::string> mask = {
+        "########################",  //
+        "########################",  //
+        "########################",  //
+        "########################",  //
+        "########........########",  //
+        "########........########",  //
+        "########........########",  //
+        "########........########",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+        "........................",  //
+    };
+    Output out = run_mask(mask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    std::vector<std::string> expected = mask;
+    for (std::string& row : expected) {
+        for (char& c : row) c = c == '#' ? 'a' : '.';
+    }
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'a', 4}}), 24);
+    EXPECT_EQ(out.segment_count, 1u);
+}
+
+TEST(ReferenceCompaction, IncreasingRawOrderNotScanOrder) {
+    // Y without bridges keeps its young label 18. In scan order Y (first pixel (8,4)) comes before B (first pixel
+    // (0,8)), but compaction follows the raw values 6 < 7 < 18. The isolated 2x2 block at (20..21, 12..13) is
+    // fillable on level 5 only, with no labelled texel anywhere near: it stays 0.
+    Params p = explicit_bg(2, 1);
+    p.label_edges = false;
+    const std::vector<std::string> mask = {
+        "................########",  //
+        "................########",  //
+        "................########",  //
+        "................########",  //
+        "........####....########",  //
+        "........####....########",  //
+        "........####....########",  //
+        "........####....########",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+        "########................",  //
+        "########............##..",  //
+        "########............##..",  //
+        "########................",  //
+        "########................",  //
+    };
+    const std::vector<std::string> expected = {
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "................AAAAAAAA",  //
+        "........YYYY....AAAAAAAA",  //
+        "........YYYY....AAAAAAAA",  //
+        "........YYYY....AAAAAAAA",  //
+        "........YYYY....AAAAAAAA",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+        "BBBBBBBB................",  //
+    };
+    Output out = run_mask(mask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'A', 6}, {'B', 7}, {'Y', 18}}), 24);
+    EXPECT_LABELS(out.labels, labels_of(expected, {{'A', 1}, {'B', 2}, {'Y', 3}}), 24);
+    EXPECT_EQ(out.segment_count, 3u);
+    EXPECT_EQ(out.fillable, mask_of(mask));
+
+    p.compact = false;
+    Output raw = run_mask(mask, p);
+    ASSERT_TRUE(raw.ok) << raw.error;
+    EXPECT_EQ(raw.labels, raw.raw_labels);
+    EXPECT_LABELS(raw.labels, labels_of(expected, {{'A', 6}, {'B', 7}, {'Y', 18}}), 24);
+    EXPECT_EQ(raw.segment_count, 3u);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Step 6 schedule. 8 x 8 with b = g = 1 (explicit): N = 4, M = 3, U = 2; offsets 0, 1, 5, 21. The only full aligned
+// 2x2 blocks are (0..1, 0..1) -> level-3 texel (0,0) -> label 6 and (6..7, 6..7) -> texel (3,3) -> label 21.
+
+const std::vector<std::string> kScheduleMask = {
+    "####.#..",  //
+    "##.##...",  //
+    "#....#..",  //
+    "#.##.#..",  //
+    "..#..#..",  //
+    "###..###",  //
+    ".....###",  //
+    "...#####",  //
+};
+
+TEST(ReferenceStep6, RowsThenColumnsOnce) {
+    // Rows: row 0 left-to-right takes x2, x3 from 6; row 6 right-to-left takes x5 from 21; row 7 right-to-left takes
+    // x5, x4, x3 one after the other (each update visible to the next pixel). Columns then: column 0 top-to-bottom
+    // takes y2, y3 from 6; column 3 takes (3,1) from (3,0); column 5 bottom-to-top takes y5..y2 from 21; columns 6, 7
+    // take y5. Not reached: (4,1) (would need a second row pass), (5,0), (2..3, 3), (2,4), (0..2, 5).
+    Params p = explicit_bg(1, 1);
+    p.label_edges = false;
+    Output out = run_mask(kScheduleMask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    const std::vector<std::string> expected = {
+        "aaaa....",  //
+        "aa.a....",  //
+        "a....b..",  //
+        "a....b..",  //
+        ".....b..",  //
+        ".....bbb",  //
+        ".....bbb",  //
+        "...bbbbb",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'a', 6}, {'b', 21}}), 8);
+    EXPECT_LABELS(out.labels, labels_of(expected, {{'a', 1}, {'b', 2}}), 8);
+}
+
+TEST(ReferenceStep6, EdgeLabellingReadsStateAfterColumns) {
+    Params p = explicit_bg(1, 1);
+    Output out = run_mask(kScheduleMask, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    // E.g. (4,0): left 6, others fillable-unlabelled -> 6. (5,1): only (5,2) = 21 labelled -> 21. (2,2): its only
+    // fillable neighbour (2,3) is unlabelled -> 0. (1,4): fillable neighbours unlabelled -> 0.
+    const std::vector<std::string> expected = {
+        "aaaaa...",  //
+        "aaaa.b..",  //
+        "aa.abbb.",  //
+        "aa..bbb.",  //
+        "a...bbbb",  //
+        "....bbbb",  //
+        "...bbbbb",  //
+        "..bbbbbb",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'a', 6}, {'b', 21}}), 8);
+}
+
+TEST(ReferenceStep6, EdgeLabellingTakesSmallestNeighbourAndSkipsInvalid) {
+    // b = g = 1 on 8x8. Seeds: P (4..5, 0..1) -> texel (2,0) -> 8; Q (0..1, 2..3) -> texel (0,1) -> 10;
+    // R (4..5, 4..5) -> texel (2,2) -> 16. Column x = 3 (y 0..3) takes 8 (rows, then column). (2,2) sees Q = 10 on its
+    // left and 8 on its right -> 8. (2,3) is invalid -> stays 0. (1,0) only touches edge pixels -> 0 (no spreading).
+    // (7,7) is fillable but unreachable -> 0, and so is its neighbour (7,6).
+    const std::vector<std::string> mask = {
+        "...###..",  //
+        "...###..",  //
+        "##.#....",  //
+        "##.#....",  //
+        "....##..",  //
+        "....##..",  //
+        "........",  //
+        ".......#",  //
+    };
+    std::vector<std::uint8_t> valid(64, 1);
+    valid[3 * 8 + 2] = 0;
+    Params p = explicit_bg(1, 1);
+    Output out = run_mask(mask, p, &valid);
+    ASSERT_TRUE(out.ok) << out.error;
+    const std::vector<std::string> expected = {
+        "..ppppp.",  //
+        "qqppppp.",  //
+        "qqpppp..",  //
+        "qq.ppr..",  //
+        "qq.prrr.",  //
+        "...rrrr.",  //
+        "....rr..",  //
+        "........",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(expected, {{'p', 8}, {'q', 10}, {'r', 16}}), 8);
+    EXPECT_LABELS(out.labels, labels_of(expected, {{'p', 1}, {'q', 2}, {'r', 3}}), 8);
+    EXPECT_EQ(out.segment_count, 3u);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Parameters.
+
+TEST(ReferenceParams, Rejection) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    auto rejected = [&](const Params& p) {
+        Output a = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+        Output b = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+        Output c = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+        return !a.ok && !a.error.empty() && !b.ok && !b.error.empty() && !c.ok && !c.error.empty();
+    };
+    auto with = [](auto change) {
+        Params p;
+        change(p);
+        return p;
+    };
+    EXPECT_FALSE(rejected(Params{}));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.ct = nan; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.ct = inf; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.ct = -0.01; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.dt = nan; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.dt = -1.0; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.dt = -inf; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.unit_mm = 0.0; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.unit_mm = -1.0; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.unit_mm = inf; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.unit_mm = nan; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.bridge_levels = 0; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.unjoinable_gap = 0; })));
+    EXPECT_TRUE(rejected(with([&](Params& p) { p.bridge_levels = -3; })));
+    EXPECT_FALSE(rejected(with([&](Params& p) { p.dt = inf; })));
+    EXPECT_FALSE(rejected(with([&](Params& p) { p.ct = 0.0; })));
+    EXPECT_FALSE(rejected(with([&](Params& p) { p.ct = 10.0; })));
+    EXPECT_FALSE(rejected(with([&](Params& p) { p.dt = 0.0; })));
+
+    // normal_radius matters only when normals are estimated.
+    Params r0;
+    r0.normal_radius = 0;
+    EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, r0).ok);
+    EXPECT_FALSE(pyrseg_ref::segment(pts.data(), nullptr, 16, 16, r0).ok);
+    EXPECT_TRUE(pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, r0).ok);
+
+    // Sizes.
+    const Params p;
+    EXPECT_FALSE(pyrseg_ref::segment_mask(mask.data(), nullptr, 0, 16, p).ok);
+    EXPECT_FALSE(pyrseg_ref::segment_mask(mask.data(), nullptr, 16, -1, p).ok);
+    EXPECT_FALSE(pyrseg_ref::segment(pts.data(), nrm.data(), 0, 0, p).ok);
+    EXPECT_TRUE(pyrseg_ref::estimate_normals(pts.data(), 16, 16, 0).empty());
+}
+
+TEST(ReferenceParams, TooLargeIsRejectedBeforeReadingInput) {
+    // 65536^2 = 2^32 pixels do not fit 32-bit labels; the inputs are null, so any read or allocation would show.
+    const Params p;
+    Output a = pyrseg_ref::segment_mask(nullptr, nullptr, 65536, 65536, p);
+    EXPECT_FALSE(a.ok);
+    EXPECT_FALSE(a.error.empty());
+    Output b = pyrseg_ref::segment(nullptr, nullptr, 65536, 65536, p);
+    EXPECT_FALSE(b.ok);
+    Output c =
+        pyrseg_ref::segment(nullptr, nullptr, std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), p);
+    EXPECT_FALSE(c.ok);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Metric: validity, curvature, depth.
+
+TEST(ReferenceMetric, InvalidPointsAndNormals) {
+    // 4x4 frontal plane (fallback path). Making pixel (1,1) invalid in any way clears B there; every other pixel still
+    // has valid neighbours with the same normal and depth, so stays fillable, and they form one component (raw 1).
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    struct Case {
+        const char* what;
+        int comp;  // 0..2: point x, y, z; 3..5: normal x, y, z
+        float value;
+    };
+    const std::vector<Case> cases = {
+        {"x NaN", 0, nan},  {"x +inf", 0, inf}, {"y -inf", 1, -inf},  {"z NaN", 2, nan},
+        {"z +inf", 2, inf}, {"z 0", 2, 0.0f},   {"z -0", 2, -0.0f},   {"z negative", 2, -5.0f},
+        {"nx NaN", 3, nan}, {"ny inf", 4, inf}, {"nz -inf", 5, -inf},
+    };
+    const std::vector<std::uint8_t> expected_b = {1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    const std::vector<std::uint32_t> expected_raw = {1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    for (const Case& c : cases) {
+        std::vector<float> pts = grid_points(4, 4, [](int, int) { return 1000.0f; });
+        std::vector<float> nrm = constant_normals(16, 0.0f, 0.0f, -1.0f);
+        if (c.comp < 3) {
+            pts[3 * 5 + static_cast<std::size_t>(c.comp)] = c.value;
+        } else {
+            nrm[3 * 5 + static_cast<std::size_t>(c.comp - 3)] = c.value;
+        }
+        Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 4, 4, Params{});
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_EQ(out.fillable, expected_b) << c.what;
+        EXPECT_EQ(out.raw_labels, expected_raw) << c.what;
+    }
+    // A zero normal, with either sign of zero, is invalid.
+    for (float zero : {0.0f, -0.0f}) {
+        std::vector<float> pts = grid_points(4, 4, [](int, int) { return 1000.0f; });
+        std::vector<float> nrm = constant_normals(16, 0.0f, 0.0f, -1.0f);
+        nrm[15] = zero;
+        nrm[16] = zero;
+        nrm[17] = zero;
+        Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 4, 4, Params{});
+        EXPECT_EQ(out.fillable, expected_b);
+    }
+}
+
+TEST(ReferenceMetric, SubnormalDepthIsValid) {
+    // All z = the smallest subnormal: valid (z > 0), equal depths, equal normals -> all fillable, one component.
+    const float tiny = std::numeric_limits<float>::denorm_min();
+    const std::vector<float> pts = grid_points(4, 4, [&](int, int) { return tiny; });
+    const std::vector<float> nrm = constant_normals(16, 0.0f, 0.0f, -1.0f);
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 4, 4, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>(16, 1)));
+    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(16, 1)));
+}
+
+TEST(ReferenceMetric, ValidButNotFillableGetsEdgeLabelInvalidDoesNot) {
+    // 16x16 frontal plane, defaults (N = 5, M = 3, U = 1). Pixel (5,5) has normal (0,0,0): invalid; its neighbours
+    // keep k = 7 and stay fillable. Pixel (10,10) has normal (denorm_min, 0, 0): valid, but quantizes to (0,0,0), so
+    // it and its 8 neighbours fail the curvature test (mean dot <= 7/8 < cos(0.25)).
+    // Level 2 texels (1,0) -> 3 and (0,1) -> 4 are fillable; everything fillable is one component at level 3 -> 3.
+    // Step 6 fills the pixels under non-fillable coarse texels; edge labelling gives the 3x3 ring 3 but not its
+    // centre (10,10) (all its 4-neighbours are non-fillable) and not the invalid (5,5).
+    std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const std::size_t a = 5 * 16 + 5;
+    nrm[3 * a] = 0.0f;
+    nrm[3 * a + 1] = 0.0f;
+    nrm[3 * a + 2] = 0.0f;
+    const std::size_t c = 10 * 16 + 10;
+    nrm[3 * c] = std::numeric_limits<float>::denorm_min();
+    nrm[3 * c + 1] = 0.0f;
+    nrm[3 * c + 2] = 0.0f;
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    std::vector<std::uint8_t> expected_b(256, 1);
+    expected_b[a] = 0;
+    for (int y = 9; y <= 11; ++y) {
+        for (int x = 9; x <= 11; ++x) expected_b[static_cast<std::size_t>(y * 16 + x)] = 0;
+    }
+    EXPECT_EQ(out.fillable, expected_b);
+    std::vector<std::uint32_t> expected_raw(256, 3);
+    expected_raw[a] = 0;
+    expected_raw[c] = 0;
+    EXPECT_LABELS(out.raw_labels, expected_raw, 16);
+    EXPECT_EQ(out.segment_count, 1u);
+    EXPECT_EQ(out.normals, nrm);  // given normals are copied as they are
+}
+
+// Two pixels side by side (2x1, fallback path): each has exactly one valid neighbour (k = 1).
+std::vector<std::uint8_t> pair_fillable(const float* n0, const float* n1, const Params& p) {
+    const float pts[6] = {0.0f, 0.0f, 1000.0f, 1.0f, 0.0f, 1000.0f};
+    const float nrm[6] = {n0[0], n0[1], n0[2], n1[0], n1[1], n1[2]};
+    Output out = pyrseg_ref::segment(pts, nrm, 2, 1, p);
+    EXPECT_TRUE(out.ok) << out.error;
+    return out.fillable;
+}
+
+TEST(ReferenceMetric, CurvatureAtAndAbovePiNeverAnEdge) {
+    // (1,1,1) and (-1,-1,-1): S = -3 * 2^26. ct >= pi -> Tc = -2^28 -> k*Tc = -2^28 <= S: fillable. Just below pi,
+    // Tc = floor(cos(ct) * 2^26) = -2^26 > S: edge.
+    const float up[3] = {1.0f, 1.0f, 1.0f};
+    const float down[3] = {-1.0f, -1.0f, -1.0f};
+    const std::vector<std::uint8_t> both = {1, 1};
+    const std::vector<std::uint8_t> none = {0, 0};
+    Params p;
+    p.ct = std::numbers::pi;
+    EXPECT_EQ(pair_fillable(up, down, p), both);
+    p.ct = 100.0;
+    EXPECT_EQ(pair_fillable(up, down, p), both);
+    p.ct = std::nextafter(std::numbers::pi, 0.0);
+    EXPECT_EQ(pair_fillable(up, down, p), none);
+    p.ct = 3.1;
+    EXPECT_EQ(pair_fillable(up, down, p), none);
+}
+
+TEST(ReferenceMetric, CurvatureThresholdAndHalfEvenQuantization) {
+    const float front[3] = {0.0f, 0.0f, -1.0f};
+    const float tilted[3] = {0.0f, 0.1f, -0.995f};  // q = (0, 819, -8151): dot with (0,0,-8192) = 8151 * 8192 < 2^26
+    Params p;
+    p.ct = 0.0;  // Tc = 2^26
+    EXPECT_EQ(pair_fillable(front, front, p), (std::vector<std::uint8_t>{1, 1}));
+    EXPECT_EQ(pair_fillable(front, tilted, p), (std::vector<std::uint8_t>{0, 0}));
+    p.ct = 0.25;  // Tc = 65022611 <= 66772992
+    EXPECT_EQ(pair_fillable(front, tilted, p), (std::vector<std::uint8_t>{1, 1}));
+
+    // ct = sqrt(3) * 2^-13: cos(ct) * 2^26 = 2^26 - 1.5 (to well below an ulp), so Tc = 2^26 - 2.
+    // n = (2.5 / 8192, 0, -1) quantizes to (2, 0, -8192) with round half to even (3 with half away from zero);
+    // with m = (-1 / 8192, 0, -1) -> (-1, 0, -8192) the dot is 2^26 - 2 (fillable) rather than 2^26 - 3 (edge).
+    p.ct = std::sqrt(3.0) / 8192.0;
+    const float half[3] = {2.5f / 8192.0f, 0.0f, -1.0f};
+    const float minus_one[3] = {-1.0f / 8192.0f, 0.0f, -1.0f};
+    EXPECT_EQ(pair_fillable(half, minus_one, p), (std::vector<std::uint8_t>{1, 1}));
+    const float three_half[3] = {3.5f / 8192.0f, 0.0f, -1.0f};  // -> 4: dot 2^26 - 4 < Tc
+    EXPECT_EQ(pair_fillable(three_half, minus_one, p), (std::vector<std::uint8_t>{0, 0}));
+    // Components outside [-1, 1] are clamped: (2, 0, -3) -> (8192, 0, -8192), dot with itself 2^27 >= 2^26.
+    const float big[3] = {2.0f, 0.0f, -3.0f};
+    p.ct = 0.0;
+    EXPECT_EQ(pair_fillable(big, big, p), (std::vector<std::uint8_t>{1, 1}));
+}
+
+std::vector<std::uint8_t> row_fillable(const std::vector<float>& z, const Params& p) {
+    const int w = static_cast<int>(z.size());
+    const std::vector<float> pts = grid_points(w, 1, [&](int x, int) { return z[static_cast<std::size_t>(x)]; });
+    const std::vector<float> nrm = constant_normals(w, 0.0f, 0.0f, -1.0f);
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), w, 1, p);
+    EXPECT_TRUE(out.ok) << out.error;
+    return out.fillable;
+}
+
+TEST(ReferenceMetric, DepthThreshold) {
+    Params p;  // dt = 10 mm, unit 1 mm
+    // The middle pixel sees |dz| = 0 and 10 -> d = 10 <= 10; the ends see one neighbour -> d = 0.
+    EXPECT_EQ(row_fillable({1000.0f, 1000.0f, 1010.0f}, p), (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(row_fillable({1000.0f, 1000.0f, 1010.5f}, p), (std::vector<std::uint8_t>{1, 0, 1}));
+    p.dt = 0.0;
+    EXPECT_EQ(row_fillable({1000.0f, 1000.0f, 1010.0f}, p), (std::vector<std::uint8_t>{1, 0, 1}));
+    p.dt = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(row_fillable({1000.0f, 1000.0f, 1.0e30f}, p), (std::vector<std::uint8_t>{1, 1, 1}));
+
+    // Metres: dt_units = (float)(10 / 1000) = 0.00999999977...; 1.01f - 1.0f = 0.0099999905 passes, 1.0101f fails.
+    Params m;
+    m.unit_mm = 1000.0;
+    EXPECT_EQ(row_fillable({1.0f, 1.0f, 1.01f}, m), (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(row_fillable({1.0f, 1.0f, 1.0101f}, m), (std::vector<std::uint8_t>{1, 0, 1}));
+}
+
+TEST(ReferenceMetric, DepthIsMaxMinusMinOfDifferences) {
+    // A spike: the centre sees |dz| = 50 to all 8 neighbours -> d = 0 -> fillable; each neighbour sees 0 and 50.
+    const std::vector<float> pts =
+        grid_points(3, 3, [](int x, int y) { return (x == 1 && y == 1) ? 1050.0f : 1000.0f; });
+    const std::vector<float> nrm = constant_normals(9, 0.0f, 0.0f, -1.0f);
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 3, 3, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>{0, 0, 0, 0, 1, 0, 0, 0, 0}));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// End to end through the metric.
+
+TEST(ReferenceEndToEnd, TwoPlanesWithDepthStep) {
+    // 16x16, z = 1000 for x < 8 and 1100 for x >= 8, given normals (0,0,-1). Columns 7 and 8 see |dz| = 0 and 100:
+    // edges. Level 4 fillable columns X 0..2 and 5..7; level 3: X 0 and 3 -> new labels 6, 10, 14, 18 and 9, 13,
+    // 17, 21; step 2 -> 6 and 9. Level 4 X = 2 and X = 5 get 0 from their parents and 6 / 9 in step 4. Level 5
+    // column 6 and 9 get their labels in step 6 (rows), columns 7 and 8 by edge labelling.
+    const std::vector<float> pts = grid_points(16, 16, [](int x, int) { return x < 8 ? 1000.0f : 1100.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    std::vector<std::uint8_t> expected_b;
+    std::vector<std::uint32_t> expected_raw;
+    std::vector<std::uint32_t> expected;
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 16; ++x) {
+            expected_b.push_back((x == 7 || x == 8) ? 0 : 1);
+            expected_raw.push_back(x < 8 ? 6u : 9u);
+            expected.push_back(x < 8 ? 1u : 2u);
+        }
+    }
+    EXPECT_EQ(out.fillable, expected_b);
+    EXPECT_LABELS(out.raw_labels, expected_raw, 16);
+    EXPECT_LABELS(out.labels, expected, 16);
+    EXPECT_EQ(out.segment_count, 2u);
+
+    // dt = +inf removes the step: everything fillable, the 1x1 level is fillable, label 1 everywhere.
+    Params p;
+    p.dt = std::numeric_limits<double>::infinity();
+    Output flat = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+    ASSERT_TRUE(flat.ok) << flat.error;
+    EXPECT_EQ(flat.raw_labels, (std::vector<std::uint32_t>(256, 1)));
+}
+
+TEST(ReferenceEndToEnd, FrontalPlaneWithEstimatedNormals) {
+    // Every tangent is along +x / +y, so every normal is (0,0,-1) after orientation (borders one-sided, same result).
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    Output out = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, Params{});
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.normals, constant_normals(256, 0.0f, 0.0f, -1.0f));
+    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>(256, 1)));
+    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(256, 1)));
+    EXPECT_EQ(out.segment_count, 1u);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Normals pass (docs/algorithm.md section 8).
+
+TEST(ReferenceNormals, TiltedPlaneEveryPixelIncludingBorders) {
+    // z = 10 + x. Centre: u = (2,0,2), v = (0,2,0); borders: u = (1,0,1) or v = (0,1,0). F gives U = (2^14, 0, 2^14),
+    // V = (0, 2^14, 0) either way; C = (-2^28, 0, 2^28) -> D = (-2^14, 0, 2^14), len = 23170, q = (-5793, 0, 5793);
+    // q . F(P) > 0 (z dominates) -> flipped.
+    const std::vector<float> pts = grid_points(3, 3, [](int x, int) { return 10.0f + static_cast<float>(x); });
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    ASSERT_EQ(n.size(), 27u);
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 3; ++x) EXPECT_EQ(normal_at(n, 3, x, y), q13(5793, 0, -5793)) << x << "," << y;
+    }
+}
+
+TEST(ReferenceNormals, SkewedPlane) {
+    // z = 8 + x/2 + y/4, centre (1,1): u = (2, 0, 1) -> U = (16384, 0, 8192); v = (0, 2, 0.5) -> V = (0, 16384, 4096).
+    // C = (-2^27, -2^26, 2^28) -> D = (-8192, -4096, 16384), len = 18770, q = (-3575, -1788, 7151) -> flipped.
+    const std::vector<float> pts = grid_points(
+        3, 3, [](int x, int y) { return 8.0f + 0.5f * static_cast<float>(x) + 0.25f * static_cast<float>(y); });
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(3575, 1788, -7151));
+}
+
+TEST(ReferenceNormals, CurvedSurfaceOneSidedAtBorders) {
+    // z = 10 + x^2 (10, 11, 14). x = 0: u = P1 - P0 = (1,0,1) -> (5793, 0, -5793). x = 1: u = P2 - P0 = (2,0,4) ->
+    // U = (8192, 0, 16384), D = (-16384, 0, 8192), len = 18317 -> (7327, 0, -3664). x = 2: u = P2 - P1 = (1,0,3) ->
+    // U = (8192, 0, 24576), D = (-24576, 0, 8192), len = 25905 -> (7772, 0, -2591).
+    const std::vector<float> pts = grid_points(3, 3, [](int x, int) { return 10.0f + static_cast<float>(x * x); });
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    for (int y = 0; y < 3; ++y) {
+        EXPECT_EQ(normal_at(n, 3, 0, y), q13(5793, 0, -5793)) << y;
+        EXPECT_EQ(normal_at(n, 3, 1, y), q13(7327, 0, -3664)) << y;
+        EXPECT_EQ(normal_at(n, 3, 2, y), q13(7772, 0, -2591)) << y;
+    }
+}
+
+TEST(ReferenceNormals, InvalidNeighbourFallsBackToOneSided) {
+    // Same surface; the right neighbour of the centre has z < 0, so u = P - L = (1, 0, 1) -> (5793, 0, -5793).
+    std::vector<float> pts = grid_points(3, 3, [](int x, int) { return 10.0f + static_cast<float>(x * x); });
+    pts[3 * (1 * 3 + 2) + 2] = -14.0f;
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(5793, 0, -5793));
+    EXPECT_EQ(normal_at(n, 3, 2, 1), q13(0, 0, 0));  // not point-valid itself
+}
+
+TEST(ReferenceNormals, RadiusTwo) {
+    // z = 10 + x^2 on 5x5, r = 2. (0,2): u = P2 - P0 = (2,0,4) -> (7327, 0, -3664). (1,2): x - 2 < 0, so
+    // u = P3 - P1 = (2,0,8) -> U = (4096, 0, 16384), D = (-16384, 0, 4096), len = 16888 -> (7948, 0, -1987).
+    // (2,2): u = P4 - P0 = (4,0,16) -> same U -> (7948, 0, -1987). (4,2): u = P4 - P2 = (2,0,12) ->
+    // U = (4096, 0, 24576), D = (-24576, 0, 4096), len = 24914 -> (8081, 0, -1347).
+    const std::vector<float> pts = grid_points(5, 5, [](int x, int) { return 10.0f + static_cast<float>(x * x); });
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 5, 5, 2);
+    EXPECT_EQ(normal_at(n, 5, 0, 2), q13(7327, 0, -3664));
+    EXPECT_EQ(normal_at(n, 5, 1, 2), q13(7948, 0, -1987));
+    EXPECT_EQ(normal_at(n, 5, 2, 2), q13(7948, 0, -1987));
+    EXPECT_EQ(normal_at(n, 5, 4, 2), q13(8081, 0, -1347));
+}
+
+TEST(ReferenceNormals, NonDyadicTangentsTruncateTowardZero) {
+    // Centre of 3x3 with L, T at z = 10 and R, D at z = 10.3f, 10.1f: u = (2, 0, 0.30000019), v = (0, 2, 0.10000038)
+    // (exact float subtractions). F: 0.30000019 * 2^13 = 2457.6 -> 2457, 0.10000038 * 2^13 = 819.2 -> 819.
+    // C = (-2457 * 2^14, -819 * 2^14, 2^28) -> D = (-2457, -819, 16384), len = 16587, q = (-1213, -404, 8092) ->
+    // flipped. With R, D at 9.7f, 9.9f the tangent components are negative and their magnitudes are truncated the same
+    // way (sign-magnitude, toward zero; an arithmetic shift would give 1214 and 405).
+    auto centre = [](float zr, float zd) {
+        std::vector<float> pts = grid_points(3, 3, [](int, int) { return 10.0f; });
+        pts[3 * 4 + 2] = 10.15f;
+        pts[3 * 5 + 2] = zr;  // (2,1)
+        pts[3 * 7 + 2] = zd;  // (1,2)
+        return normal_at(pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1), 3, 1, 1);
+    };
+    EXPECT_EQ(centre(10.3f, 10.1f), q13(1213, 404, -8092));
+    EXPECT_EQ(centre(9.7f, 9.9f), q13(-1213, -404, -8092));
+}
+
+TEST(ReferenceNormals, MissingNeighboursGiveNoNormal) {
+    // Only the centre is valid: no tangent at all.
+    std::vector<float> pts = grid_points(
+        3, 3, [](int x, int y) { return (x == 1 && y == 1) ? 10.0f : std::numeric_limits<float>::quiet_NaN(); });
+    std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(n, std::vector<float>(27, 0.0f));
+
+    // Horizontal neighbours but no vertical ones (a single row).
+    pts = grid_points(3, 1, [](int, int) { return 10.0f; });
+    n = pyrseg_ref::estimate_normals(pts.data(), 3, 1, 1);
+    EXPECT_EQ(n, std::vector<float>(9, 0.0f));
+
+    // Vertical neighbours of the centre invalid (z = 0), horizontal ones fine.
+    pts = grid_points(3, 3, [](int x, int) { return x == 1 ? 0.0f : 10.0f; });
+    pts[3 * 4 + 2] = 10.0f;
+    n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(0, 0, 0));
+
+    // Collinear tangents: u = (1,0,0), v = (2,0,0) -> C = 0 -> no normal.
+    const std::vector<float> line = {0.0f, 0.0f, 10.0f, 1.0f, 0.0f, 10.0f, 2.0f, 0.0f, 10.0f, 3.0f, 1.0f, 10.0f};
+    n = pyrseg_ref::estimate_normals(line.data(), 2, 2, 1);
+    EXPECT_EQ(normal_at(n, 2, 0, 0), q13(0, 0, 0));
+}
+
+TEST(ReferenceNormals, OrientationTowardTheCamera) {
+    // Frontal plane: C = (0, 0, 2^28) -> q = (0, 0, 8192), q . F(P) > 0 -> flipped to (0, 0, -8192).
+    std::vector<float> pts = grid_points(3, 3, [](int, int) { return 10.0f; });
+    std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(0, 0, -8192));
+    // Mirrored grid (x = -column): u = (-2, 0, 0) -> C = (0, 0, -2^28) -> already toward the camera, not flipped.
+    for (std::size_t i = 0; i < 9; ++i) pts[3 * i] = -pts[3 * i];
+    n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(0, 0, -8192));
+}
+
+TEST(ReferenceNormals, ShiftPastThirtyOneAndZeroDotNotFlipped) {
+    // P = (x * 2^30, y * 2^30, 10 + x). Centre: u = (2^31, 0, 2): z shift 9 + 30 = 39 > 31 -> 0, so U = (2^14, 0, 0);
+    // V = (0, 2^14, 0); q = (0, 0, 8192). F(P) = F(2^30, 2^30, 11) = (2^14, 2^14, 0) (z shift 36): q . F(P) = 0, not
+    // > 0, so no flip.
+    const std::vector<float> pts = [] {
+        std::vector<float> v;
+        for (int y = 0; y < 3; ++y) {
+            for (int x = 0; x < 3; ++x) {
+                v.push_back(static_cast<float>(x) * 1073741824.0f);
+                v.push_back(static_cast<float>(y) * 1073741824.0f);
+                v.push_back(10.0f + static_cast<float>(x));
+            }
+        }
+        return v;
+    }();
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 3, 3, 1);
+    EXPECT_EQ(normal_at(n, 3, 1, 1), q13(0, 0, 8192));
+}
+
+TEST(ReferenceNormals, SmallCrossProductIsShiftedLeft) {
+    // 2x2, pixel (0,0) at (0,0,10): u = (1, 1, 2^-14) -> U = (16384, 16384, 1); v = (1+2^-14, 1+2^-14, 2^-14) ->
+    // V = (16385, 16385, 1). C = (-1, 1, 0): s = 0 -> D = (-16384, 16384, 0), len = 23170, q = (-5793, 5793, 0).
+    // F(P) = (0, 0, 20480): q . F(P) = 0 -> not flipped.
+    // (Without the left shift len would be 1 and q = (-8192, 8192, 0).)
+    const float e = 1.0f / 16384.0f;
+    const std::vector<float> pts = {0.0f,     0.0f,     10.0f,     1.0f, 1.0f, 10.0f + e,
+                                    1.0f + e, 1.0f + e, 10.0f + e, 1.0f, 1.0f, 10.0f};
+    const std::vector<float> n = pyrseg_ref::estimate_normals(pts.data(), 2, 2, 1);
+    EXPECT_EQ(normal_at(n, 2, 0, 0), q13(-5793, 5793, 0));
+}
+
+}  // namespace
