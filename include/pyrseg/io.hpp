@@ -1,0 +1,61 @@
+#pragma once
+// pyrseg::io: the file formats the CLI and the tests need: PCD in, .npy and PNG out (and back in, for tests).
+// Every failure is a pyrseg::Error whose message names the file: ErrorCode::io when the file cannot be opened,
+// read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::invalid_argument
+// for bad arguments to a writer.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace pyrseg::io {
+
+// An organized cloud, packed, row-major: point (x, y) is points[3 * (y * width + x) + c].
+struct PointCloud {
+    int width = 0, height = 0;
+    std::vector<float> points;   // 3*W*H xyz (NaN where invalid)
+    std::vector<float> normals;  // 3*W*H, or empty when the file has no normal_x/normal_y/normal_z fields
+};
+
+enum class PcdEncoding { ascii, binary, binary_compressed };
+
+// Reads a PCD v0.7 file (DATA ascii, binary or binary_compressed). Needs fields x y z (TYPE F, SIZE 4 or 8) and an
+// organized cloud (HEIGHT > 1); normal_x normal_y normal_z are read when present, every other field is skipped.
+// VIEWPOINT is ignored: points are returned in the file's frame.
+PointCloud read_pcd(const std::filesystem::path& path);
+
+// Writes fields x y z (and normal_x normal_y normal_z when cloud.normals is not empty) as F 4, the way PCL does.
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding);
+
+// NumPy .npy (format 1.0), C order, little-endian.
+void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int height, int width);  // '<u4' H x W
+void write_npy(const std::filesystem::path& path, const float* data, int height, int width,
+               int channels);  // '<f4' H x W x C (C=1: H x W)
+
+struct NpyArray {
+    std::string dtype;                 // numpy's descr, e.g. "<f4", "|u1"
+    std::vector<std::size_t> shape;    // empty for a 0-d array
+    std::vector<unsigned char> bytes;  // the array data, C order, as stored
+};
+// Format 1.0/2.0/3.0 headers, C order, little-endian or byte-order-free dtypes of kind b, i, u, f, c.
+NpyArray read_npy(const std::filesystem::path& path);
+
+void write_png_rgb(const std::filesystem::path& path, const std::uint8_t* rgb, int width, int height);
+void write_png_gray16(const std::filesystem::path& path, const std::uint16_t* gray, int width, int height);
+void write_png_gray8(const std::filesystem::path& path, const std::uint8_t* gray, int width, int height);
+
+struct Image {
+    int width = 0, height = 0, channels = 0, bit_depth = 0;
+    std::vector<std::uint8_t> data;  // data as stored: 16-bit samples in host order
+};
+// Palette images come back as RGB (RGBA with transparency), gray below 8 bits as 8-bit; bit_depth is 8 or 16.
+Image read_png(const std::filesystem::path& path);
+
+// Colour-coded segmentation: label 0 black, other labels distinct saturated colours (a fixed hash of the label so
+// the same label is the same colour in every picture; neighbouring label values clearly different).
+std::array<std::uint8_t, 3> label_color(std::uint32_t label);
+std::vector<std::uint8_t> colorize_labels(const std::uint32_t* labels, int width, int height);  // 3*W*H RGB
+
+}  // namespace pyrseg::io

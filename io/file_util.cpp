@@ -1,0 +1,66 @@
+#include "file_util.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <system_error>
+
+namespace pyrseg::io::detail {
+
+namespace {
+
+struct FileCloser {
+    void operator()(std::FILE* f) const noexcept { std::fclose(f); }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+std::string errno_text(int err) {
+    return std::error_code(err, std::generic_category()).message();
+}
+
+}  // namespace
+
+void fail(ErrorCode code, const std::filesystem::path& path, std::string_view what) {
+    throw Error(code, path.string() + ": " + std::string(what));
+}
+
+std::vector<unsigned char> read_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status)) {
+        fail(ErrorCode::io, path, "cannot open: " + (ec ? ec.message() : errno_text(ENOENT)));
+    }
+    if (std::filesystem::is_directory(status)) fail(ErrorCode::io, path, "cannot read: is a directory");
+    if (!std::filesystem::is_regular_file(status)) fail(ErrorCode::io, path, "cannot read: not a regular file");
+
+    errno = 0;
+    File file(std::fopen(path.c_str(), "rb"));
+    if (!file) fail(ErrorCode::io, path, "cannot open: " + errno_text(errno));
+
+    std::vector<unsigned char> bytes;
+    // The size is only a hint: the file may change under us, so read to the end rather than trusting it.
+    const auto hint = std::filesystem::file_size(path, ec);
+    if (!ec && hint < (std::size_t{1} << 40)) bytes.reserve(static_cast<std::size_t>(hint));
+    unsigned char chunk[1 << 16];
+    for (;;) {
+        const std::size_t n = std::fread(chunk, 1, sizeof chunk, file.get());
+        bytes.insert(bytes.end(), chunk, chunk + n);
+        if (n < sizeof chunk) break;
+    }
+    if (std::ferror(file.get())) fail(ErrorCode::io, path, "read error: " + errno_text(errno));
+    return bytes;
+}
+
+void write_file(const std::filesystem::path& path, const void* data, std::size_t size) {
+    errno = 0;
+    File file(std::fopen(path.c_str(), "wb"));
+    if (!file) fail(ErrorCode::io, path, "cannot open for writing: " + errno_text(errno));
+    if (size > 0 && std::fwrite(data, 1, size, file.get()) != size) {
+        fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+    }
+    // Buffered data only reaches the disk at fclose, so a full disk shows up here.
+    if (std::fclose(file.release()) != 0) fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+}
+
+}  // namespace pyrseg::io::detail
