@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/thread_pool.hpp"
+#include "backends/cpu/union_find_fill.hpp"
 
 namespace pyrseg::cpu {
 namespace {
@@ -15,6 +18,19 @@ using std::uint32_t;
 
 constexpr size_t kColumnBlock = 64;  // columns swept together, row by row, so column sweeps stay cache-friendly
 
+// The largest level a fixed-point fill runs on: N-1, or N itself for the tiny-image fallback.
+size_t fill_scratch_size(const core::Plan& plan) {
+    const PyrLevel& lv = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
+    return size_t(lv.width) * lv.height;
+}
+
+// PYRSEG_CPU_FILL=sweeps runs steps 2 and 4 as repeated row/column sweeps of the shared relaxation (the GPU
+// scheme) instead of union-find; both reach the contract's fixed point, and the tests check that they agree.
+bool use_sweeps_for_fixed_points() {
+    const char* env = std::getenv("PYRSEG_CPU_FILL");
+    return env != nullptr && std::strcmp(env, "sweeps") == 0;
+}
+
 class CpuExecutor final : public core::PassExecutor {
 public:
     explicit CpuExecutor(const core::Plan& plan)
@@ -22,7 +38,10 @@ public:
           quant_(plan.pixel_count()),
           mask_(plan.total_texels),
           labels_(plan.total_texels),
-          lut_(size_t(plan.max_label) + 1) {}
+          lut_(size_t(plan.max_label) + 1),
+          parent_(fill_scratch_size(plan)),
+          best_(fill_scratch_size(plan)),
+          sweeps_(use_sweeps_for_fixed_points()) {}
 
     void bind_cloud(const CloudView& cloud) override {
         cloud_ = cloud;
@@ -122,7 +141,11 @@ public:
                 }
             });
         }
-        while (sweep(lv, false)) {
+        if (sweeps_) {
+            while (sweep(lv, false)) {
+            }
+        } else {
+            union_find_fill(pool_, lv, mask_.data(), labels_.data(), parent_.data(), best_.data());
         }
     }
 
@@ -276,6 +299,9 @@ private:
     std::vector<std::uint8_t> mask_;   // all levels
     std::vector<uint32_t> labels_;     // all levels
     std::vector<uint32_t> lut_;        // raw label -> compacted label
+    std::vector<uint32_t> parent_;     // union-find scratch
+    std::vector<uint32_t> best_;
+    bool sweeps_;
     uint32_t segment_count_ = 0;
     bool compacted_ = false;
     bool normals_estimated_ = false;

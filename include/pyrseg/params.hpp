@@ -8,7 +8,7 @@ inline constexpr double kDefaultCurvatureThreshold = 0.25;  // ct, radians
 inline constexpr double kDefaultDepthThresholdMm = 10.0;    // dt, millimetres
 inline constexpr int kDefaultBridgeLevels = 2;              // b
 inline constexpr int kDefaultUnjoinableGap = 2;             // g
-inline constexpr int kDefaultNormalRadius = 1;              // normals pass neighbour offset, pixels
+inline constexpr int kDefaultNormalRadius = 2;              // normals pass neighbour offset, pixels
 
 struct Params {
     double ct = kDefaultCurvatureThreshold;  // curvature threshold in radians; >= pi disables curvature edges
