@@ -8,4 +8,12 @@ if [ "${1:-}" = "--asan" ]; then
   preset=asan
 fi
 scripts/build.sh "$preset"
-ctest --preset "$preset" -j2 --timeout 900
+status=0
+ctest --preset "$preset" -j2 --timeout 900 || status=$?
+# ctest lists skipped tests without their reasons; the tests' own words are in its log.
+log="build/$preset/Testing/Temporary/LastTest.log"
+if [ -f "$log" ] && grep -q "unavailable:" "$log"; then
+  echo "Skipped backends, with the reasons they gave:"
+  grep -h "unavailable:" "$log" | sort -u | sed 's/^/  /'
+fi
+exit "$status"

@@ -20,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kDemoUsage =
-    "Usage: pyrseg demo [--out DIR] [--size WxH] [--seed N] [--runs N] [--data DIR] [parameters]\n"
+    "Usage: pyrseg demo [--out DIR] [--size WxH] [--seed N] [--noise MM] [--runs N] [--data DIR] [parameters]\n"
     "\n"
     "Generates a synthetic bin-picking scene (boxes, cylinders, spheres touching each other in a bin, with\n"
     "structured-light noise and holes), segments it from its points alone (normals estimated) with every\n"
@@ -30,6 +30,7 @@ constexpr const char* kDemoUsage =
     "  --out DIR     where the pictures go (default pyrseg-demo)\n"
     "  --size WxH    scene size (default 2064x1544, a Photoneo PhoXi frame)\n"
     "  --seed N      scene seed (default 1)\n"
+    "  --noise MM    sensor noise of the scene, sigma along the viewing ray (default 0.1 mm, PhoXi-like)\n"
     "  --runs N      timed runs per backend after one warm-up (default 5)\n"
     "  --data DIR    folder of sample .pcd scans (default ../shared/data)\n"
     "\n";
@@ -141,7 +142,7 @@ double median_depth(const std::vector<float>& points) {
 
 int cmd_demo(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
-    values.insert({"out", "size", "seed", "runs", "data"});
+    values.insert({"out", "size", "seed", "noise", "runs", "data"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -160,6 +161,8 @@ int cmd_demo(const std::vector<std::string>& argv) {
         }
     }
     if (const auto seed = args.integer("seed")) scene_options.seed = std::uint64_t(*seed);
+    scene_options.noise_mm = args.number("noise").value_or(0.1);
+    if (scene_options.noise_mm < 0) throw UsageError{"--noise must be >= 0"};
     const int runs = args.integer("runs").value_or(5);
     if (runs < 1) throw UsageError{"--runs must be >= 1"};
     const fs::path out_dir = args.value("out").value_or("pyrseg-demo");

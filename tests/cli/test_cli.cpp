@@ -1,0 +1,159 @@
+// The pyrseg command-line tool, run as a user runs it: exit codes, messages, files written.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <string>
+#include <vector>
+
+#include "pyrseg/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+    int status;
+    std::string output;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args) {
+    const std::string command = std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    if (pipe == nullptr) return {-1, "popen failed"};
+    std::string out;
+    std::array<char, 4096> buffer{};
+    while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+    const int status = pclose(pipe);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path temp_dir() {
+    const fs::path dir = fs::temp_directory_path() / ("pyrseg_cli_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    return dir;
+}
+
+fs::path mug_scan() { return fs::path(PYRSEG_SHARED_DATA_DIR) / "table_scene_mug_stereo_textured.pcd"; }
+
+TEST(Cli, EveryCommandExplainsItselfWithHelp) {
+    for (const char* command : {"--help", "segment --help", "demo --help", "backends --help"}) {
+        const CliRun r = run(command);
+        EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
+        EXPECT_NE(r.output.find("Usage"), std::string::npos) << command << "\n" << r.output;
+    }
+    EXPECT_NE(run("segment --help").output.find("--unit-mm"), std::string::npos);
+}
+
+TEST(Cli, UsageErrorsExitWithTwoAndSayWhat) {
+    CliRun r = run("");
+    EXPECT_EQ(r.status, 2);
+    r = run("frobnicate");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("unknown command 'frobnicate'"), std::string::npos) << r.output;
+    r = run("segment");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("INPUT"), std::string::npos) << r.output;
+    r = run("segment x.pcd --dt banana --labels o.npy");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("--dt expects a number"), std::string::npos) << r.output;
+    r = run("segment x.pcd --bogus");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("unknown option --bogus"), std::string::npos) << r.output;
+    r = run("segment x.pcd");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("nothing to write"), std::string::npos) << r.output;
+}
+
+TEST(Cli, FileAndParameterErrorsNameTheProblem) {
+    const fs::path dir = temp_dir();
+    CliRun r = run("segment " + (dir / "missing.pcd").string() + " --labels " + (dir / "o.npy").string());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.output.find("missing.pcd"), std::string::npos) << r.output;
+    const fs::path garbage = dir / "garbage.pcd";
+    FILE* f = std::fopen(garbage.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("VERSION 0.7\nFIELDS x y\n", f);
+    std::fclose(f);
+    r = run("segment " + garbage.string() + " --labels " + (dir / "o.npy").string());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.output.find("garbage.pcd"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "scan.ply").string() + " --labels o.npy");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.output.find("unsupported input format"), std::string::npos) << r.output;
+    if (fs::exists(mug_scan())) {
+        r = run("segment " + mug_scan().string() + " --ct -1 --labels " + (dir / "o.npy").string());
+        EXPECT_EQ(r.status, 1);
+        EXPECT_NE(r.output.find("ct"), std::string::npos) << r.output;
+        r = run("segment " + mug_scan().string() + " --backend nope --labels " + (dir / "o.npy").string());
+        EXPECT_EQ(r.status, 1);
+        EXPECT_NE(r.output.find("unknown backend 'nope'"), std::string::npos) << r.output;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(Cli, BackendsListsEveryBackendAndWhyNot) {
+    const CliRun r = run("backends");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("cpu     available"), std::string::npos) << r.output;
+    for (const char* name : {"cuda", "vulkan", "opencl"}) EXPECT_NE(r.output.find(name), std::string::npos);
+}
+
+// The acceptance case: the PCL mug scan, in metres, with default parameters.
+TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
+    if (!fs::exists(mug_scan())) GTEST_SKIP() << "sample scan not present: " << mug_scan().string();
+    const fs::path dir = temp_dir();
+    const fs::path labels_path = dir / "mug.npy";
+    const fs::path png_path = dir / "mug.png";
+    const CliRun r = run("segment " + mug_scan().string() + " --unit-mm 1000 --labels " + labels_path.string() +
+                      " --png " + png_path.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(png_path));
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
+    ASSERT_EQ(npy.dtype, "<u4");
+    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+    std::vector<std::uint32_t> labels(640 * 480);
+    std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
+    const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
+    std::map<std::uint32_t, std::size_t> sizes;
+    for (std::uint32_t l : labels) ++sizes[l];
+
+    // Table top: points spread over it, around the mug, all in one large segment.
+    const std::uint32_t table = at(200, 420);
+    ASSERT_NE(table, 0u);
+    for (const auto& [x, y] : {std::pair{160, 200}, {600, 200}, {600, 450}, {300, 350}, {520, 260}, {250, 250}}) {
+        EXPECT_EQ(at(x, y), table) << "table point (" << x << ", " << y << ")";
+    }
+    EXPECT_GT(sizes[table], 100000u);
+    // The mug: a different segment of its own, where the mug is.
+    const std::uint32_t mug = at(392, 262);
+    EXPECT_NE(mug, 0u);
+    EXPECT_NE(mug, table);
+    EXPECT_GT(sizes[mug], 2000u);
+    EXPECT_LT(sizes[mug], 20000u);
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != mug) continue;
+        const int x = int(i % 640);
+        const int y = int(i / 640);
+        EXPECT_TRUE(x > 300 && x < 500 && y > 200 && y < 340) << "mug pixel far from the mug at " << x << "," << y;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
+    const fs::path dir = temp_dir();
+    const CliRun r = run("demo --size 160x120 --runs 1 --data " + (dir / "none").string() + " --out " + dir.string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("agree byte for byte"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "synthetic_figure.png"));
+    EXPECT_TRUE(fs::exists(dir / "synthetic_segments.png"));
+    EXPECT_TRUE(fs::exists(dir / "synthetic_truth.png"));
+    fs::remove_all(dir);
+}
+
+}  // namespace
