@@ -67,7 +67,8 @@ int register_all() {
         const int w = size[0];
         const int h = size[1];
         for (const bool given : {false, true}) {
-            const std::string suffix = std::to_string(w) + "x" + std::to_string(h) + (given ? "/given_normals" : "/estimated_normals");
+            const std::string suffix =
+                std::to_string(w) + "x" + std::to_string(h) + (given ? "/given_normals" : "/estimated_normals");
             benchmark::RegisterBenchmark(("memcpy_input/" + suffix).c_str(),
                                          [=](benchmark::State& st) { copy_input(st, w, h, given); })
                 ->Unit(benchmark::kMillisecond)

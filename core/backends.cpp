@@ -7,7 +7,6 @@
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 
-
 namespace pyrseg {
 
 std::vector<BackendInfo> list_backends() {

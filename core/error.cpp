@@ -4,14 +4,22 @@ namespace pyrseg {
 
 const char* to_string(ErrorCode code) noexcept {
     switch (code) {
-        case ErrorCode::invalid_argument: return "invalid argument";
-        case ErrorCode::invalid_parameter: return "invalid parameter";
-        case ErrorCode::size_mismatch: return "size mismatch";
-        case ErrorCode::image_too_large: return "image too large";
-        case ErrorCode::backend_unavailable: return "backend unavailable";
-        case ErrorCode::io: return "I/O error";
-        case ErrorCode::format: return "format error";
-        case ErrorCode::internal: return "internal error";
+        case ErrorCode::invalid_argument:
+            return "invalid argument";
+        case ErrorCode::invalid_parameter:
+            return "invalid parameter";
+        case ErrorCode::size_mismatch:
+            return "size mismatch";
+        case ErrorCode::image_too_large:
+            return "image too large";
+        case ErrorCode::backend_unavailable:
+            return "backend unavailable";
+        case ErrorCode::io:
+            return "I/O error";
+        case ErrorCode::format:
+            return "format error";
+        case ErrorCode::internal:
+            return "internal error";
     }
     return "unknown error";
 }

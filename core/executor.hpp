@@ -20,14 +20,14 @@ public:
     // Input: a cloud (passes from normals on), or a caller's mask (passes from the pyramid on).
     virtual void bind_cloud(const CloudView& cloud) = 0;
     virtual void bind_mask(const MaskView& mask) = 0;
-    virtual void estimate_normals() = 0;  // when the cloud has no normals
-    virtual void quantize() = 0;          // validity and qn per pixel
-    virtual void metric() = 0;            // fillable mask B into level N
-    virtual void mip(int parent_level) = 0;  // level parent_level from level parent_level + 1
+    virtual void estimate_normals() = 0;                          // when the cloud has no normals
+    virtual void quantize() = 0;                                  // validity and qn per pixel
+    virtual void metric() = 0;                                    // fillable mask B into level N
+    virtual void mip(int parent_level) = 0;                       // level parent_level from level parent_level + 1
     virtual void init_labels(int level, std::uint32_t mode) = 0;  // PYR_INIT_* (shaders/pyr_types.h)
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4
-    virtual void fill_once(int level) = 0;  // step 6 a and b
-    virtual void label_edges() = 0;         // step 6 c
+    virtual void fill_once(int level) = 0;                                      // step 6 a and b
+    virtual void label_edges() = 0;                                             // step 6 c
     // Step 7: counts the distinct labels of level N (the segment count K) and, when apply, renumbers them.
     virtual std::uint32_t compact(bool apply) = 0;
     virtual void read_back(Result& out, const Outputs& outputs) = 0;

@@ -14,7 +14,9 @@ constexpr std::uint64_t kMax32 = std::numeric_limits<std::uint32_t>::max();
 // Largest normals radius accepted: beyond this the tangents span most of any real frame.
 constexpr int kMaxNormalRadius = 1024;
 
-[[noreturn]] void bad_parameter(const std::string& what) { throw Error(ErrorCode::invalid_parameter, what); }
+[[noreturn]] void bad_parameter(const std::string& what) {
+    throw Error(ErrorCode::invalid_parameter, what);
+}
 
 int ceil_log2(std::uint64_t v) {
     int n = 0;
@@ -26,8 +28,7 @@ int ceil_log2(std::uint64_t v) {
 
 Thresholds compute_thresholds(const Params& params) {
     if (!std::isfinite(params.ct) || params.ct < 0.0) {
-        bad_parameter("ct (curvature threshold) must be a finite angle >= 0 radians, got " +
-                      std::to_string(params.ct));
+        bad_parameter("ct (curvature threshold) must be a finite angle >= 0 radians, got " + std::to_string(params.ct));
     }
     if (std::isnan(params.dt) || params.dt < 0.0) {
         bad_parameter("dt (depth threshold) must be >= 0 millimetres (or +inf), got " + std::to_string(params.dt));
@@ -86,9 +87,9 @@ Plan make_plan(int width, int height, const Params& params) {
     plan.total_texels = offset;
     // Every backend indexes the all-levels buffers with 32-bit integers.
     if (plan.total_texels > kMax32) {
-        throw Error(ErrorCode::image_too_large,
-                    "image " + std::to_string(width) + " x " + std::to_string(height) + " needs " +
-                        std::to_string(plan.total_texels) + " pyramid texels, more than 32-bit indices address");
+        throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                    " needs " + std::to_string(plan.total_texels) +
+                                                    " pyramid texels, more than 32-bit indices address");
     }
     for (int k = 1; k <= n; ++k) plan.levels[std::size_t(k - 1)].offset = std::uint32_t(offsets[std::size_t(k)]);
 

@@ -22,11 +22,11 @@ struct Plan {
     int height = 0;
     Params params;
     Thresholds thresholds{};
-    int level_count = 0;       // N
-    int bridge_level = 0;      // M = N - b
-    int unjoinable_level = 0;  // U = M - g
-    bool small_image = false;  // the contract's fallback: plain 4-connected components
-    std::vector<PyrLevel> levels;   // levels[k - 1] is level k; level N is the full image
+    int level_count = 0;              // N
+    int bridge_level = 0;             // M = N - b
+    int unjoinable_level = 0;         // U = M - g
+    bool small_image = false;         // the contract's fallback: plain 4-connected components
+    std::vector<PyrLevel> levels;     // levels[k - 1] is level k; level N is the full image
     std::uint32_t old_label_max = 0;  // offset_{U+1}: labels 1..this are old
     std::uint32_t max_label = 0;      // the largest label any pass can create
     std::uint64_t total_texels = 0;   // offset_{N+1}, the size of the all-levels buffers

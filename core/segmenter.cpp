@@ -38,8 +38,8 @@ void check_layout(const char* what, std::size_t row_stride, int point_stride, in
     const std::size_t stride = row_stride == 0 ? std::size_t(width) : row_stride;
     const std::size_t limit = std::numeric_limits<std::size_t>::max() / sizeof(float) / std::size_t(point_stride);
     if (stride > (limit - std::size_t(width)) / std::size_t(height)) {
-        throw Error(ErrorCode::invalid_argument, std::string(what) + " row_stride " + std::to_string(row_stride) +
-                                                     " is too large to address");
+        throw Error(ErrorCode::invalid_argument,
+                    std::string(what) + " row_stride " + std::to_string(row_stride) + " is too large to address");
     }
 }
 
@@ -96,10 +96,20 @@ void Segmenter::segment_mask(const MaskView& mask, Result& out) {
     impl_->executor->read_back(out, impl_->outputs);
 }
 
-int Segmenter::width() const noexcept { return impl_->plan.width; }
-int Segmenter::height() const noexcept { return impl_->plan.height; }
-const Params& Segmenter::params() const noexcept { return impl_->plan.params; }
-const std::string& Segmenter::backend_name() const noexcept { return impl_->backend; }
-const std::vector<PassTiming>& Segmenter::last_timings() const noexcept { return impl_->timings; }
+int Segmenter::width() const noexcept {
+    return impl_->plan.width;
+}
+int Segmenter::height() const noexcept {
+    return impl_->plan.height;
+}
+const Params& Segmenter::params() const noexcept {
+    return impl_->plan.params;
+}
+const std::string& Segmenter::backend_name() const noexcept {
+    return impl_->backend;
+}
+const std::vector<PassTiming>& Segmenter::last_timings() const noexcept {
+    return impl_->timings;
+}
 
 }  // namespace pyrseg

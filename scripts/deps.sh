@@ -6,7 +6,7 @@ packages=(
   build-essential cmake ninja-build pkg-config  # toolchain
   libgtest-dev libbenchmark-dev                 # tests, benchmarks
   liblzf-dev libpng-dev                         # PCD binary_compressed, PNG pictures
-  clang glslang-tools spirv-tools               # compile checks of shaders/ as OpenCL C and GLSL
+  clang clang-format glslang-tools spirv-tools  # shaders/ compile checks as OpenCL C and GLSL; style
 )
 
 missing=()

@@ -5,6 +5,8 @@
 #define PYR_COMPACT_H
 #include "pyr_types.h"
 
-PYR_FN pyr_u32 pyr_compact_label(PYR_CTX_PARAM, pyr_u32 raw) { return raw == 0u ? 0u : PYR_LUT(raw); }
+PYR_FN pyr_u32 pyr_compact_label(PYR_CTX_PARAM, pyr_u32 raw) {
+    return raw == 0u ? 0u : PYR_LUT(raw);
+}
 
 #endif /* PYR_COMPACT_H */

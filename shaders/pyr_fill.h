@@ -10,8 +10,7 @@
  * just taken an old label must still take a smaller one): a fillable texel whose label is old (1..anchor_max) gets
  * PYR_MASK_ANCHORED in its mask before the fill starts. Returns the texel's new mask value. */
 PYR_FN pyr_u32 pyr_anchor_mask(pyr_u32 mask, pyr_u32 label, pyr_u32 anchor_max) {
-    return ((mask & PYR_MASK_FILLABLE) != 0u && label != 0u && label <= anchor_max) ? (mask | PYR_MASK_ANCHORED)
-                                                                                    : mask;
+    return ((mask & PYR_MASK_FILLABLE) != 0u && label != 0u && label <= anchor_max) ? (mask | PYR_MASK_ANCHORED) : mask;
 }
 
 PYR_FN pyr_u32 pyr_fill_relax(pyr_u32 self_label, pyr_u32 self_mask, pyr_u32 nb_label, pyr_u32 nb_mask) {

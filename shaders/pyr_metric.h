@@ -4,8 +4,7 @@
 #define PYR_METRIC_H
 #include "pyr_types.h"
 
-PYR_FN pyr_u32 pyr_metric_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_i32 tc,
-                                   pyr_f32 dt) {
+PYR_FN pyr_u32 pyr_metric_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_i32 tc, pyr_f32 dt) {
     pyr_u32 i = y * w + x;
     if (PYR_Q_VALID(i) == 0u) return 0u;
     pyr_i32 qx = PYR_QN(i, 0);

@@ -35,7 +35,9 @@ PYR_FN PyrIVec3 pyr_to_fixed(pyr_f32 x, pyr_f32 y, pyr_f32 z) {
     return r;
 }
 
-PYR_FN pyr_i32 pyr_iabs(pyr_i32 v) { return v < 0 ? -v : v; }
+PYR_FN pyr_i32 pyr_iabs(pyr_i32 v) {
+    return v < 0 ? -v : v;
+}
 
 /* Magnitude shifted right (s > 0) or left (s < 0), sign kept. */
 PYR_FN pyr_i32 pyr_shift_magnitude(pyr_i32 v, pyr_i32 s) {

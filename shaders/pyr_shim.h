@@ -3,7 +3,8 @@
  *  - no pointers or references: memory goes through accessor macros the including entry point defines
  *    (PYR_PT, PYR_Q_VALID, PYR_QN, PYR_QZ, PYR_MASK, PYR_LABEL, PYR_STORE_LABEL, PYR_VALID) and the context
  *    parameter PYR_CTX_PARAM / argument PYR_CTX_ARG that carries whatever those macros need;
- *  - casts only through PYR_I32 / PYR_U32 / PYR_F32, structs only through PYR_STRUCT / PYR_STRUCT_END;
+ *  - casts only through PYR_I32 / PYR_U32 / PYR_F32; a struct is declared PYR_TYPEDEF(Name) struct Name {...};
+ *    (OpenCL C needs the typedef to use the bare name);
  *  - entry points name their buffers pyr_buf_* (a prefix shared code never uses), so that no local variable of
  *    shared code can shadow a buffer an accessor macro refers to; shared code avoids the keywords of all four
  *    languages (OpenCL C: local, global, constant, private, kernel; GLSL: input, output, sample, filter, ...);
@@ -27,8 +28,7 @@
 #define PYR_SQRT(f) sqrt(f)
 #define PYR_MSB(u) findMSB(u)
 #define PYR_PRECISE precise
-#define PYR_STRUCT(name) struct name
-#define PYR_STRUCT_END(name) ;
+#define PYR_TYPEDEF(name)
 
 #elif defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)
 #pragma OPENCL FP_CONTRACT OFF
@@ -45,8 +45,7 @@
 #define PYR_SQRT(f) sqrt(f)
 #define PYR_MSB(u) (31 - (int)clz((uint)(u)))
 #define PYR_PRECISE
-#define PYR_STRUCT(name) typedef struct name
-#define PYR_STRUCT_END(name) name;
+#define PYR_TYPEDEF(name) typedef struct name name;
 
 #elif defined(__CUDACC__)
 #define PYR_FN static __host__ __device__ __forceinline__
@@ -68,8 +67,7 @@
 #define PYR_FABS(f) fabsf(f)
 #define PYR_SQRT(f) sqrtf(f)
 #define PYR_PRECISE
-#define PYR_STRUCT(name) struct name
-#define PYR_STRUCT_END(name) ;
+#define PYR_TYPEDEF(name)
 
 #else /* C++ (CPU backend, host code) */
 #include <bit>
@@ -88,8 +86,7 @@
 #define PYR_SQRT(f) std::sqrt(f)
 #define PYR_MSB(u) (static_cast<std::int32_t>(std::bit_width(static_cast<std::uint32_t>(u))) - 1)
 #define PYR_PRECISE
-#define PYR_STRUCT(name) struct name
-#define PYR_STRUCT_END(name) ;
+#define PYR_TYPEDEF(name)
 #endif
 
 #endif /* PYR_SHIM_H */

@@ -5,25 +5,28 @@
 
 /* One pyramid level: its size and where its texels start in the all-levels buffers. A new label for the texel
  * at buffer index i is i + 1 (contract section 4), since the buffers use the labels' offsets. */
-PYR_STRUCT(PyrLevel) {
+PYR_TYPEDEF(PyrLevel)
+struct PyrLevel {
     pyr_u32 width;
     pyr_u32 height;
     pyr_u32 offset;
-} PYR_STRUCT_END(PyrLevel)
+};
 
-PYR_STRUCT(PyrIVec3) {
+PYR_TYPEDEF(PyrIVec3)
+struct PyrIVec3 {
     pyr_i32 x;
     pyr_i32 y;
     pyr_i32 z;
-} PYR_STRUCT_END(PyrIVec3)
+};
 
 /* A quantized pixel: validity and qn (contract section 2). */
-PYR_STRUCT(PyrQuant) {
+PYR_TYPEDEF(PyrQuant)
+struct PyrQuant {
     pyr_i32 qx;
     pyr_i32 qy;
     pyr_i32 qz;
     pyr_u32 valid;
-} PYR_STRUCT_END(PyrQuant)
+};
 
 /* Normals are quantized to multiples of 2^-13. */
 #define PYR_NORMAL_SCALE 8192.0f

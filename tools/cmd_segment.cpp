@@ -100,8 +100,8 @@ int cmd_segment(const std::vector<std::string>& argv) {
                                  colorize(result.labels, result.width, result.height)}}));
     }
     std::printf("%s: %d x %d, normals %s, %u segments, %.1f ms on %s\n", input.string().c_str(), result.width,
-                result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count,
-                elapsed.count(), segmenter.backend_name().c_str());
+                result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
+                segmenter.backend_name().c_str());
     return 0;
 }
 

@@ -51,7 +51,8 @@ RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int heigh
 
 RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height) {
     RgbImage img{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 3)};
-    for (std::size_t i = 0; i < fillable.size(); ++i) std::fill_n(img.rgb.begin() + std::ptrdiff_t(3 * i), 3, fillable[i] ? 255 : 0);
+    for (std::size_t i = 0; i < fillable.size(); ++i)
+        std::fill_n(img.rgb.begin() + std::ptrdiff_t(3 * i), 3, fillable[i] ? 255 : 0);
     return img;
 }
 

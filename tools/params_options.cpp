@@ -19,8 +19,8 @@ const char* const kParameterHelp =
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
-const std::set<std::string> kParameterValueOptions = {"ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap",
-                                                      "normal-radius"};
+const std::set<std::string> kParameterValueOptions = {
+    "ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap", "normal-radius"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
 
 Params parse_params(const Args& args) {

@@ -70,8 +70,8 @@ public:
         const auto radius = uint32_t(plan_.params.normal_radius);
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
-                const PyrIVec3 q = kernels::pyr_normal_q(c, uint32_t(w), uint32_t(plan_.height), uint32_t(x),
-                                                         uint32_t(y), radius);
+                const PyrIVec3 q =
+                    kernels::pyr_normal_q(c, uint32_t(w), uint32_t(plan_.height), uint32_t(x), uint32_t(y), radius);
                 float* n = normals_.data() + 3 * (y * w + x);
                 n[0] = float(q.x) * PYR_NORMAL_UNIT;
                 n[1] = float(q.y) * PYR_NORMAL_UNIT;
@@ -117,7 +117,8 @@ public:
         const PyrLevel child = plan_.level(parent_level + 1);
         rows(parent.height, [&](size_t y) {
             std::uint8_t* out = mask_.data() + parent.offset + y * parent.width;
-            for (uint32_t x = 0; x < parent.width; ++x) out[x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, uint32_t(y)));
+            for (uint32_t x = 0; x < parent.width; ++x)
+                out[x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, uint32_t(y)));
         });
     }
 
@@ -127,7 +128,8 @@ public:
         const PyrLevel parent = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
         rows(lv.height, [&](size_t y) {
             uint32_t* out = labels_.data() + lv.offset + y * lv.width;
-            for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, uint32_t(y), mode);
+            for (uint32_t x = 0; x < lv.width; ++x)
+                out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, uint32_t(y), mode);
         });
     }
 
@@ -194,7 +196,8 @@ public:
         const PassContext c = context();
         rows(size_t(plan_.height), [&](size_t y) {
             const size_t w = size_t(plan_.width);
-            for (size_t i = y * w; i < (y + 1) * w; ++i) out.labels[i] = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
+            for (size_t i = y * w; i < (y + 1) * w; ++i)
+                out.labels[i] = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
         });
         if (outputs.raw_labels) {
             out.raw_labels.assign(raw, raw + pixels);
@@ -296,10 +299,10 @@ private:
     CloudView cloud_{};
     std::vector<float> normals_;  // estimated, packed
     std::vector<QuantPixel> quant_;
-    std::vector<std::uint8_t> mask_;   // all levels
-    std::vector<uint32_t> labels_;     // all levels
-    std::vector<uint32_t> lut_;        // raw label -> compacted label
-    std::vector<uint32_t> parent_;     // union-find scratch
+    std::vector<std::uint8_t> mask_;  // all levels
+    std::vector<uint32_t> labels_;    // all levels
+    std::vector<uint32_t> lut_;       // raw label -> compacted label
+    std::vector<uint32_t> parent_;    // union-find scratch
     std::vector<uint32_t> best_;
     bool sweeps_;
     uint32_t segment_count_ = 0;

@@ -20,8 +20,8 @@ struct PassContext {
     std::size_t row_stride = 0;     // in points
     std::size_t point_stride = 3;   // in floats
     const QuantPixel* quant = nullptr;
-    std::uint8_t* mask = nullptr;      // all levels
-    std::uint32_t* labels = nullptr;   // all levels
+    std::uint8_t* mask = nullptr;     // all levels
+    std::uint32_t* labels = nullptr;  // all levels
     const std::uint32_t* lut = nullptr;
 };
 

@@ -28,7 +28,8 @@ public:
             body(std::size_t{0}, count);
             return;
         }
-        run(count, grain, [](const void* ctx, std::size_t b, std::size_t e) { (*static_cast<const Body*>(ctx))(b, e); },
+        run(
+            count, grain, [](const void* ctx, std::size_t b, std::size_t e) { (*static_cast<const Body*>(ctx))(b, e); },
             &body);
     }
 

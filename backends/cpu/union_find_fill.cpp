@@ -14,7 +14,9 @@ using std::uint32_t;
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 
 // A texel takes part when it is fillable and not anchored; anchored texels only contribute their labels.
-bool eligible(std::uint8_t m) { return (m & (PYR_MASK_FILLABLE | PYR_MASK_ANCHORED)) == PYR_MASK_FILLABLE; }
+bool eligible(std::uint8_t m) {
+    return (m & (PYR_MASK_FILLABLE | PYR_MASK_ANCHORED)) == PYR_MASK_FILLABLE;
+}
 
 uint32_t find(uint32_t* parent, uint32_t i) {
     while (parent[i] != i) {
@@ -35,7 +37,9 @@ void unite(uint32_t* parent, uint32_t a, uint32_t b) {
     }
 }
 
-uint32_t load(uint32_t& v) { return std::atomic_ref<uint32_t>(v).load(std::memory_order_relaxed); }
+uint32_t load(uint32_t& v) {
+    return std::atomic_ref<uint32_t>(v).load(std::memory_order_relaxed);
+}
 
 }  // namespace
 

@@ -18,8 +18,8 @@ struct Params {
     // not fit the image is rejected instead.
     std::optional<int> bridge_levels;
     std::optional<int> unjoinable_gap;
-    bool label_edges = true;  // step 6c: valid edge pixels join their smallest labelled neighbour
-    bool compact = true;      // step 7: renumber labels 1..K
+    bool label_edges = true;                   // step 6c: valid edge pixels join their smallest labelled neighbour
+    bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
 };
 

@@ -15,8 +15,8 @@ struct Outputs {
 struct Result {
     int width = 0;
     int height = 0;
-    std::vector<std::uint32_t> labels;  // width*height, row-major; compacted 1..K unless Params::compact is false
-    std::uint32_t segment_count = 0;    // K, the number of distinct non-zero labels
+    std::vector<std::uint32_t> labels;        // width*height, row-major; compacted 1..K unless Params::compact is false
+    std::uint32_t segment_count = 0;          // K, the number of distinct non-zero labels
     std::vector<std::uint32_t> raw_labels;    // filled when Outputs::raw_labels
     std::vector<std::uint8_t> fillable_mask;  // filled when Outputs::fillable_mask
     std::vector<float> normals;               // filled when Outputs::normals

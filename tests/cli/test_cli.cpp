@@ -1,13 +1,13 @@
 // The pyrseg command-line tool, run as a user runs it: exit codes, messages, files written.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <map>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <string>
 #include <vector>
 
@@ -39,7 +39,9 @@ fs::path temp_dir() {
     return dir;
 }
 
-fs::path mug_scan() { return fs::path(PYRSEG_SHARED_DATA_DIR) / "table_scene_mug_stereo_textured.pcd"; }
+fs::path mug_scan() {
+    return fs::path(PYRSEG_SHARED_DATA_DIR) / "table_scene_mug_stereo_textured.pcd";
+}
 
 TEST(Cli, EveryCommandExplainsItselfWithHelp) {
     for (const char* command : {"--help", "segment --help", "demo --help", "backends --help"}) {
@@ -111,7 +113,7 @@ TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
     const fs::path labels_path = dir / "mug.npy";
     const fs::path png_path = dir / "mug.png";
     const CliRun r = run("segment " + mug_scan().string() + " --unit-mm 1000 --labels " + labels_path.string() +
-                      " --png " + png_path.string());
+                         " --png " + png_path.string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(fs::exists(png_path));
     const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);

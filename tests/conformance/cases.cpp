@@ -59,8 +59,8 @@ std::vector<ConformanceCase> build_cases() {
     std::vector<ConformanceCase> cases;
     CaseRng rng(20261122);
     // The sizes that matter: degenerate strips, the fallback boundary (8 vs 9), odd sizes, camera frames.
-    const int fixed[][2] = {{1, 1},   {1, 7},   {7, 1},     {8, 8},    {9, 9},     {33, 17},  {640, 480},
-                            {640, 480}, {1031, 772}, {2064, 1544}, {2, 2},  {16, 1},  {1, 16},  {17, 9}};
+    const int fixed[][2] = {{1, 1},     {1, 7},      {7, 1},       {8, 8}, {9, 9},  {33, 17}, {640, 480},
+                            {640, 480}, {1031, 772}, {2064, 1544}, {2, 2}, {16, 1}, {1, 16},  {17, 9}};
     for (const auto& size : fixed) {
         const bool vary = int(cases.size()) % 2 == 1;
         cases.push_back(make_case(int(cases.size()), size[0], size[1], rng, vary));

@@ -25,8 +25,8 @@ Outputs everything() {
 }
 
 // Segments `points` with `backend` and compares every output with the reference.
-void expect_conformance(const std::string& backend, const float* points, const float* normals, int width,
-                        int height, const Params& params, const float* warmup_points = nullptr) {
+void expect_conformance(const std::string& backend, const float* points, const float* normals, int width, int height,
+                        const Params& params, const float* warmup_points = nullptr) {
     const pyrseg_ref::Output ref = pyrseg_ref::segment(points, normals, width, height, to_reference(params));
     if (!ref.ok) {
         EXPECT_THROW(Segmenter(width, height, params, backend, everything()), pyrseg::Error)
@@ -66,17 +66,17 @@ TEST_P(SyntheticScenes, MatchesReference) {
         o.seed += 7777;
         other = synthetic::generate(o);
     }
-    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr,
-                       scene.width, scene.height, c.params, small ? other.points.data() : nullptr);
+    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr, scene.width,
+                       scene.height, c.params, small ? other.points.data() : nullptr);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Backends, SyntheticScenes,
-    ::testing::Combine(::testing::ValuesIn(available_backend_names()),
-                       ::testing::Range(0, int(conformance_cases().size()))),
-    [](const ::testing::TestParamInfo<SyntheticScenes::ParamType>& param_info) {
-        return std::get<0>(param_info.param) + "_" + conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
-    });
+INSTANTIATE_TEST_SUITE_P(Backends, SyntheticScenes,
+                         ::testing::Combine(::testing::ValuesIn(available_backend_names()),
+                                            ::testing::Range(0, int(conformance_cases().size()))),
+                         [](const ::testing::TestParamInfo<SyntheticScenes::ParamType>& param_info) {
+                             return std::get<0>(param_info.param) + "_" +
+                                    conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
+                         });
 
 class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 

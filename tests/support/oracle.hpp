@@ -68,9 +68,9 @@ inline bool skip_unavailable(const std::string& backend, std::string* reason) {
     return true;
 }
 
-#define PYRSEG_SKIP_IF_UNAVAILABLE(backend)                                                     \
-    do {                                                                                        \
-        std::string skip_reason_;                                                               \
+#define PYRSEG_SKIP_IF_UNAVAILABLE(backend)                                                         \
+    do {                                                                                            \
+        std::string skip_reason_;                                                                   \
         if (::pyrseg::test::skip_unavailable(backend, &skip_reason_)) GTEST_SKIP() << skip_reason_; \
     } while (0)
 
@@ -89,6 +89,8 @@ inline std::vector<std::string> available_backend_names() {
     return names;
 }
 
-inline std::string shared_data_dir() { return PYRSEG_SHARED_DATA_DIR; }
+inline std::string shared_data_dir() {
+    return PYRSEG_SHARED_DATA_DIR;
+}
 
 }  // namespace pyrseg::test

@@ -74,8 +74,8 @@ TEST(Segmenter, ReportsTimingsOfEveryPass) {
         passes.emplace_back(t.pass);
         EXPECT_GE(t.milliseconds, 0.0);
     }
-    EXPECT_EQ(passes, (std::vector<std::string>{"normals", "quantize", "metric", "mip", "labels", "fill",
-                                                "final_fill", "edges", "compact"}));
+    EXPECT_EQ(passes, (std::vector<std::string>{"normals", "quantize", "metric", "mip", "labels", "fill", "final_fill",
+                                                "edges", "compact"}));
 }
 
 TEST(Backends, CpuIsAlwaysAvailableAndLast) {
