@@ -11,6 +11,7 @@
 #include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
 
@@ -91,15 +92,6 @@ void print_timing_table(const std::vector<Timed>& all) {
     }
 }
 
-void write_figure(const fs::path& path, const Result& r) {
-    std::uint32_t ccl_count = 0;
-    const auto ccl = connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
-    write_png(path.string(),
-              side_by_side({{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
-                            {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
-                            {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}}));
-}
-
 // Segments the scene with every available backend; returns false when they disagree.
 bool segment_everywhere(const std::string& name, const CloudView& view, const Params& params, int runs,
                         const fs::path& out_dir, std::vector<fs::path>& written) {
@@ -121,21 +113,11 @@ bool segment_everywhere(const std::string& name, const CloudView& view, const Pa
     print_timing_table(all);
     const fs::path figure = out_dir / (name + "_figure.png");
     const fs::path segments = out_dir / (name + "_segments.png");
-    write_figure(figure, r);
+    write_png(figure.string(), comparison_figure(r));
     write_png(segments.string(), colorize(r.labels, r.width, r.height));
     written.push_back(figure);
     written.push_back(segments);
     return agree;
-}
-
-double median_depth(const std::vector<float>& points) {
-    std::vector<float> z;
-    for (std::size_t i = 2; i < points.size(); i += 3) {
-        if (std::isfinite(points[i]) && points[i] > 0) z.push_back(points[i]);
-    }
-    if (z.empty()) return 0.0;
-    std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(z.size() / 2), z.end());
-    return z[z.size() / 2];
 }
 
 }  // namespace

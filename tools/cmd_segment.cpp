@@ -9,6 +9,7 @@
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
 
@@ -27,16 +28,6 @@ constexpr const char* kSegmentUsage =
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n";
-
-double median_depth(const std::vector<float>& points) {
-    std::vector<float> z;
-    for (std::size_t i = 2; i < points.size(); i += 3) {
-        if (std::isfinite(points[i]) && points[i] > 0) z.push_back(points[i]);
-    }
-    if (z.empty()) return 0.0;
-    std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(z.size() / 2), z.end());
-    return z[z.size() / 2];
-}
 
 }  // namespace
 
@@ -89,16 +80,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (labels_path) io::write_npy(*labels_path, result.labels.data(), result.height, result.width);
     if (png_path) write_png(*png_path, colorize(result.labels, result.width, result.height));
     if (mask_path) write_png(*mask_path, mask_picture(result.fillable_mask, result.width, result.height));
-    if (figure_path) {
-        std::uint32_t ccl_count = 0;
-        const auto ccl = connected_components(result.fillable_mask, result.width, result.height, &ccl_count);
-        write_png(*figure_path,
-                  side_by_side({{"fillable mask", mask_picture(result.fillable_mask, result.width, result.height)},
-                                {"connected components: " + std::to_string(ccl_count),
-                                 colorize(ccl, result.width, result.height)},
-                                {"pyramid: " + std::to_string(result.segment_count),
-                                 colorize(result.labels, result.width, result.height)}}));
-    }
+    if (figure_path) write_png(*figure_path, comparison_figure(result));
     std::printf("%s: %d x %d, normals %s, %u segments, %.1f ms on %s\n", input.string().c_str(), result.width,
                 result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
                 segmenter.backend_name().c_str());

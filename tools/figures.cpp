@@ -111,6 +111,14 @@ RgbImage side_by_side(const std::vector<Panel>& panels) {
     return out;
 }
 
+RgbImage comparison_figure(const Result& r) {
+    std::uint32_t ccl_count = 0;
+    const auto ccl = connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
+    return side_by_side({{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
+                         {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
+                         {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}});
+}
+
 void write_png(const std::string& path, const RgbImage& image) {
     io::write_png_rgb(path, image.rgb.data(), image.width, image.height);
 }

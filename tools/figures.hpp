@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "pyrseg/result.hpp"
+
 namespace pyrseg::cli {
 
 struct RgbImage {
@@ -27,6 +29,9 @@ struct Panel {
 };
 // Panels side by side (all the same size), each under its caption, on a dark background.
 [[nodiscard]] RgbImage side_by_side(const std::vector<Panel>& panels);
+
+// The paper's Figure 3 for one result (needs Outputs::fillable_mask): mask | plain connected components | pyramid.
+[[nodiscard]] RgbImage comparison_figure(const Result& result);
 
 void write_png(const std::string& path, const RgbImage& image);
 
