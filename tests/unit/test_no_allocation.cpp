@@ -1,0 +1,72 @@
+// "No allocation per frame": after the first frame has sized the Result, segmenting allocates nothing at all.
+// Counted with a replaced global operator new (this test binary only).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <functional>
+#include <new>
+
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
+
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+    if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace pyrseg {
+namespace {
+
+long allocations_during(const std::function<void()>& f) {
+    allocations = 0;
+    counting = true;
+    f();
+    counting = false;
+    return allocations.load();
+}
+
+TEST(NoAllocation, WarmFramesAllocateNothing) {
+    synthetic::SceneOptions o;
+    o.width = 320;
+    o.height = 240;
+    const synthetic::Scene a = synthetic::generate(o);
+    o.seed = 2;
+    const synthetic::Scene b = synthetic::generate(o);
+    Outputs outputs;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = true;
+    for (const bool given_normals : {false, true}) {
+        Segmenter segmenter(320, 240, {}, "cpu", outputs);
+        Result result;
+        const CloudView va{a.points.data(), given_normals ? a.normals.data() : nullptr, 320, 240};
+        const CloudView vb{b.points.data(), given_normals ? b.normals.data() : nullptr, 320, 240};
+        segmenter.segment(va, result);  // sizes everything
+        EXPECT_EQ(allocations_during([&] {
+                      for (int frame = 0; frame < 4; ++frame) segmenter.segment(frame % 2 ? va : vb, result);
+                  }),
+                  0)
+            << (given_normals ? "given normals" : "estimated normals");
+        EXPECT_GT(result.segment_count, 1u);
+        // The counter does count: a fresh Result must be sized.
+        EXPECT_GT(allocations_during([&] {
+                      Result fresh;
+                      segmenter.segment(va, fresh);
+                  }),
+                  0);
+    }
+}
+
+}  // namespace
+}  // namespace pyrseg
