@@ -4,5 +4,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
 scripts/deps.sh
-cmake --preset "$preset" >/dev/null
+# Show which backends this build has and why not the others; the rest of configure's output is noise.
+cmake --preset "$preset" | grep -E "^-- pyrseg" || true
 cmake --build --preset "$preset"
