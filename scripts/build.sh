@@ -5,5 +5,9 @@ cd "$(dirname "$0")/.."
 preset="${1:-release}"
 scripts/deps.sh
 # Show which backends this build has and why not the others; the rest of configure's output is noise.
-cmake --preset "$preset" | grep -E "^-- pyrseg" || true
+if ! configure_log=$(cmake --preset "$preset" 2>&1); then
+  echo "$configure_log"
+  exit 1
+fi
+grep -E "^-- pyrseg" <<<"$configure_log" || true
 cmake --build --preset "$preset"
