@@ -108,8 +108,13 @@ bool segment_everywhere(const std::string& name, const CloudView& view, const Pa
         }
     }
     const Result& r = all.front().result;
-    std::printf("%s: %d x %d, %u segments; %zu backend(s) %s\n", name.c_str(), r.width, r.height, r.segment_count,
-                all.size(), agree ? "agree byte for byte" : "DISAGREE");
+    if (all.size() == 1) {
+        std::printf("%s: %d x %d, %u segments; only %s is available here, so there is nothing to cross-check\n",
+                    name.c_str(), r.width, r.height, r.segment_count, all.front().backend.c_str());
+    } else {
+        std::printf("%s: %d x %d, %u segments; %zu backends %s\n", name.c_str(), r.width, r.height, r.segment_count,
+                    all.size(), agree ? "agree byte for byte" : "DISAGREE");
+    }
     print_timing_table(all);
     const fs::path figure = out_dir / (name + "_figure.png");
     const fs::path segments = out_dir / (name + "_segments.png");
