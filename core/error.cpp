@@ -12,6 +12,8 @@ const char* to_string(ErrorCode code) noexcept {
             return "size mismatch";
         case ErrorCode::image_too_large:
             return "image too large";
+        case ErrorCode::out_of_memory:
+            return "out of memory";
         case ErrorCode::backend_unavailable:
             return "backend unavailable";
         case ErrorCode::io:

@@ -6,9 +6,14 @@
 #include <cstring>
 #include <vector>
 
+#include <unistd.h>
+#include <new>
+#include <string>
+
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
+#include "pyrseg/error.hpp"
 
 namespace pyrseg::cpu {
 namespace {
@@ -311,10 +316,37 @@ private:
     bool from_mask_ = false;
 };
 
+size_t physical_memory_bytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const long page = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page > 0 ? size_t(pages) * size_t(page) : 0;
+}
+
 }  // namespace
 
+size_t memory_needed(const core::Plan& plan) {
+    const size_t pixels = plan.pixel_count();
+    return pixels * (sizeof(QuantPixel) + 3 * sizeof(float)) +  // quantized pixels, estimated normals
+           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
+           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
+           2 * fill_scratch_size(plan) * sizeof(uint32_t);                          // union-find
+}
+
 std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
-    return std::make_unique<CpuExecutor>(plan);
+    const size_t needed = memory_needed(plan);
+    const size_t available = physical_memory_bytes();
+    const auto mib = [](size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
+    const std::string what = "a " + std::to_string(plan.width) + " x " + std::to_string(plan.height) +
+                             " image needs about " + mib(needed) + " on the CPU backend";
+    // Checked up front: an allocation this large may succeed on paper and then get the process killed.
+    if (available != 0 && needed > available) {
+        throw Error(ErrorCode::out_of_memory, what + ", more than this machine's " + mib(available));
+    }
+    try {
+        return std::make_unique<CpuExecutor>(plan);
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::out_of_memory, what + ", and allocating it failed");
+    }
 }
 
 }  // namespace pyrseg::cpu

@@ -11,6 +11,7 @@ enum class ErrorCode {
     size_mismatch,        // a frame whose size differs from the Segmenter's
     image_too_large,      // labels or pixel indices would not fit in 32 bits
     backend_unavailable,  // unknown backend name, or a backend that cannot run here (the message says why)
+    out_of_memory,        // the buffers for this image size do not fit in this machine's memory
     io,                   // a file could not be opened, read or written
     format,               // a file's contents are malformed or unsupported
     internal,             // a bug: please report it

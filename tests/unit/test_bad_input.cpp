@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
 
@@ -154,6 +156,16 @@ TEST(BadInput, BridgeParametersThatDoNotFitAndHugeImagesAreErrors) {
     expect_error(ErrorCode::invalid_parameter, "bridge_levels", [&] { Segmenter(640, 480, p, "cpu"); });
     expect_error(ErrorCode::image_too_large, "32-bit", [] { Segmenter(70000, 70000, {}, "cpu"); });
     expect_error(ErrorCode::image_too_large, "32-bit", [] { Segmenter(60000, 60000, {}, "cpu"); });
+}
+
+TEST(BadInput, ImagesTooLargeForThisMachinesMemoryAreErrors) {
+    // 55000 x 55000 passes the 32-bit checks but needs about 70 GiB on the CPU backend.
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const double gib = double(pages) * double(sysconf(_SC_PAGE_SIZE)) / double(1 << 30);
+    if (gib > 64)
+        GTEST_SKIP() << "this machine has " << gib << " GiB: the image would fit, and this test allocates nothing";
+    expect_error(ErrorCode::out_of_memory, "55000 x 55000 image needs about",
+                 [] { Segmenter(55000, 55000, {}, "cpu"); });
 }
 
 TEST(BadInput, TheCallersBuffersAreNotModified) {
