@@ -42,8 +42,10 @@ std::string resolve_backend_name(std::string_view requested) {
     for (const BackendInfo& b : all) {
         if (b.name == name) {
             if (!b.available) {
-                throw Error(ErrorCode::backend_unavailable,
-                            "backend '" + name + "' (" + origin + ") is unavailable: " + b.reason);
+                std::string message = "backend '" + name;
+                message += "' (" + origin + ") is unavailable: ";
+                message += b.reason;
+                throw Error(ErrorCode::backend_unavailable, message);
             }
             return b.name;
         }

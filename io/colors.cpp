@@ -12,14 +12,14 @@ namespace pyrseg::io {
 namespace {
 
 // 2^32 / g^2 and 2^32 / g for the plastic number g: the R2 sequence, the 2-D analogue of golden-ratio hashing.
-constexpr std::uint32_t hue_step = 0x91E10DA5u;
-constexpr std::uint32_t shade_step = 0xC13FA9A9u;
-constexpr unsigned min_level = 130;  // lowest saturation or value, out of 255: keeps every colour vivid
+constexpr std::uint32_t kHueStep = 0x91E10DA5u;
+constexpr std::uint32_t kShadeStep = 0xC13FA9A9u;
+constexpr unsigned kMinLevel = 130;  // lowest saturation or value, out of 255: keeps every colour vivid
 
 // Around the hue circle in six sectors, each channel is full, off, rising or falling.
 enum Ramp { full, off, rise, fall };
-constexpr Ramp ramps[6][3] = {{full, rise, off}, {fall, full, off}, {off, full, rise},
-                              {off, fall, full}, {rise, off, full}, {full, off, fall}};
+constexpr Ramp kRamps[6][3] = {{full, rise, off}, {fall, full, off}, {off, full, rise},
+                               {off, fall, full}, {rise, off, full}, {full, off, fall}};
 
 unsigned ramp_level(Ramp r, unsigned up) {
     switch (r) {
@@ -40,16 +40,17 @@ unsigned ramp_level(Ramp r, unsigned up) {
 std::array<std::uint8_t, 3> label_color(std::uint32_t label) {
     if (label == 0) return {0, 0, 0};
     // Integer arithmetic only, so the same label is the same colour on every machine.
-    const std::uint32_t hue = static_cast<std::uint32_t>((std::uint64_t{label * hue_step} * 1536) >> 32);
-    const unsigned t = (label * shade_step) >> 24;
+    const std::uint32_t hue =
+        static_cast<std::uint32_t>((std::uint64_t{static_cast<std::uint32_t>(label * kHueStep)} * 1536) >> 32);
+    const unsigned t = (label * kShadeStep) >> 24;
     const unsigned up = hue & 255;
     const unsigned sector = hue >> 8;
     // Half the shades darken the pure hue, half pale it, so colours with nearby hues still differ.
-    const unsigned value = t < 128 ? 255 - (127 - t) * (255 - min_level) / 127 : 255;
-    const unsigned saturation = t < 128 ? 255 : 255 - (t - 128) * (255 - min_level) / 127;
+    const unsigned value = t < 128 ? 255 - (127 - t) * (255 - kMinLevel) / 127 : 255;
+    const unsigned saturation = t < 128 ? 255 : 255 - (t - 128) * (255 - kMinLevel) / 127;
     std::array<std::uint8_t, 3> out{};
     for (int c = 0; c < 3; ++c) {
-        unsigned v = 255 - (saturation * (255 - ramp_level(ramps[sector][c], up)) + 127) / 255;
+        unsigned v = 255 - (saturation * (255 - ramp_level(kRamps[sector][c], up)) + 127) / 255;
         v = (v * value + 127) / 255;
         out[static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(v);
     }

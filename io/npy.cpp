@@ -20,9 +20,9 @@ using detail::fail;
 
 static_assert(std::endian::native == std::endian::little, "npy '<' dtypes are written straight from memory");
 
-constexpr char magic[] = "\x93NUMPY";
-constexpr std::size_t magic_len = 6;
-constexpr std::size_t align = 64;
+constexpr char kMagic[] = "\x93NUMPY";
+constexpr std::size_t kMagicLen = 6;
+constexpr std::size_t kAlign = 64;
 
 std::string shape_repr(const std::vector<std::size_t>& shape) {
     std::string s = "(";
@@ -35,11 +35,11 @@ void write_array(const std::filesystem::path& path, const char* descr, const std
     // The same dict numpy writes (keys sorted), padded the way numpy's _wrap_header pads it.
     std::string dict =
         std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': " + shape_repr(shape) + ", }";
-    const std::size_t used = magic_len + 2 + 2 + dict.size() + 1;
-    dict.append(align - used % align, ' ');
+    const std::size_t used = kMagicLen + 2 + 2 + dict.size() + 1;
+    dict.append(kAlign - used % kAlign, ' ');
     dict += '\n';
     const auto header_len = static_cast<std::uint16_t>(dict.size());
-    std::string out(magic, magic_len);
+    std::string out(kMagic, kMagicLen);
     out += '\x01';
     out += '\x00';
     out.append(reinterpret_cast<const char*>(&header_len), 2);
@@ -186,7 +186,7 @@ void write_npy(const std::filesystem::path& path, const float* data, int height,
 
 NpyArray read_npy(const std::filesystem::path& path) {
     const std::vector<unsigned char> bytes = detail::read_file(path);
-    if (bytes.size() < magic_len + 4 || std::memcmp(bytes.data(), magic, magic_len) != 0) {
+    if (bytes.size() < kMagicLen + 4 || std::memcmp(bytes.data(), kMagic, kMagicLen) != 0) {
         fail(ErrorCode::format, path, "not a .npy file (no \\x93NUMPY magic)");
     }
     const unsigned major = bytes[6], minor = bytes[7];

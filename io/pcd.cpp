@@ -28,7 +28,7 @@ using detail::PcdHeader;
 static_assert(std::endian::native == std::endian::little, "PCD binary reading assumes a little-endian host");
 
 // LZF copies at most 264 bytes per 3-byte back reference, so no valid block expands more than 88 times.
-constexpr std::uint64_t max_lzf_ratio = 88;
+constexpr std::uint64_t kMaxLzfRatio = 88;
 
 float load_float(const unsigned char* p, int size) {
     if (size == 8) {
@@ -111,7 +111,7 @@ void read_compressed(const PcdHeader& h, const std::vector<unsigned char>& bytes
              what + "compressed size " + std::to_string(compressed) + " exceeds the " + std::to_string(left - 8) +
                  " bytes left in the file (truncated file?)");
     }
-    if (compressed == 0 || uncompressed > max_lzf_ratio * compressed) {
+    if (compressed == 0 || uncompressed > kMaxLzfRatio * compressed) {
         fail(ErrorCode::format, path,
              what + "compressed size " + std::to_string(compressed) + " is too small to hold " +
                  std::to_string(uncompressed) + " bytes of LZF data");

@@ -14,8 +14,8 @@ namespace pyrseg::io::detail {
 
 namespace {
 
-constexpr std::uint64_t max_count = std::uint64_t{1} << 24;       // values of one field in one point
-constexpr std::uint64_t max_point_size = std::uint64_t{1} << 32;  // bytes per point, all fields
+constexpr std::uint64_t kMaxCount = std::uint64_t{1} << 24;      // values of one field in one point
+constexpr std::uint64_t kMaxPointSize = std::uint64_t{1} << 32;  // bytes per point, all fields
 
 std::vector<std::string_view> split(std::string_view line) {
     std::vector<std::string_view> tokens;
@@ -31,13 +31,13 @@ std::vector<std::string_view> split(std::string_view line) {
 
 // Header text quoted in messages: short, and with control bytes shown as '?' so a binary file cannot garble them.
 std::string quote(std::string_view text) {
-    constexpr std::size_t max_len = 40;
+    constexpr std::size_t kMaxLen = 40;
     std::string out = "'";
-    for (std::size_t i = 0; i < text.size() && i < max_len; ++i) {
+    for (std::size_t i = 0; i < text.size() && i < kMaxLen; ++i) {
         const auto c = static_cast<unsigned char>(text[i]);
         out += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
     }
-    if (text.size() > max_len) out += "...";
+    if (text.size() > kMaxLen) out += "...";
     return out + "'";
 }
 
@@ -75,7 +75,7 @@ public:
 
 private:
     enum Key { version, fields, size, type, count, width, height, viewpoint, points, data, key_count };
-    static constexpr std::array<std::string_view, key_count> key_names = {
+    static constexpr std::array<std::string_view, key_count> kEyNames = {
         "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
 
     [[noreturn]] void fail(const std::string& what) const { detail::fail(ErrorCode::format, path_, what); }
@@ -101,7 +101,7 @@ private:
             const auto tokens = split(raw);
             if (tokens.empty() || tokens[0].front() == '#') continue;
             std::size_t k = 0;
-            while (k < key_count && key_names[k] != tokens[0]) ++k;
+            while (k < key_count && kEyNames[k] != tokens[0]) ++k;
             if (k == key_count) {
                 fail("header line " + std::to_string(number) + " " + quote(raw) +
                      " is not a PCD header line (expected VERSION, FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, "
@@ -109,7 +109,7 @@ private:
             }
             Line& line = lines_[k];
             if (line.present) {
-                fail("header line " + std::to_string(number) + ": second " + std::string(key_names[k]) +
+                fail("header line " + std::to_string(number) + ": second " + std::string(kEyNames[k]) +
                      " line (the first is line " + std::to_string(line.number) + ")");
             }
             line.present = true;
@@ -124,7 +124,7 @@ private:
     }
 
     const Line& required(Key k) const {
-        if (!lines_[k].present) fail("missing " + std::string(key_names[k]) + " line in the header");
+        if (!lines_[k].present) fail("missing " + std::string(kEyNames[k]) + " line in the header");
         return lines_[k];
     }
 
@@ -132,7 +132,7 @@ private:
     std::string_view single(Key k) const {
         const Line& line = required(k);
         if (line.values.size() != 1) {
-            fail(std::string(key_names[k]) + " needs exactly one value, line " + std::to_string(line.number) + " has " +
+            fail(std::string(kEyNames[k]) + " needs exactly one value, line " + std::to_string(line.number) + " has " +
                  std::to_string(line.values.size()));
         }
         return line.values[0];
@@ -165,11 +165,11 @@ private:
         const Line& line = lines_[k];
         const auto n = h.fields.size();
         if (line.values.size() < n) {
-            fail(std::string(key_names[k]) + " has no entry for field " + quote(h.fields[line.values.size()].name) +
+            fail(std::string(kEyNames[k]) + " has no entry for field " + quote(h.fields[line.values.size()].name) +
                  " (" + std::to_string(line.values.size()) + " entries for " + std::to_string(n) + " FIELDS)");
         }
         if (line.values.size() > n) {
-            fail(std::string(key_names[k]) + " has " + std::to_string(line.values.size()) + " entries for " +
+            fail(std::string(kEyNames[k]) + " has " + std::to_string(line.values.size()) + " entries for " +
                  std::to_string(n) + " FIELDS");
         }
         return line.values;
@@ -203,9 +203,9 @@ private:
             }
             if (has_count) {
                 const auto c = parse_uint(counts[i]);
-                if (!c || *c < 1 || *c > max_count) {
+                if (!c || *c < 1 || *c > kMaxCount) {
                     fail(field + "COUNT " + quote(counts[i]) + " is not a number from 1 to " +
-                         std::to_string(max_count));
+                         std::to_string(kMaxCount));
                 }
                 f.count = *c;
             }
@@ -213,16 +213,16 @@ private:
             // No overflow: offset <= 2^32 here and one field adds at most 8 * 2^24 bytes.
             offset += f.bytes();
             h.values_per_point += f.count;
-            if (offset > max_point_size) {
-                fail("points of more than " + std::to_string(max_point_size) + " bytes are not supported");
+            if (offset > kMaxPointSize) {
+                fail("points of more than " + std::to_string(kMaxPointSize) + " bytes are not supported");
             }
         }
         h.point_size = offset;
     }
 
     void find_xyz_and_normals(PcdHeader& h) const {
-        constexpr std::array<const char*, 3> xyz_names = {"x", "y", "z"};
-        constexpr std::array<const char*, 3> normal_names = {"normal_x", "normal_y", "normal_z"};
+        constexpr std::array<const char*, 3> kXyzNames = {"x", "y", "z"};
+        constexpr std::array<const char*, 3> kNormalNames = {"normal_x", "normal_y", "normal_z"};
         auto find = [&](const char* name) {
             for (std::size_t i = 0; i < h.fields.size(); ++i) {
                 if (h.fields[i].name == name) return static_cast<int>(i);
@@ -237,22 +237,22 @@ private:
             }
         };
         for (int c = 0; c < 3; ++c) {
-            h.xyz[c] = find(xyz_names[static_cast<std::size_t>(c)]);
+            h.xyz[c] = find(kXyzNames[static_cast<std::size_t>(c)]);
             if (h.xyz[c] < 0) {
-                fail(std::string("no field '") + xyz_names[static_cast<std::size_t>(c)] +
+                fail(std::string("no field '") + kXyzNames[static_cast<std::size_t>(c)] +
                      "': pyrseg needs fields x, y and z");
             }
             check_float(h.xyz[c]);
         }
         int found = 0;
         for (int c = 0; c < 3; ++c) {
-            h.normal[c] = find(normal_names[static_cast<std::size_t>(c)]);
+            h.normal[c] = find(kNormalNames[static_cast<std::size_t>(c)]);
             found += h.normal[c] >= 0 ? 1 : 0;
         }
         if (found != 0 && found != 3) {
             std::string missing;
             for (int c = 0; c < 3; ++c) {
-                if (h.normal[c] < 0) missing += std::string(missing.empty() ? "" : " ") + normal_names[c];
+                if (h.normal[c] < 0) missing += std::string(missing.empty() ? "" : " ") + kNormalNames[c];
             }
             fail("normals need all of normal_x normal_y normal_z; missing " + missing);
         }
@@ -264,7 +264,7 @@ private:
         auto dim = [&](Key k) {
             const std::string_view v = single(k);
             const auto n = parse_uint(v);
-            if (!n) fail(std::string(key_names[k]) + " " + quote(v) + " is not a non-negative integer");
+            if (!n) fail(std::string(kEyNames[k]) + " " + quote(v) + " is not a non-negative integer");
             return *n;
         };
         const std::uint64_t w = dim(width);
@@ -276,8 +276,8 @@ private:
         if (hgt == 1) {
             fail("unorganized cloud (HEIGHT 1): pyrseg needs an organized cloud (HEIGHT > 1, one point per pixel)");
         }
-        constexpr std::uint64_t max_points = INT_MAX;
-        if (w > max_points || hgt > max_points || w * hgt > max_points) {
+        constexpr std::uint64_t kMaxPoints = INT_MAX;
+        if (w > kMaxPoints || hgt > kMaxPoints || w * hgt > kMaxPoints) {
             fail("WIDTH " + std::to_string(w) + " x HEIGHT " + std::to_string(hgt) +
                  " is more points than pyrseg supports (2^31 - 1)");
         }

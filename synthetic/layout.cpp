@@ -9,27 +9,27 @@
 namespace pyrseg::synthetic::detail {
 namespace {
 
-constexpr double pi = 3.141592653589793;
-constexpr double deg = pi / 180.0;
+constexpr double kPi = 3.141592653589793;
+constexpr double kDeg = kPi / 180.0;
 
 // Roughly a PhoXi M over a small-load-carrier bin: the camera 1.2 m from the floor point it looks at.
-constexpr double camera_distance = 1200.0;
-constexpr double bin_half_x = 365.0;  // inner half sizes
-constexpr double bin_half_y = 265.0;
-constexpr double wall_thickness = 15.0;
-constexpr double bin_height = 220.0;  // floor to rim
-constexpr double bottom_thickness = 15.0;
+constexpr double kCameraDistance = 1200.0;
+constexpr double kBinHalfX = 365.0;  // inner half sizes
+constexpr double kBinHalfY = 265.0;
+constexpr double kWallThickness = 15.0;
+constexpr double kBinHeight = 220.0;  // floor to rim
+constexpr double kBottomThickness = 15.0;
 
 // Objects rest this far above what carries them and stop this close to what they slide against: far below the
 // noise, yet wide enough for the overlap test to settle quickly.
-constexpr double clearance = 0.01;
+constexpr double kClearance = 0.01;
 // Sliding probes in steps shorter than the thinnest wall and object, so that nothing is skipped over.
-constexpr double probe_step = 4.0;
-constexpr double separation = 15.0;               // gap kept between objects (and walls) when they must not touch
-constexpr double wall_rise = 1000.0;              // see Packer::add_wall
-constexpr double max_pile_top = bin_height + 60;  // how high above the floor a pile may reach
+constexpr double kProbeStep = 4.0;
+constexpr double kSeparation = 15.0;             // gap kept between objects (and walls) when they must not touch
+constexpr double kWallRise = 1000.0;             // see Packer::add_wall
+constexpr double kMaxPileTop = kBinHeight + 60;  // how high above the floor a pile may reach
 
-const Vec3 world_up{0, 0, 1};
+const Vec3 kWorldUp{0, 0, 1};
 
 enum class Kind { upright_box, leaning_box, standing_cylinder, lying_cylinder, sphere };
 
@@ -49,7 +49,7 @@ Vec3 horizontal(double angle) {
 // An object of the given kind at the origin; lean is the horizontal direction a leaning box tips towards.
 Solid make_object(Kind kind, Rng& rng, Vec3 lean, bool steep) {
     Solid s;
-    const double yaw = rng.uniform(0, 2 * pi);
+    const double yaw = rng.uniform(0, 2 * kPi);
     switch (kind) {
         case Kind::upright_box:
         case Kind::leaning_box: {
@@ -57,29 +57,29 @@ Solid make_object(Kind kind, Rng& rng, Vec3 lean, bool steep) {
             const double a = rng.uniform(50, 170), b = rng.uniform(40, std::min(a, 130.0));
             s.half = {a / 2, b / 2, rng.uniform(30, 110) / 2};
             if (kind == Kind::upright_box) {
-                s.frame = frame_from_z(world_up, horizontal(yaw));
+                s.frame = frame_from_z(kWorldUp, horizontal(yaw));
                 break;
             }
             // Tipped about a bottom edge towards lean, as a box leaning on a wall or on a neighbour rests.
             if (rng.chance(0.5)) std::swap(s.half.x, s.half.y);
-            const Vec3 axis = cross(world_up, lean);
-            const double tilt = (steep ? rng.uniform(15, 40) : rng.uniform(8, 20)) * deg;
+            const Vec3 axis = cross(kWorldUp, lean);
+            const double tilt = (steep ? rng.uniform(15, 40) : rng.uniform(8, 20)) * kDeg;
             s.frame.axis[0] = rotated(lean, axis, tilt);
             s.frame.axis[1] = axis;
-            s.frame.axis[2] = rotated(world_up, axis, tilt);
+            s.frame.axis[2] = rotated(kWorldUp, axis, tilt);
             break;
         }
         case Kind::standing_cylinder:
             s.shape = Shape::cylinder;
             s.half.x = s.half.y = rng.uniform(20, 50);
             s.half.z = rng.uniform(30, 90);
-            s.frame = frame_from_z(world_up, horizontal(yaw));
+            s.frame = frame_from_z(kWorldUp, horizontal(yaw));
             break;
         case Kind::lying_cylinder:
             s.shape = Shape::cylinder;
             s.half.x = s.half.y = rng.uniform(18, 45);
             s.half.z = rng.uniform(40, 100);
-            s.frame = frame_from_z(horizontal(yaw), world_up);
+            s.frame = frame_from_z(horizontal(yaw), kWorldUp);
             break;
         case Kind::sphere:
             s.shape = Shape::sphere;
@@ -98,8 +98,8 @@ public:
     // a rim or hanging out of the bin.
     void add_wall(const Solid& wall) {
         Solid tall = wall;
-        tall.half.z += wall_rise / 2;
-        tall.center = tall.center + world_up * (wall_rise / 2);
+        tall.half.z += kWallRise / 2;
+        tall.center = tall.center + kWorldUp * (kWallRise / 2);
         blockers_.push_back(tall);
         ++walls_;
     }
@@ -113,17 +113,17 @@ public:
 
 private:
     [[nodiscard]] Vec3 random_point(double inset) {
-        const double hx = std::max(bin_half_x - inset, 0.0), hy = std::max(bin_half_y - inset, 0.0);
+        const double hx = std::max(kBinHalfX - inset, 0.0), hy = std::max(kBinHalfY - inset, 0.0);
         return center_ + frame_.to_parent({rng_.uniform(-hx, hx), rng_.uniform(-hy, hy), 0});
     }
 
     // Whether p lies over the floor of the bin (or of the region objects are put in when there is none).
     [[nodiscard]] bool inside(Vec3 p) const {
         const Vec3 l = frame_.to_local(p - center_);
-        return std::abs(l.x) < bin_half_x && std::abs(l.y) < bin_half_y;
+        return std::abs(l.x) < kBinHalfX && std::abs(l.y) < kBinHalfY;
     }
 
-    void rest(Solid& s) const { s.center.z += base_z_ + clearance - support(s, -world_up).z; }
+    void rest(Solid& s) const { s.center.z += base_z_ + kClearance - support(s, -kWorldUp).z; }
 
     [[nodiscard]] bool free(const Solid& s, double margin = 0) const {
         return std::none_of(blockers_.begin(), blockers_.end(), [&](const Solid& b) { return overlaps(s, b, margin); });
@@ -134,11 +134,11 @@ private:
     [[nodiscard]] bool slide(Solid& s, Vec3 dir, double distance) const {
         const Vec3 start = s.center;
         double lo = 0;
-        for (double reach = probe_step;; reach += probe_step) {
+        for (double reach = kProbeStep;; reach += kProbeStep) {
             const double hi = std::min(reach, distance);
             if (!free(moved(s, dir * hi))) {
                 double a = lo, b = hi;
-                while (b - a > clearance / 2) {
+                while (b - a > kClearance / 2) {
                     const double mid = 0.5 * (a + b);
                     (free(moved(s, dir * mid)) ? a : b) = mid;
                 }
@@ -159,11 +159,11 @@ private:
 
     bool place_apart() {
         const Kind kind = random_kind(rng_);
-        const Solid shape = make_object(kind, rng_, horizontal(rng_.uniform(0, 2 * pi)), false);
+        const Solid shape = make_object(kind, rng_, horizontal(rng_.uniform(0, 2 * kPi)), false);
         for (int attempt = 0; attempt < 60; ++attempt) {
             Solid s = moved(shape, random_point(40));
             rest(s);
-            if (free(s, separation)) return commit(s);
+            if (free(s, kSeparation)) return commit(s);
         }
         return false;
     }
@@ -173,7 +173,7 @@ private:
         for (std::size_t i = 0; i < objects.size(); ++i) {
             const Solid& o = objects[i];
             const bool upright = o.frame.axis[2].z > 0.999999 && o.shape != Shape::sphere;
-            if (upright && support(o, -world_up).z < base_z_ + 2 * clearance) twins.push_back(i);
+            if (upright && support(o, -kWorldUp).z < base_z_ + 2 * kClearance) twins.push_back(i);
         }
         // The first chance is always taken, so that every touching scene has a flush pair: two faces meeting
         // without a depth step, the hardest case for depth-edge segmentation.
@@ -206,7 +206,7 @@ private:
                 if (distance < 1) continue;
                 dir = towards * (1.0 / distance);
             } else {
-                dir = horizontal(rng_.uniform(0, 2 * pi));
+                dir = horizontal(rng_.uniform(0, 2 * kPi));
                 distance = 0;
             }
             Solid s = moved(make_object(kind, rng_, dir, true), start);
@@ -229,9 +229,9 @@ private:
                 const double half_along = face % 2 == 0 ? original.half.y : original.half.x;
                 offset = along * (rng_.uniform(-0.6, 0.6) * half_along);
             } else {
-                dir = horizontal(rng_.uniform(0, 2 * pi));
+                dir = horizontal(rng_.uniform(0, 2 * kPi));
             }
-            const double distance = 2 * bounding_radius(original) + 2 * probe_step;
+            const double distance = 2 * bounding_radius(original) + 2 * kProbeStep;
             Solid s = moved(original, dir * distance + offset);
             if (!inside(s.center) || !free(s)) continue;
             if (!slide(s, -dir, distance)) continue;
@@ -246,10 +246,10 @@ private:
             Solid s = moved(shape, random_point(40));
             rest(s);
             const double rise = 600;
-            Solid high = moved(s, world_up * rise);
+            Solid high = moved(s, kWorldUp * rise);
             if (!free(high)) continue;
-            (void)slide(high, -world_up, rise);
-            if (support(high, world_up).z > max_pile_top) continue;
+            (void)slide(high, -kWorldUp, rise);
+            if (support(high, kWorldUp).z > kMaxPileTop) continue;
             return commit(high);
         }
         return false;
@@ -271,47 +271,47 @@ Layout make_layout(const SceneOptions& options) {
     Rng rng(options.seed, Stream::layout);
     Layout layout;
 
-    const double tilt = rng.uniform(2, 6) * deg;
-    const Vec3 forward = rotated(-world_up, horizontal(rng.uniform(0, 2 * pi)), tilt);
+    const double tilt = rng.uniform(2, 6) * kDeg;
+    const Vec3 forward = rotated(-kWorldUp, horizontal(rng.uniform(0, 2 * kPi)), tilt);
     layout.camera = frame_from_z(forward, {1, 0, 0});
-    layout.camera_position = forward * -camera_distance;
+    layout.camera_position = forward * -kCameraDistance;
 
     Solid floor;
     floor.shape = Shape::plane;
-    floor.id = floor_id;
+    floor.id = kFloorId;
     layout.solids.push_back(floor);
 
     const Vec3 bin_center{rng.uniform(-40, 40), rng.uniform(-30, 30), 0};
-    const Frame bin_frame = frame_from_z(world_up, horizontal(rng.uniform(-8, 8) * deg));
-    const double base_z = options.bin ? bottom_thickness : 0.0;
+    const Frame bin_frame = frame_from_z(kWorldUp, horizontal(rng.uniform(-8, 8) * kDeg));
+    const double base_z = options.bin ? kBottomThickness : 0.0;
     Packer packer(options, rng, bin_center, bin_frame, base_z);
 
     if (options.bin) {
         Solid bottom;
         bottom.shape = Shape::box;
-        bottom.id = bin_bottom_id;
-        bottom.center = bin_center + world_up * (bottom_thickness / 2);
+        bottom.id = kBinBottomId;
+        bottom.center = bin_center + kWorldUp * (kBottomThickness / 2);
         bottom.frame = bin_frame;
-        bottom.half = {bin_half_x, bin_half_y, bottom_thickness / 2};
+        bottom.half = {kBinHalfX, kBinHalfY, kBottomThickness / 2};
         layout.solids.push_back(bottom);
         // Local x of each wall is its inward normal; the x walls run past the corners to close them.
-        const double along_x = bin_half_x + wall_thickness / 2, along_y = bin_half_y + wall_thickness / 2;
+        const double along_x = kBinHalfX + kWallThickness / 2, along_y = kBinHalfY + kWallThickness / 2;
         const struct {
             Vec3 offset, inward;
             double length = 0;
-        } walls[4] = {{{along_x, 0, 0}, {-1, 0, 0}, bin_half_y + wall_thickness},
-                      {{0, along_y, 0}, {0, -1, 0}, bin_half_x},
-                      {{-along_x, 0, 0}, {1, 0, 0}, bin_half_y + wall_thickness},
-                      {{0, -along_y, 0}, {0, 1, 0}, bin_half_x}};
+        } walls[4] = {{{along_x, 0, 0}, {-1, 0, 0}, kBinHalfY + kWallThickness},
+                      {{0, along_y, 0}, {0, -1, 0}, kBinHalfX},
+                      {{-along_x, 0, 0}, {1, 0, 0}, kBinHalfY + kWallThickness},
+                      {{0, -along_y, 0}, {0, 1, 0}, kBinHalfX}};
         for (int i = 0; i < 4; ++i) {
             Solid wall;
             wall.shape = Shape::box;
-            wall.id = first_wall_id + static_cast<std::uint32_t>(i);
-            wall.center = bin_center + bin_frame.to_parent(walls[i].offset) + world_up * (bin_height / 2);
+            wall.id = kFirstWallId + static_cast<std::uint32_t>(i);
+            wall.center = bin_center + bin_frame.to_parent(walls[i].offset) + kWorldUp * (kBinHeight / 2);
             wall.frame.axis[0] = bin_frame.to_parent(walls[i].inward);
-            wall.frame.axis[2] = world_up;
-            wall.frame.axis[1] = cross(world_up, wall.frame.axis[0]);
-            wall.half = {wall_thickness / 2, walls[i].length, bin_height / 2};
+            wall.frame.axis[2] = kWorldUp;
+            wall.frame.axis[1] = cross(kWorldUp, wall.frame.axis[0]);
+            wall.half = {kWallThickness / 2, walls[i].length, kBinHeight / 2};
             layout.solids.push_back(wall);
             packer.add_wall(wall);
         }
@@ -325,7 +325,7 @@ Layout make_layout(const SceneOptions& options) {
             continue;
         }
         misses = 0;
-        objects.back().id = first_object_id + static_cast<std::uint32_t>(objects.size() - 1);
+        objects.back().id = kFirstObjectId + static_cast<std::uint32_t>(objects.size() - 1);
     }
     layout.objects_placed = static_cast<int>(objects.size());
     layout.solids.insert(layout.solids.end(), objects.begin(), objects.end());

@@ -12,22 +12,22 @@
 namespace pyrseg::synthetic::detail {
 namespace {
 
-constexpr double inf = std::numeric_limits<double>::infinity();
-constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
-constexpr double pi = 3.141592653589793;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr float kNanF = std::numeric_limits<float>::quiet_NaN();
+constexpr double kPi = 3.141592653589793;
 
-constexpr double projector_baseline = 150.0;  // projector to camera, along camera x (mm)
+constexpr double kProjectorBaseline = 150.0;  // projector to camera, along camera x (mm)
 // Below this cosine between surface normal and camera or projector ray, the pattern is too faint to decode.
-constexpr double min_decodable_cos = 0.1;
-constexpr int tile_width = 64;
-constexpr int band_height = 16;
-constexpr std::size_t shadow_grid = 64;  // cells per side of the projector-space grid of occluders
+constexpr double kMinDecodableCos = 0.1;
+constexpr int kTileWidth = 64;
+constexpr int kBandHeight = 16;
+constexpr std::size_t kShadowGrid = 64;  // cells per side of the projector-space grid of occluders
 
 // A camera-space solid with the conservative bounds that let most rays skip it.
 struct Bounded {
-    double zmin = 0;                                  // no point of the solid is nearer (camera depth)
-    double u0 = -inf, u1 = inf, v0 = -inf, v1 = inf;  // pixel rectangle holding its image
-    double a0 = -inf, a1 = inf, b0 = -inf, b1 = inf;  // the same for the projector, in normalized coordinates
+    double zmin = 0;                                      // no point of the solid is nearer (camera depth)
+    double u0 = -kInf, u1 = kInf, v0 = -kInf, v1 = kInf;  // pixel rectangle holding its image
+    double a0 = -kInf, a1 = kInf, b0 = -kInf, b1 = kInf;  // the same for the projector, in normalized coordinates
 };
 
 Bounded bounds_of(const Solid& s, double f, double cx, double cy) {
@@ -35,14 +35,14 @@ Bounded bounds_of(const Solid& s, double f, double cx, double cy) {
     if (s.shape == Shape::plane) return b;
     Vec3 corners[8];
     bounding_corners(s, corners);
-    b.zmin = inf;
-    double u0 = inf, u1 = -inf, v0 = inf, v1 = -inf, a0 = inf, a1 = -inf;
+    b.zmin = kInf;
+    double u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, a0 = kInf, a1 = -kInf;
     for (const Vec3& c : corners) {
         b.zmin = std::min(b.zmin, c.z);
         if (c.z <= 1.0) continue;
         u0 = std::min(u0, c.x / c.z), u1 = std::max(u1, c.x / c.z);
         v0 = std::min(v0, c.y / c.z), v1 = std::max(v1, c.y / c.z);
-        const double a = (c.x - projector_baseline) / c.z;
+        const double a = (c.x - kProjectorBaseline) / c.z;
         a0 = std::min(a0, a), a1 = std::max(a1, a);
     }
     if (b.zmin <= 1.0) {  // reaches behind the image plane: no useful rectangle
@@ -59,8 +59,8 @@ Bounded bounds_of(const Solid& s, double f, double cx, double cy) {
 class ShadowGrid {
 public:
     ShadowGrid(const std::vector<Solid>& solids, const std::vector<Bounded>& bounds) {
-        a0_ = b0_ = inf;
-        double a1 = -inf, b1 = -inf;
+        a0_ = b0_ = kInf;
+        double a1 = -kInf, b1 = -kInf;
         for (std::size_t i = 0; i < solids.size(); ++i) {
             if (solids[i].shape == Shape::plane) continue;
             a0_ = std::min(a0_, bounds[i].a0), a1 = std::max(a1, bounds[i].a1);
@@ -69,14 +69,14 @@ public:
         // Rays beyond twice the field of view never reach a pixel, so an unbounded occluder is clipped there.
         a0_ = std::max(a0_, -2.0), b0_ = std::max(b0_, -2.0), a1 = std::min(a1, 2.0), b1 = std::min(b1, 2.0);
         if (!(a0_ < a1) || !(b0_ < b1)) return;
-        sa_ = static_cast<double>(shadow_grid) / (a1 - a0_), sb_ = static_cast<double>(shadow_grid) / (b1 - b0_);
-        cells_.resize(shadow_grid * shadow_grid);
+        sa_ = static_cast<double>(kShadowGrid) / (a1 - a0_), sb_ = static_cast<double>(kShadowGrid) / (b1 - b0_);
+        cells_.resize(kShadowGrid * kShadowGrid);
         for (std::size_t i = 0; i < solids.size(); ++i) {
             if (solids[i].shape == Shape::plane) continue;
             const std::size_t i0 = cell(bounds[i].a0, a0_, sa_), i1 = cell(bounds[i].a1, a0_, sa_);
             const std::size_t j0 = cell(bounds[i].b0, b0_, sb_), j1 = cell(bounds[i].b1, b0_, sb_);
             for (std::size_t j = j0; j <= j1; ++j) {
-                for (std::size_t k = i0; k <= i1; ++k) cells_[j * shadow_grid + k].push_back(i);
+                for (std::size_t k = i0; k <= i1; ++k) cells_[j * kShadowGrid + k].push_back(i);
             }
         }
     }
@@ -85,14 +85,14 @@ public:
     [[nodiscard]] const std::vector<std::size_t>* at(double a, double b) const {
         if (cells_.empty()) return nullptr;
         const double fa = (a - a0_) * sa_, fb = (b - b0_) * sb_;
-        const auto cells = static_cast<double>(shadow_grid);
+        const auto cells = static_cast<double>(kShadowGrid);
         if (!(fa >= 0 && fa < cells && fb >= 0 && fb < cells)) return nullptr;
-        return &cells_[static_cast<std::size_t>(fb) * shadow_grid + static_cast<std::size_t>(fa)];
+        return &cells_[static_cast<std::size_t>(fb) * kShadowGrid + static_cast<std::size_t>(fa)];
     }
 
 private:
     static std::size_t cell(double x, double origin, double scale) {
-        return static_cast<std::size_t>(std::clamp((x - origin) * scale, 0.0, static_cast<double>(shadow_grid - 1)));
+        return static_cast<std::size_t>(std::clamp((x - origin) * scale, 0.0, static_cast<double>(kShadowGrid - 1)));
     }
 
     double a0_, b0_, sa_ = 0, sb_ = 0;
@@ -124,13 +124,13 @@ std::vector<Blob> make_blobs(const SceneOptions& options, double half_w, double 
         Blob b{};
         const double r = std::exp(rng.uniform(std::log(0.006), std::log(0.045)));
         const double stretch = std::exp(rng.uniform(-0.45, 0.45));
-        const double rotation = rng.uniform(0, pi);
+        const double rotation = rng.uniform(0, kPi);
         b.x = rng.uniform(-half_w, half_w), b.y = rng.uniform(-half_h, half_h);
         b.ax = r * stretch, b.ay = r / stretch;
         b.cos_r = std::cos(rotation), b.sin_r = std::sin(rotation);
-        b.w1 = rng.uniform(0, 0.25), b.p1 = rng.uniform(0, 2 * pi);
-        b.w2 = rng.uniform(0, 0.12), b.p2 = rng.uniform(0, 2 * pi);
-        double area = pi * b.ax * b.ay * (1 + 0.5 * (b.w1 * b.w1 + b.w2 * b.w2));
+        b.w1 = rng.uniform(0, 0.25), b.p1 = rng.uniform(0, 2 * kPi);
+        b.w2 = rng.uniform(0, 0.12), b.p2 = rng.uniform(0, 2 * kPi);
+        double area = kPi * b.ax * b.ay * (1 + 0.5 * (b.w1 * b.w1 + b.w2 * b.w2));
         if (area > remaining) {  // the last blob shrinks to hit the target
             const double shrink = std::sqrt(remaining / area);
             b.ax *= shrink, b.ay *= shrink;
@@ -162,16 +162,16 @@ public:
 
     void band(int v_begin, std::vector<std::vector<Entry>>& tiles) const {
         const int w = scene_.width;
-        const int v_end = std::min(v_begin + band_height, scene_.height);
-        const int tile_count = (w + tile_width - 1) / tile_width;
+        const int v_end = std::min(v_begin + kBandHeight, scene_.height);
+        const int tile_count = (w + kTileWidth - 1) / kTileWidth;
         tiles.resize(static_cast<std::size_t>(tile_count));
         for (int t = 0; t < tile_count; ++t) {
-            list_tile(t * tile_width, std::min(w, (t + 1) * tile_width), v_begin, v_end,
+            list_tile(t * kTileWidth, std::min(w, (t + 1) * kTileWidth), v_begin, v_end,
                       tiles[static_cast<std::size_t>(t)]);
         }
         for (int v = v_begin; v < v_end; ++v) {
             Rng rng(options_.seed, static_cast<std::uint64_t>(Stream::noise_rows) + static_cast<std::uint64_t>(v));
-            for (int u = 0; u < w; ++u) pixel(u, v, tiles[static_cast<std::size_t>(u / tile_width)], rng);
+            for (int u = 0; u < w; ++u) pixel(u, v, tiles[static_cast<std::size_t>(u / kTileWidth)], rng);
         }
     }
 
@@ -186,7 +186,7 @@ private:
             const Bounded& b = bounds_[i];
             if (s.shape == Shape::plane) {
                 // Depth along a plane is monotonic across the tile, so its corners bound it.
-                double zmin = inf;
+                double zmin = kInf;
                 const Vec3 n = s.frame.axis[2];
                 for (int c = 0; c < 4; ++c) {
                     const Vec3 d = ray((c & 1) ? u1 - 1 : u0, (c & 2) ? v1 - 1 : v0);
@@ -207,9 +207,9 @@ private:
 
     // Whether the projector cannot light p (normal n) on solid k, or lights it too obliquely.
     [[nodiscard]] bool unlit(Vec3 p, Vec3 n, std::size_t k) const {
-        const Vec3 projector{projector_baseline, 0, 0};
+        const Vec3 projector{kProjectorBaseline, 0, 0};
         const Vec3 q = p - projector;
-        if (dot(n, q) > -min_decodable_cos * norm(q)) return true;
+        if (dot(n, q) > -kMinDecodableCos * norm(q)) return true;
         const std::vector<std::size_t>* candidates = shadows_->at(q.x / q.z, q.y / q.z);
         if (candidates == nullptr) return false;
         Hit hit;
@@ -222,7 +222,7 @@ private:
 
     void pixel(int u, int v, const std::vector<Entry>& list, Rng& rng) const {
         const Vec3 d = ray(u, v);
-        double best = inf;
+        double best = kInf;
         std::size_t k = 0;
         Hit nearest, hit;
         for (const Entry& e : list) {
@@ -237,15 +237,15 @@ private:
             static_cast<std::size_t>(v) * static_cast<std::size_t>(scene_.width) + static_cast<std::size_t>(u);
         float* point = scene_.points.data() + 3 * at;
         float* normal = scene_.normals.data() + 3 * at;
-        bool valid = best < inf;
+        bool valid = best < kInf;
         const double length = norm(d);
         if (valid && dropouts_) {
-            valid = dot(nearest.normal, d) <= -min_decodable_cos * length && !unlit(d * best, nearest.normal, k);
+            valid = dot(nearest.normal, d) <= -kMinDecodableCos * length && !unlit(d * best, nearest.normal, k);
         }
         if (!valid) {
-            point[0] = point[1] = point[2] = nan_f;
-            normal[0] = normal[1] = normal[2] = nan_f;
-            scene_.object_id[at] = no_data_id;
+            point[0] = point[1] = point[2] = kNanF;
+            normal[0] = normal[1] = normal[2] = kNanF;
+            scene_.object_id[at] = kNoDataId;
             return;
         }
         const double t = options_.noise_mm > 0 ? best + options_.noise_mm * rng.normal() / length : best;
@@ -278,9 +278,9 @@ void punch_blobs(const std::vector<Blob>& blobs, Scene& scene) {
                 if (!b.contains((u - scene.cx) / f, (v - scene.cy) / f)) continue;
                 const std::size_t at =
                     static_cast<std::size_t>(v) * static_cast<std::size_t>(scene.width) + static_cast<std::size_t>(u);
-                std::fill_n(scene.points.begin() + static_cast<std::ptrdiff_t>(3 * at), 3, nan_f);
-                std::fill_n(scene.normals.begin() + static_cast<std::ptrdiff_t>(3 * at), 3, nan_f);
-                scene.object_id[at] = no_data_id;
+                std::fill_n(scene.points.begin() + static_cast<std::ptrdiff_t>(3 * at), 3, kNanF);
+                std::fill_n(scene.normals.begin() + static_cast<std::ptrdiff_t>(3 * at), 3, kNanF);
+                scene.object_id[at] = kNoDataId;
             }
         }
     }
@@ -289,7 +289,7 @@ void punch_blobs(const std::vector<Blob>& blobs, Scene& scene) {
 }  // namespace
 
 double focal_length(int width, int height) {
-    const double tan_half = std::tan(30.0 * pi / 180.0);
+    const double tan_half = std::tan(30.0 * kPi / 180.0);
     return std::max(static_cast<double>(width), height * 4.0 / 3.0) / (2.0 * tan_half);
 }
 
@@ -300,11 +300,11 @@ void render(const std::vector<Solid>& solids, const SceneOptions& options, Scene
     scene.object_id.resize(pixels);
 
     const Renderer renderer(solids, options, scene);
-    const int bands = (scene.height + band_height - 1) / band_height;
+    const int bands = (scene.height + kBandHeight - 1) / kBandHeight;
     std::atomic<int> next{0};
     auto work = [&] {
         std::vector<std::vector<Entry>> tiles;
-        for (int b = next++; b < bands; b = next++) renderer.band(b * band_height, tiles);
+        for (int b = next++; b < bands; b = next++) renderer.band(b * kBandHeight, tiles);
     };
     int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
     threads = std::clamp(threads, 1, std::min(bands, 256));

@@ -7,8 +7,8 @@
 namespace pyrseg::synthetic::detail {
 namespace {
 
-constexpr double inf = std::numeric_limits<double>::infinity();
-constexpr double min_cos = 1e-5;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMinCos = 1e-5;
 
 double sign_of(double v) {
     return v < 0 ? -1.0 : 1.0;
@@ -67,7 +67,7 @@ double bounding_radius(const Solid& solid) {
         case Shape::plane:
             break;
     }
-    return inf;
+    return kInf;
 }
 
 void bounding_corners(const Solid& solid, Vec3 corners[8]) {
@@ -92,7 +92,7 @@ bool ray_entry(const Solid& solid, Vec3 origin, Vec3 dir, double t_max, Hit& hit
         case Shape::box: {
             const Vec3 o = solid.frame.to_local(origin - solid.center);
             const Vec3 d = solid.frame.to_local(dir);
-            double t_in = -inf, t_out = inf, sign = 1;
+            double t_in = -kInf, t_out = kInf, sign = 1;
             int axis = -1;
             if (!clip_slab(o.x, d.x, solid.half.x, 0, t_in, t_out, axis, sign)) return false;
             if (!clip_slab(o.y, d.y, solid.half.y, 1, t_in, t_out, axis, sign)) return false;
@@ -105,7 +105,7 @@ bool ray_entry(const Solid& solid, Vec3 origin, Vec3 dir, double t_max, Hit& hit
         case Shape::cylinder: {
             const Vec3 o = solid.frame.to_local(origin - solid.center);
             const Vec3 d = solid.frame.to_local(dir);
-            double t_in = -inf, t_out = inf, sign = 1;
+            double t_in = -kInf, t_out = kInf, sign = 1;
             int axis = -1;
             if (!clip_slab(o.z, d.z, solid.half.z, 2, t_in, t_out, axis, sign)) return false;
             const double r = solid.half.x;
@@ -151,7 +151,7 @@ bool ray_entry(const Solid& solid, Vec3 origin, Vec3 dir, double t_max, Hit& hit
         }
     }
     if (!(h.t > 0) || !(h.t < t_max)) return false;
-    if (dot(h.normal, dir) > -min_cos * norm(dir)) return false;
+    if (dot(h.normal, dir) > -kMinCos * norm(dir)) return false;
     hit = h;
     return true;
 }

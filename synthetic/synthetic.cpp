@@ -31,13 +31,12 @@ Primitive primitive_of(const detail::Solid& s) {
 }  // namespace
 
 Scene generate(const SceneOptions& options) {
-    check(options.width >= 1 && options.width <= max_image_side,
-          "width " + std::to_string(options.width) + " is outside 1.." + std::to_string(max_image_side));
-    check(options.height >= 1 && options.height <= max_image_side,
-          "height " + std::to_string(options.height) + " is outside 1.." + std::to_string(max_image_side));
-    check(
-        options.object_count >= 0 && options.object_count <= max_object_count,
-        "object_count " + std::to_string(options.object_count) + " is outside 0.." + std::to_string(max_object_count));
+    check(options.width >= 1 && options.width <= kMaxImageSide,
+          "width " + std::to_string(options.width) + " is outside 1.." + std::to_string(kMaxImageSide));
+    check(options.height >= 1 && options.height <= kMaxImageSide,
+          "height " + std::to_string(options.height) + " is outside 1.." + std::to_string(kMaxImageSide));
+    check(options.object_count >= 0 && options.object_count <= kMaxObjectCount,
+          "object_count " + std::to_string(options.object_count) + " is outside 0.." + std::to_string(kMaxObjectCount));
     check(std::isfinite(options.noise_mm) && options.noise_mm >= 0, "noise_mm must be finite and >= 0");
     check(options.hole_fraction >= 0 && options.hole_fraction <= 1, "hole_fraction must be within 0..1");
     check(options.threads >= 0, "threads must be >= 0");

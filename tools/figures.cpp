@@ -104,7 +104,7 @@ RgbImage side_by_side(const std::vector<Panel>& panels) {
         const RgbImage& img = panels[p].image;
         for (int y = 0; y < std::min(ph, img.height); ++y) {
             const auto src = img.rgb.begin() + 3 * std::ptrdiff_t(y) * img.width;
-            std::copy(src, src + 3 * std::min(pw, img.width),
+            std::copy(src, src + std::ptrdiff_t{3} * std::min(pw, img.width),
                       out.rgb.begin() + 3 * (std::ptrdiff_t(y + caption_h) * out.width + x0));
         }
     }

@@ -12,14 +12,14 @@
 namespace pyrseg::synthetic {
 
 // Values of Scene::object_id.
-inline constexpr std::uint32_t no_data_id = 0;
-inline constexpr std::uint32_t floor_id = 1;
-inline constexpr std::uint32_t bin_bottom_id = 2;
-inline constexpr std::uint32_t first_wall_id = 3;  // the four walls are 3, 4, 5, 6
-inline constexpr std::uint32_t first_object_id = 7;
+inline constexpr std::uint32_t kNoDataId = 0;
+inline constexpr std::uint32_t kFloorId = 1;
+inline constexpr std::uint32_t kBinBottomId = 2;
+inline constexpr std::uint32_t kFirstWallId = 3;  // the four walls are 3, 4, 5, 6
+inline constexpr std::uint32_t kFirstObjectId = 7;
 
-inline constexpr int max_image_side = 16384;
-inline constexpr int max_object_count = 1000;
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr int kMaxObjectCount = 1000;
 
 struct SceneOptions {
     int width = 640;

@@ -8,8 +8,8 @@
 namespace pyrseg::io::test {
 namespace {
 
-const std::vector<FieldSpec> xyz_rgba = {{"x"}, {"y"}, {"z"}, {"rgba", 'U', 4, 1}};
-constexpr int W = 5, H = 4;
+const std::vector<FieldSpec> kXyzRgba = {{"x"}, {"y"}, {"z"}, {"rgba", 'U', 4, 1}};
+constexpr int kW = 5, kH = 4;
 
 std::vector<std::vector<double>> xyz_rgba_values(int n) {
     std::vector<std::vector<double>> v;
@@ -56,16 +56,16 @@ void expect_error_containing(const fs::path& path, const std::string& text) {
 class PcdMalformed : public ::testing::TestWithParam<std::string> {
 protected:
     std::string encoding() const { return GetParam(); }
-    std::vector<std::string> header_lines() const { return split_lines(pcd_header(xyz_rgba, W, H, encoding())); }
-    std::string body() const { return pcd_body(xyz_rgba, xyz_rgba_values(W * H), encoding()); }
+    std::vector<std::string> header_lines() const { return split_lines(pcd_header(kXyzRgba, kW, kH, encoding())); }
+    std::string body() const { return pcd_body(kXyzRgba, xyz_rgba_values(kW * kH), encoding()); }
     ScratchDir dir;
 };
 
 TEST_P(PcdMalformed, ValidBaseFileLoads) {
     write_bytes(dir / "base.pcd", join_lines(header_lines()) + body());
     const PointCloud c = read_pcd(dir / "base.pcd");
-    EXPECT_EQ(c.width, W);
-    EXPECT_EQ(c.height, H);
+    EXPECT_EQ(c.width, kW);
+    EXPECT_EQ(c.height, kH);
     EXPECT_TRUE(c.normals.empty());
     EXPECT_EQ(c.points[3 * 4 + 2], 1.5f);
 }
@@ -127,7 +127,7 @@ TEST_P(PcdMalformed, EveryHeaderLineBrokenInTurn) {
 }
 
 TEST_P(PcdMalformed, TruncatedAtEveryOffset) {
-    const PointCloud cloud = make_cloud(W, H, true);
+    const PointCloud cloud = make_cloud(kW, kH, true);
     write_pcd(dir / "full.pcd", cloud, encoding_of(encoding()));
     const std::string full = read_bytes(dir / "full.pcd");
     // An ascii file cut inside its last line is still a valid file (with a shorter last number, or none missing).
@@ -145,7 +145,7 @@ TEST_P(PcdMalformed, TruncatedAtEveryOffset) {
 }
 
 TEST_P(PcdMalformed, RandomByteFlips) {
-    const PointCloud cloud = make_cloud(W, H, true);
+    const PointCloud cloud = make_cloud(kW, kH, true);
     write_pcd(dir / "full.pcd", cloud, encoding_of(encoding()));
     const std::string full = read_bytes(dir / "full.pcd");
     std::mt19937 rng(20240611u + static_cast<unsigned>(encoding().size()));
@@ -179,7 +179,7 @@ TEST_P(PcdMalformed, RandomDataAfterValidHeader) {
         for (std::size_t k = 0; k < len; ++k) bytes += static_cast<char>(rng());
         if (encoding() == "binary_compressed" && len >= 8) {
             // Make the sizes plausible so the LZF decoder itself gets the random data.
-            const std::uint32_t c = static_cast<std::uint32_t>(len - 8), u = W * H * 16;
+            const std::uint32_t c = static_cast<std::uint32_t>(len - 8), u = kW * kH * 16;
             std::memcpy(bytes.data() + bytes.size() - len, &c, 4);
             std::memcpy(bytes.data() + bytes.size() - len + 4, &u, 4);
         }
@@ -238,12 +238,12 @@ INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdMalformed, ::testing::Values("ascii", 
 class PcdCompressedBlock : public ::testing::Test {
 protected:
     void SetUp() override {
-        header_ = pcd_header(xyz_rgba, W, H, "binary_compressed");
-        const std::string body = pcd_body(xyz_rgba, xyz_rgba_values(W * H), "binary_compressed");
+        header_ = pcd_header(kXyzRgba, kW, kH, "binary_compressed");
+        const std::string body = pcd_body(kXyzRgba, xyz_rgba_values(kW * kH), "binary_compressed");
         std::memcpy(&compressed_, body.data(), 4);
         std::memcpy(&uncompressed_, body.data() + 4, 4);
         block_ = body.substr(8);
-        ASSERT_EQ(uncompressed_, W * H * 16u);
+        ASSERT_EQ(uncompressed_, kW * kH * 16u);
         ASSERT_EQ(compressed_, block_.size());
     }
     std::string file(std::uint32_t c, std::uint32_t u, const std::string& block) const {

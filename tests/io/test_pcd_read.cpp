@@ -4,7 +4,7 @@
 namespace pyrseg::io::test {
 namespace {
 
-const std::vector<FieldSpec> mixed_fields = {
+const std::vector<FieldSpec> kMixedFields = {
     {"x", 'F', 8, 1},        {"_", 'U', 1, 3},        {"y", 'F', 4, 1},         {"rgb", 'F', 4, 1},
     {"normal_z", 'F', 4, 1}, {"z", 'F', 4, 1},        {"intensity", 'U', 2, 1}, {"label", 'I', 4, 1},
     {"normal_x", 'F', 8, 1}, {"normal_y", 'F', 4, 1}, {"curvature", 'F', 4, 1}, {"fpfh", 'F', 4, 33},
@@ -33,7 +33,7 @@ TEST_P(PcdForeign, SkipsOtherFieldsAndConvertsDoubles) {
     const int w = 4, h = 3;
     std::vector<std::vector<double>> values;
     for (int i = 0; i < w * h; ++i) values.push_back(mixed_point(i));
-    write_bytes(dir / "mixed.pcd", build_pcd(mixed_fields, w, h, values, GetParam()));
+    write_bytes(dir / "mixed.pcd", build_pcd(kMixedFields, w, h, values, GetParam()));
     const PointCloud cloud = read_pcd(dir / "mixed.pcd");
     ASSERT_EQ(cloud.width, w);
     ASSERT_EQ(cloud.height, h);

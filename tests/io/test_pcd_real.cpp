@@ -6,12 +6,12 @@
 namespace pyrseg::io::test {
 namespace {
 
-const fs::path shared_dir = PYRSEG_SHARED_DATA_DIR;
+const fs::path kSharedDir = PYRSEG_SHARED_DATA_DIR;
 
 class RealScan : public ::testing::TestWithParam<std::string> {
 protected:
     void SetUp() override {
-        path_ = shared_dir / GetParam();
+        path_ = kSharedDir / GetParam();
         if (!fs::exists(path_)) GTEST_SKIP() << "shared sample data not found: " << path_ << " (no ../shared/data)";
     }
     fs::path path_;

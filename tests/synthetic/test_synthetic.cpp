@@ -53,7 +53,7 @@ std::size_t pixel_count(const Scene& s) {
 }
 
 std::size_t missing(const Scene& s) {
-    return static_cast<std::size_t>(std::count(s.object_id.begin(), s.object_id.end(), syn::no_data_id));
+    return static_cast<std::size_t>(std::count(s.object_id.begin(), s.object_id.end(), syn::kNoDataId));
 }
 
 // The per-pixel invariants every scene must hold.
@@ -64,7 +64,7 @@ void expect_consistent(const Scene& s) {
     ASSERT_EQ(s.object_id.size(), n);
     std::size_t bad = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        const bool valid = s.object_id[i] != syn::no_data_id;
+        const bool valid = s.object_id[i] != syn::kNoDataId;
         for (int c = 0; c < 3; ++c) {
             bad += std::isnan(s.points[3 * i + static_cast<std::size_t>(c)]) == valid;
             bad += std::isnan(s.normals[3 * i + static_cast<std::size_t>(c)]) == valid;
@@ -93,7 +93,7 @@ struct SurfaceCheck {
 };
 
 SurfaceCheck check_surface(const Primitive& prim, const V3& p, const V3& n) {
-    constexpr double tol = 1e-3;
+    constexpr double kTol = 1e-3;
     const V3 d = sub(p, prim.center);
     const V3 l{dot(d, prim.axes[0]), dot(d, prim.axes[1]), dot(d, prim.axes[2])};
     const V3 nl{dot(n, prim.axes[0]), dot(n, prim.axes[1]), dot(n, prim.axes[2])};
@@ -110,15 +110,15 @@ SurfaceCheck check_surface(const Primitive& prim, const V3& p, const V3& n) {
             for (int i = 0; i < 3; ++i) {
                 const double e = std::abs(l[static_cast<std::size_t>(i)]) - prim.half_size[static_cast<std::size_t>(i)];
                 outside = std::max(outside, e);
-                if (e > -tol && is_axis(i, l[static_cast<std::size_t>(i)] < 0 ? -1 : 1)) normal_ok = true;
+                if (e > -kTol && is_axis(i, l[static_cast<std::size_t>(i)] < 0 ? -1 : 1)) normal_ok = true;
             }
             return {outside, normal_ok};
         }
         case Shape::cylinder: {
             const double radial = std::hypot(l[0], l[1]);
             const double side = radial - prim.half_size[0], cap = std::abs(l[2]) - prim.half_size[2];
-            bool normal_ok = cap > -tol && is_axis(2, l[2] < 0 ? -1 : 1);
-            if (side > -tol) {
+            bool normal_ok = cap > -kTol && is_axis(2, l[2] < 0 ? -1 : 1);
+            if (side > -kTol) {
                 normal_ok = normal_ok || (std::abs(nl[0] - l[0] / radial) < 1e-4 &&
                                           std::abs(nl[1] - l[1] / radial) < 1e-4 && std::abs(nl[2]) < 1e-5);
             }
@@ -218,10 +218,10 @@ TEST(Synthetic, RejectsInvalidOptions) {
     throws([](SceneOptions& o) { o.width = 0; });
     throws([](SceneOptions& o) { o.width = -3; });
     throws([](SceneOptions& o) { o.height = 0; });
-    throws([](SceneOptions& o) { o.width = syn::max_image_side + 1; });
-    throws([](SceneOptions& o) { o.height = syn::max_image_side + 1; });
+    throws([](SceneOptions& o) { o.width = syn::kMaxImageSide + 1; });
+    throws([](SceneOptions& o) { o.height = syn::kMaxImageSide + 1; });
     throws([](SceneOptions& o) { o.object_count = -1; });
-    throws([](SceneOptions& o) { o.object_count = syn::max_object_count + 1; });
+    throws([](SceneOptions& o) { o.object_count = syn::kMaxObjectCount + 1; });
     throws([](SceneOptions& o) { o.noise_mm = -0.1; });
     throws([](SceneOptions& o) { o.noise_mm = std::nan(""); });
     throws([](SceneOptions& o) { o.hole_fraction = -0.01; });
@@ -250,13 +250,13 @@ TEST(Synthetic, ShowsFloorBinAndSeveralObjects) {
         ASSERT_EQ(s.primitives.size(), 6u + static_cast<std::size_t>(s.objects_placed));
         std::map<std::uint32_t, std::size_t> seen;
         for (const std::uint32_t id : s.object_id) ++seen[id];
-        EXPECT_GT(seen[syn::floor_id], pixel_count(s) / 10);
-        EXPECT_GT(seen[syn::bin_bottom_id], pixel_count(s) / 20);
-        for (std::uint32_t wall = syn::first_wall_id; wall < syn::first_object_id; ++wall) EXPECT_GT(seen[wall], 100u);
+        EXPECT_GT(seen[syn::kFloorId], pixel_count(s) / 10);
+        EXPECT_GT(seen[syn::kBinBottomId], pixel_count(s) / 20);
+        for (std::uint32_t wall = syn::kFirstWallId; wall < syn::kFirstObjectId; ++wall) EXPECT_GT(seen[wall], 100u);
         const auto objects =
-            std::count_if(seen.begin(), seen.end(), [](const auto& e) { return e.first >= syn::first_object_id; });
+            std::count_if(seen.begin(), seen.end(), [](const auto& e) { return e.first >= syn::kFirstObjectId; });
         EXPECT_GE(objects, 8);
-        EXPECT_LT(seen.rbegin()->first, syn::first_object_id + static_cast<std::uint32_t>(s.objects_placed));
+        EXPECT_LT(seen.rbegin()->first, syn::kFirstObjectId + static_cast<std::uint32_t>(s.objects_placed));
     }
 }
 
@@ -268,8 +268,8 @@ TEST(Synthetic, WithoutBinObjectsLieOnThePlainFloor) {
     EXPECT_EQ(s.objects_placed, o.object_count);
     EXPECT_EQ(s.primitives.size(), 1u + static_cast<std::size_t>(s.objects_placed));
     std::set<std::uint32_t> ids(s.object_id.begin(), s.object_id.end());
-    for (std::uint32_t id = syn::bin_bottom_id; id < syn::first_object_id; ++id) EXPECT_EQ(ids.count(id), 0u);
-    EXPECT_GE(std::count_if(ids.begin(), ids.end(), [](std::uint32_t id) { return id >= syn::first_object_id; }), 8);
+    for (std::uint32_t id = syn::kBinBottomId; id < syn::kFirstObjectId; ++id) EXPECT_EQ(ids.count(id), 0u);
+    EXPECT_GE(std::count_if(ids.begin(), ids.end(), [](std::uint32_t id) { return id >= syn::kFirstObjectId; }), 8);
 }
 
 TEST(Synthetic, EmptyBin) {
@@ -277,7 +277,7 @@ TEST(Synthetic, EmptyBin) {
     o.object_count = 0;
     const Scene s = generate(o);
     EXPECT_EQ(s.objects_placed, 0);
-    EXPECT_EQ(*std::max_element(s.object_id.begin(), s.object_id.end()), syn::first_object_id - 1);
+    EXPECT_EQ(*std::max_element(s.object_id.begin(), s.object_id.end()), syn::kFirstObjectId - 1);
 }
 
 // Lowest point of an object along up, relative to the plane through origin with normal up.
@@ -306,7 +306,7 @@ TEST(Synthetic, ObjectsRestOnTheBinBottomWithoutSinkingIn) {
         o.seed = seed;
         o.width = o.height = 8;
         const Scene s = generate(o);
-        const Primitive& bottom = primitive(s, syn::bin_bottom_id);
+        const Primitive& bottom = primitive(s, syn::kBinBottomId);
         const V3 up = bottom.axes[2];
         V3 top = bottom.center;
         for (int c = 0; c < 3; ++c)
@@ -314,7 +314,7 @@ TEST(Synthetic, ObjectsRestOnTheBinBottomWithoutSinkingIn) {
         EXPECT_LT(up[2], -0.98) << "the bin's up points toward the camera";
         int resting = 0;
         for (const Primitive& p : s.primitives) {
-            if (p.id < syn::first_object_id) continue;
+            if (p.id < syn::kFirstObjectId) continue;
             const double gap = lowest(p, up, top);
             EXPECT_GT(gap, -1e-6) << "object " << p.id;
             resting += gap < 0.05;
@@ -393,7 +393,7 @@ TEST(Synthetic, ObjectsDoNotInterpenetrate) {
             const Scene s = generate(o);
             int deep = 0;
             for (const Primitive& a : s.primitives) {
-                if (a.id < syn::first_object_id) continue;
+                if (a.id < syn::kFirstObjectId) continue;
                 const std::vector<V3> samples = surface_samples(a);
                 for (const Primitive& b : s.primitives) {
                     if (b.id == a.id || b.shape == Shape::plane) continue;
@@ -437,7 +437,7 @@ TEST(Synthetic, SomeDistinctObjectsTouch) {
                 for (const std::size_t b : {a + 1, a + static_cast<std::size_t>(w)}) {
                     if ((b == a + 1 && u + 1 == w) || b >= pixel_count(s)) continue;
                     const std::uint32_t ia = s.object_id[a], ib = s.object_id[b];
-                    if (ia < syn::first_object_id || ib < syn::first_object_id || ia == ib) continue;
+                    if (ia < syn::kFirstObjectId || ib < syn::kFirstObjectId || ia == ib) continue;
                     touching += std::abs(s.points[3 * a + 2] - s.points[3 * b + 2]) < 2.0f;
                 }
             }
@@ -482,13 +482,13 @@ TEST(Synthetic, NoiselessPointsLieOnTheirSurfaces) {
         const Scene s = generate(o);
         std::size_t off_surface = 0, wrong_normal = 0;
         double floor_min = 1e300, floor_max = -1e300;
-        const Primitive& floor = primitive(s, syn::floor_id);
+        const Primitive& floor = primitive(s, syn::kFloorId);
         for (std::size_t i = 0; i < pixel_count(s); ++i) {
             const V3 p = point_at(s, i);
             const SurfaceCheck c = check_surface(primitive(s, s.object_id[i]), p, normal_at(s, i));
             off_surface += std::abs(c.distance) > 1e-3;
             wrong_normal += !c.normal_ok;
-            if (s.object_id[i] == syn::floor_id) {
+            if (s.object_id[i] == syn::kFloorId) {
                 floor_min = std::min(floor_min, dot(p, floor.axes[2]));
                 floor_max = std::max(floor_max, dot(p, floor.axes[2]));
             }
