@@ -3,6 +3,8 @@
 #include <string>
 #include <thread>
 
+#include "backends/cpu/cpu_backend.hpp"
+#include "core/backend_registry.hpp"
 #include "core/backends_config.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
@@ -55,4 +57,12 @@ std::string resolve_backend_name(std::string_view requested) {
                 "unknown backend '" + name + "' (" + origin + "); known backends: " + known + ", auto");
 }
 
+namespace core {
+
+std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
+    if (backend == "cpu") return cpu::make_executor(plan);
+    throw Error(ErrorCode::backend_unavailable, "backend '" + std::string(backend) + "' is not built in");
+}
+
+}  // namespace core
 }  // namespace pyrseg

@@ -3,7 +3,6 @@
 #include <limits>
 #include <string>
 
-#include "backends/cpu/cpu_backend.hpp"
 #include "core/backend_registry.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
@@ -11,13 +10,6 @@
 #include "pyrseg/error.hpp"
 
 namespace pyrseg {
-
-namespace core {
-std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
-    if (backend == "cpu") return cpu::make_executor(plan);
-    throw Error(ErrorCode::backend_unavailable, "backend '" + std::string(backend) + "' is not built in");
-}
-}  // namespace core
 
 namespace {
 

@@ -6,8 +6,8 @@
 #include <cstdio>
 
 int main() {
-    pyrseg::Params params;  // defaults from the paper: ct 0.25 rad, dt 10 mm
-    params.unit_mm = 1.0;   // these clouds are in millimetres; 1000 for metres
+    pyrseg::Params params;                          // defaults from the paper: ct 0.25 rad, dt 10 mm
+    params.unit_mm = 1.0;                           // these clouds are in millimetres; 1000 for metres
     pyrseg::Segmenter segmenter(640, 480, params);  // backend: $PYRSEG_BACKEND, else the best available
 
     pyrseg::Result result;  // reused: no allocation per frame once sized
