@@ -20,7 +20,9 @@ public:
 
     [[nodiscard]] unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
 
-    // Calls body(begin, end) on disjoint chunks of [0, count) of at most `grain` items, in parallel.
+    // Calls body(begin, end) on disjoint chunks of [0, count) of at most `grain` items, in parallel, and returns
+    // when all are done. The body must not throw: workers may still be running chunks of it while an exception
+    // would unwind the caller (the pass bodies neither allocate nor throw).
     template <class Body>
     void parallel_for(std::size_t count, std::size_t grain, const Body& body) {
         if (count == 0) return;
