@@ -1,5 +1,6 @@
 #include "pyrseg/segmenter.hpp"
 
+#include <chrono>
 #include <limits>
 #include <string>
 
@@ -45,6 +46,28 @@ struct Segmenter::Impl {
     std::vector<PassTiming> timings;
 };
 
+namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One frame: the input to the backend, the passes, the results back; all timed ("upload" and "download" after
+// the passes).
+template <class Bind>
+void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out) {
+    const auto upload_start = std::chrono::steady_clock::now();
+    bind();
+    const double upload_ms = milliseconds_since(upload_start);
+    core::run_pipeline(impl.plan, input, *impl.executor, impl.timings);
+    const auto download_start = std::chrono::steady_clock::now();
+    impl.executor->read_back(out, impl.outputs);
+    impl.timings.push_back(PassTiming{"upload", upload_ms});
+    impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
+}
+
+}  // namespace
+
 Segmenter::Segmenter(int width, int height, const Params& params, std::string_view backend, const Outputs& outputs)
     : impl_(std::make_unique<Impl>()) {
     impl_->plan = core::make_plan(width, height, params);
@@ -66,11 +89,10 @@ void Segmenter::segment(const CloudView& cloud, Result& out) {
                     "cloud.point_stride " + std::to_string(cloud.point_stride) + " is smaller than 3 floats");
     }
     check_layout("the cloud's", cloud.row_stride, cloud.point_stride, cloud.width, cloud.height);
-    impl_->executor->bind_cloud(cloud);
     const auto input =
         cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
-    core::run_pipeline(impl_->plan, input, *impl_->executor, impl_->timings);
-    impl_->executor->read_back(out, impl_->outputs);
+    run_frame(
+        *impl_, input, [&] { impl_->executor->bind_cloud(cloud); }, out);
 }
 
 Result Segmenter::segment(const CloudView& cloud) {
@@ -83,9 +105,8 @@ void Segmenter::segment_mask(const MaskView& mask, Result& out) {
     if (mask.fillable == nullptr) throw Error(ErrorCode::invalid_argument, "mask.fillable is null");
     check_frame_size("the mask", mask.width, mask.height, impl_->plan);
     check_layout("the mask's", mask.row_stride, 1, mask.width, mask.height);
-    impl_->executor->bind_mask(mask);
-    core::run_pipeline(impl_->plan, core::InputKind::mask, *impl_->executor, impl_->timings);
-    impl_->executor->read_back(out, impl_->outputs);
+    run_frame(
+        *impl_, core::InputKind::mask, [&] { impl_->executor->bind_mask(mask); }, out);
 }
 
 int Segmenter::width() const noexcept {

@@ -13,7 +13,9 @@
 namespace pyrseg {
 
 struct PassTiming {
-    const char* pass;  // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact"
+    // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact", then "upload"
+    // (the frame to the backend) and "download" (the results back).
+    const char* pass;
     double milliseconds;
 };
 

@@ -75,7 +75,7 @@ TEST(Segmenter, ReportsTimingsOfEveryPass) {
         EXPECT_GE(t.milliseconds, 0.0);
     }
     EXPECT_EQ(passes, (std::vector<std::string>{"normals", "quantize", "metric", "mip", "labels", "fill", "final_fill",
-                                                "edges", "compact"}));
+                                                "edges", "compact", "upload", "download"}));
 }
 
 TEST(Backends, CpuIsAlwaysAvailableAndLast) {
