@@ -53,5 +53,6 @@ _pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and gl
                 "the Vulkan backend is not implemented in this version (issue #4)")
 
 find_package(OpenCL QUIET)
-_pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" OFF
-                "the OpenCL backend is not implemented in this version (issue #3)")
+_pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" ON "")
+
+set(PYRSEG_HAVE_OPENCL ${PYRSEG_BUILD_opencl})

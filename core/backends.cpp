@@ -4,6 +4,10 @@
 #include <thread>
 
 #include "backends/cpu/cpu_backend.hpp"
+#include "core/backends_config.hpp"
+#if PYRSEG_HAVE_OPENCL
+#include "backends/opencl/opencl_backend.hpp"
+#endif
 #include "core/backend_registry.hpp"
 #include "core/backends_config.hpp"
 #include "pyrseg/backend.hpp"
@@ -16,7 +20,16 @@ std::vector<BackendInfo> list_backends() {
     // Preference order for "auto": GPUs first, the CPU always last and always there.
     all.push_back({"cuda", false, kWhyCuda, {}});
     all.push_back({"vulkan", false, kWhyVulkan, {}});
+#if PYRSEG_HAVE_OPENCL
+    {
+        BackendInfo opencl{"opencl", false, "", {}};
+        opencl.devices = opencl::describe_devices(&opencl.reason);
+        opencl.available = !opencl.devices.empty();
+        all.push_back(opencl);
+    }
+#else
     all.push_back({"opencl", false, kWhyOpencl, {}});
+#endif
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     all.push_back({"cpu", true, "", {"host CPU, " + std::to_string(threads) + " hardware threads"}});
     return all;
@@ -61,6 +74,9 @@ namespace core {
 
 std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
     if (backend == "cpu") return cpu::make_executor(plan);
+#if PYRSEG_HAVE_OPENCL
+    if (backend == "opencl") return opencl::make_executor(plan);
+#endif
     throw Error(ErrorCode::backend_unavailable, "backend '" + std::string(backend) + "' is not built in");
 }
 

@@ -7,6 +7,7 @@ packages=(
   libgtest-dev libbenchmark-dev                 # tests, benchmarks
   liblzf-dev libpng-dev                         # PCD binary_compressed, PNG pictures
   clang clang-format glslang-tools spirv-tools  # shaders/ compile checks as OpenCL C and GLSL; style
+  ocl-icd-opencl-dev opencl-headers pocl-opencl-icd  # the OpenCL backend, and PoCL to run it on in CI
 )
 
 missing=()

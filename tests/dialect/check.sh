@@ -7,8 +7,9 @@ need() { command -v "$1" >/dev/null || { echo "skipped: $1 not found ($2)"; exit
 case "$lang" in
   opencl)
     need clang "Debian package clang"
-    clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only -Wall -Werror -I"$shaders" \
-      "$here/check.cl" ;;
+    for source in "$here/check.cl" "$shaders/pyr_opencl.cl"; do  # every function, and the backend's kernels
+      clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only -Wall -Werror -I"$shaders" "$source"
+    done ;;
   glsl)
     need glslangValidator "Debian package glslang-tools"
     need spirv-val "Debian package spirv-tools"

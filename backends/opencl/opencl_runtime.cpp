@@ -1,0 +1,204 @@
+#include "backends/opencl/opencl_runtime.hpp"
+
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "pyrseg/error.hpp"
+
+extern const char kOpenclKernelSource[];  // shaders/pyr_opencl.cl with its includes, embedded at build time
+
+namespace pyrseg::opencl {
+namespace {
+
+std::string device_string(cl_device_id device, cl_device_info what) {
+    size_t size = 0;
+    if (clGetDeviceInfo(device, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "?";
+    std::string s(size, '\0');
+    clGetDeviceInfo(device, what, size, s.data(), nullptr);
+    while (!s.empty() && s.back() == '\0') s.pop_back();
+    return s;
+}
+
+std::string platform_name(cl_platform_id platform) {
+    size_t size = 0;
+    if (clGetPlatformInfo(platform, CL_PLATFORM_NAME, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "?";
+    std::string s(size, '\0');
+    clGetPlatformInfo(platform, CL_PLATFORM_NAME, size, s.data(), nullptr);
+    while (!s.empty() && s.back() == '\0') s.pop_back();
+    return s;
+}
+
+const char* type_name(cl_device_id device) {
+    cl_device_type type = 0;
+    clGetDeviceInfo(device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr);
+    if ((type & CL_DEVICE_TYPE_GPU) != 0) return "GPU";
+    if ((type & CL_DEVICE_TYPE_CPU) != 0) return "CPU";
+    if ((type & CL_DEVICE_TYPE_ACCELERATOR) != 0) return "accelerator";
+    return "other";
+}
+
+}  // namespace
+
+const char* error_name(cl_int code) {
+    switch (code) {
+        case CL_DEVICE_NOT_FOUND:
+            return "CL_DEVICE_NOT_FOUND";
+        case CL_DEVICE_NOT_AVAILABLE:
+            return "CL_DEVICE_NOT_AVAILABLE";
+        case CL_COMPILER_NOT_AVAILABLE:
+            return "CL_COMPILER_NOT_AVAILABLE";
+        case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+            return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
+        case CL_OUT_OF_RESOURCES:
+            return "CL_OUT_OF_RESOURCES";
+        case CL_OUT_OF_HOST_MEMORY:
+            return "CL_OUT_OF_HOST_MEMORY";
+        case CL_BUILD_PROGRAM_FAILURE:
+            return "CL_BUILD_PROGRAM_FAILURE";
+        case CL_INVALID_VALUE:
+            return "CL_INVALID_VALUE";
+        case CL_INVALID_DEVICE:
+            return "CL_INVALID_DEVICE";
+        case CL_INVALID_CONTEXT:
+            return "CL_INVALID_CONTEXT";
+        case CL_INVALID_COMMAND_QUEUE:
+            return "CL_INVALID_COMMAND_QUEUE";
+        case CL_INVALID_MEM_OBJECT:
+            return "CL_INVALID_MEM_OBJECT";
+        case CL_INVALID_PROGRAM:
+            return "CL_INVALID_PROGRAM";
+        case CL_INVALID_PROGRAM_EXECUTABLE:
+            return "CL_INVALID_PROGRAM_EXECUTABLE";
+        case CL_INVALID_KERNEL_NAME:
+            return "CL_INVALID_KERNEL_NAME";
+        case CL_INVALID_KERNEL:
+            return "CL_INVALID_KERNEL";
+        case CL_INVALID_ARG_INDEX:
+            return "CL_INVALID_ARG_INDEX";
+        case CL_INVALID_ARG_VALUE:
+            return "CL_INVALID_ARG_VALUE";
+        case CL_INVALID_ARG_SIZE:
+            return "CL_INVALID_ARG_SIZE";
+        case CL_INVALID_KERNEL_ARGS:
+            return "CL_INVALID_KERNEL_ARGS";
+        case CL_INVALID_WORK_DIMENSION:
+            return "CL_INVALID_WORK_DIMENSION";
+        case CL_INVALID_WORK_GROUP_SIZE:
+            return "CL_INVALID_WORK_GROUP_SIZE";
+        case CL_INVALID_GLOBAL_WORK_SIZE:
+            return "CL_INVALID_GLOBAL_WORK_SIZE";
+        case CL_INVALID_BUFFER_SIZE:
+            return "CL_INVALID_BUFFER_SIZE";
+        case -1001:
+            return "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL platform is installed)";
+        default:
+            return "an OpenCL error";
+    }
+}
+
+void fail(cl_int code, const char* what) {
+    throw Error(ErrorCode::internal,
+                std::string("OpenCL: ") + what + " failed: " + error_name(code) + " (" + std::to_string(code) + ")");
+}
+
+std::vector<DeviceRef> enumerate_devices(std::string* why_none) {
+    std::vector<DeviceRef> all;
+    cl_uint platform_count = 0;
+    const cl_int err = clGetPlatformIDs(0, nullptr, &platform_count);
+    if (err != CL_SUCCESS || platform_count == 0) {
+        if (why_none != nullptr) {
+            *why_none =
+                "no OpenCL platform found (the ICD loader found no driver; on Debian, install an ICD such as "
+                "pocl-opencl-icd, or your GPU vendor's)";
+        }
+        return all;
+    }
+    std::vector<cl_platform_id> platforms(platform_count);
+    clGetPlatformIDs(platform_count, platforms.data(), nullptr);
+    for (cl_uint p = 0; p < platform_count; ++p) {
+        cl_uint device_count = 0;
+        if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 0, nullptr, &device_count) != CL_SUCCESS) continue;
+        std::vector<cl_device_id> devices(device_count);
+        clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, device_count, devices.data(), nullptr);
+        for (cl_uint d = 0; d < device_count; ++d) {
+            DeviceRef ref;
+            ref.platform = platforms[p];
+            ref.device = devices[d];
+            ref.platform_index = p;
+            ref.device_index = d;
+            ref.description = std::to_string(p) + ":" + std::to_string(d) + " " + platform_name(platforms[p]) + ": " +
+                              device_string(devices[d], CL_DEVICE_NAME) + " (" +
+                              device_string(devices[d], CL_DEVICE_VERSION) + ", " + type_name(devices[d]) + ")";
+            all.push_back(ref);
+        }
+    }
+    if (all.empty() && why_none != nullptr) {
+        *why_none = std::to_string(platform_count) + " OpenCL platform(s) found, but no device";
+    }
+    return all;
+}
+
+DeviceRef choose_device() {
+    std::string why;
+    const std::vector<DeviceRef> all = enumerate_devices(&why);
+    if (all.empty()) throw Error(ErrorCode::backend_unavailable, "backend 'opencl' is unavailable: " + why);
+    if (const char* env = std::getenv("PYRSEG_OPENCL_DEVICE"); env != nullptr && *env != '\0') {
+        const std::string want(env);
+        for (const DeviceRef& d : all) {
+            const std::string index = std::to_string(d.platform_index) + ":" + std::to_string(d.device_index);
+            if (want == index || d.description.find(want) != std::string::npos) return d;
+        }
+        std::string list;
+        for (const DeviceRef& d : all) list += "\n  " + d.description;
+        throw Error(ErrorCode::backend_unavailable,
+                    "PYRSEG_OPENCL_DEVICE='" + want + "' matches no OpenCL device; the devices are:" + list);
+    }
+    for (const DeviceRef& d : all) {
+        cl_device_type type = 0;
+        clGetDeviceInfo(d.device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr);
+        if ((type & CL_DEVICE_TYPE_GPU) != 0) return d;
+    }
+    return all.front();
+}
+
+Runtime::~Runtime() {
+    if (program != nullptr) clReleaseProgram(program);
+    if (context != nullptr) clReleaseContext(context);
+}
+
+std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device) {
+    static std::mutex mutex;
+    static std::map<cl_device_id, std::shared_ptr<const Runtime>> cache;
+    const std::lock_guard lock(mutex);
+    if (auto it = cache.find(device.device); it != cache.end()) return it->second;
+
+    auto rt = std::make_shared<Runtime>();
+    rt->device = device.device;
+    rt->description = device.description;
+    clGetDeviceInfo(device.device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(rt->max_alloc), &rt->max_alloc, nullptr);
+    clGetDeviceInfo(device.device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(rt->global_mem), &rt->global_mem, nullptr);
+    const cl_context_properties properties[] = {CL_CONTEXT_PLATFORM,
+                                                reinterpret_cast<cl_context_properties>(device.platform), 0};
+    cl_int err = CL_SUCCESS;
+    rt->context = clCreateContext(properties, 1, &device.device, nullptr, nullptr, &err);
+    check(err, "clCreateContext");
+    const char* source = kOpenclKernelSource;
+    rt->program = clCreateProgramWithSource(rt->context, 1, &source, nullptr, &err);
+    check(err, "clCreateProgramWithSource");
+    // No fast-math options: the kernels' float operations must be IEEE (contraction is off in the source).
+    err = clBuildProgram(rt->program, 1, &device.device, "-cl-std=CL1.2", nullptr, nullptr);
+    if (err != CL_SUCCESS) {
+        size_t size = 0;
+        clGetProgramBuildInfo(rt->program, device.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+        std::string log(size, '\0');
+        clGetProgramBuildInfo(rt->program, device.device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+        throw Error(ErrorCode::internal, "OpenCL: building the pyrseg kernels for " + device.description + " failed (" +
+                                             error_name(err) + "); build log:\n" + log);
+    }
+    cache.emplace(device.device, rt);
+    return rt;
+}
+
+}  // namespace pyrseg::opencl
