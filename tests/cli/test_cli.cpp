@@ -22,8 +22,8 @@ struct CliRun {
     std::string output;  // stdout and stderr together
 };
 
-CliRun run(const std::string& args) {
-    const std::string command = std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
+CliRun run_with_env(const std::string& env, const std::string& args) {
+    const std::string command = env + std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
     FILE* pipe = popen(command.c_str(), "r");
     if (pipe == nullptr) return {-1, "popen failed"};
     std::string out;
@@ -31,6 +31,10 @@ CliRun run(const std::string& args) {
     while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
     const int status = pclose(pipe);
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+CliRun run(const std::string& args) {
+    return run_with_env("", args);
 }
 
 fs::path temp_dir() {
@@ -104,6 +108,28 @@ TEST(Cli, BackendsListsEveryBackendAndWhyNot) {
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.output.find("cpu     available"), std::string::npos) << r.output;
     for (const char* name : {"cuda", "vulkan", "opencl"}) EXPECT_NE(r.output.find(name), std::string::npos);
+}
+
+// With no OpenCL driver (the ICD loader pointed at an empty vendor folder), `pyrseg backends` says why and
+// choosing the backend is a clear error.
+TEST(Cli, NoOpenclPlatformIsExplainedAndAnError) {
+    if (run("backends").output.find("opencl  unavailable\n        not built") != std::string::npos) {
+        GTEST_SKIP() << "this build has no OpenCL backend";
+    }
+    const fs::path dir = temp_dir();
+    const std::string no_icd = "OCL_ICD_VENDORS=" + (dir / "no-vendors").string() + " ";
+    CliRun r = run_with_env(no_icd, "backends");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("no OpenCL platform found"), std::string::npos) << r.output;
+    if (fs::exists(mug_scan())) {
+        r = run_with_env(no_icd, "segment " + mug_scan().string() + " --unit-mm 1000 --backend opencl --labels " +
+                                     (dir / "o.npy").string());
+        EXPECT_EQ(r.status, 1) << r.output;
+        EXPECT_NE(r.output.find("backend 'opencl' (requested) is unavailable: no OpenCL platform found"),
+                  std::string::npos)
+            << r.output;
+    }
+    fs::remove_all(dir);
 }
 
 // The acceptance case: the PCL mug scan, in metres, with default parameters.

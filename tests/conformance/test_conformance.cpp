@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "conformance/cases.hpp"
 #include "pyrseg/error.hpp"
@@ -77,6 +79,41 @@ INSTANTIATE_TEST_SUITE_P(Backends, SyntheticScenes,
                              return std::get<0>(param_info.param) + "_" +
                                     conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
                          });
+
+// Depths in the subnormal range: validity (z > 0) and the metric's float depth differences must follow IEEE on
+// every backend, whatever a device's denormal mode (contract section 2; docs/algorithm.md section 9).
+class TinyDepths : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(TinyDepths, SubnormalDepthsFollowIeee) {
+    const int w = 48;
+    const int h = 40;
+    std::vector<float> points(3 * std::size_t(w) * std::size_t(h));
+    std::vector<float> normals(points.size());
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            float* p = &points[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+            // Subnormal depths (below 2^-126, about 1.18e-38): a step between the halves, noise-like variation.
+            const int units = (x < w / 2 ? 40 : 90) + ((x * 7 + y * 13) % 5);
+            p[0] = 0.0f;
+            p[1] = 0.0f;
+            p[2] = float(units) * std::numeric_limits<float>::denorm_min() * 1000.0f;
+            float* n = &normals[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+            n[0] = 0.0f;
+            n[1] = 0.0f;
+            n[2] = -1.0f;
+        }
+    }
+    ASSERT_LT(points[2], std::numeric_limits<float>::min());
+    Params params;
+    params.dt = 2e-41;  // subnormal too: the step (~7e-41) is an edge, the variation (<= ~6e-42) is not
+    const pyrseg_ref::Output ref = pyrseg_ref::segment(points.data(), normals.data(), w, h, to_reference(params));
+    ASSERT_TRUE(ref.ok);
+    ASSERT_EQ(ref.segment_count, 2u) << "the scene must have a depth edge, or flushing denormals would go unseen";
+    expect_conformance(GetParam(), points.data(), normals.data(), w, h, params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, TinyDepths, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 

@@ -6,7 +6,10 @@
 #include <cstdlib>
 #include <functional>
 #include <new>
+#include <string>
+#include <vector>
 
+#include "pyrseg/backend.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -44,7 +47,17 @@ long allocations_during(const std::function<void()>& f) {
     return allocations.load();
 }
 
-TEST(NoAllocation, WarmFramesAllocateNothing) {
+std::vector<std::string> available() {
+    std::vector<std::string> names;
+    for (const BackendInfo& b : list_backends()) {
+        if (b.available) names.push_back(b.name);
+    }
+    return names;
+}
+
+class NoAllocation : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(NoAllocation, WarmFramesAllocateNothing) {
     synthetic::SceneOptions o;
     o.width = 320;
     o.height = 240;
@@ -54,7 +67,7 @@ TEST(NoAllocation, WarmFramesAllocateNothing) {
     Outputs outputs;
     outputs.raw_labels = outputs.fillable_mask = outputs.normals = true;
     for (const bool given_normals : {false, true}) {
-        Segmenter segmenter(320, 240, {}, "cpu", outputs);
+        Segmenter segmenter(320, 240, {}, GetParam(), outputs);
         Result result;
         const CloudView va{a.points.data(), given_normals ? a.normals.data() : nullptr, 320, 240};
         const CloudView vb{b.points.data(), given_normals ? b.normals.data() : nullptr, 320, 240};
@@ -73,6 +86,9 @@ TEST(NoAllocation, WarmFramesAllocateNothing) {
                   0);
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Backends, NoAllocation, ::testing::ValuesIn(available()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace pyrseg
