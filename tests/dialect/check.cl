@@ -1,5 +1,5 @@
 /* Compiles every shared pass function as OpenCL C 1.2 (clang), with accessors over global buffers, to keep
- * shaders/ within the dialect. Not a backend: the OpenCL backend's entry points live in shaders/ (issue #3). */
+ * shaders/ within the dialect. Not a backend: the OpenCL backend's entry points are shaders/pyr_opencl.cl. */
 #define PYR_CTX_PARAM __global const float* pyr_buf_points, __global const int* pyr_buf_quant, __global uint* pyr_buf_mask, \
     __global uint* pyr_buf_labels, __global const uint* pyr_buf_lut
 #define PYR_CTX_ARG pyr_buf_points, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut
