@@ -12,22 +12,23 @@ extern const char kOpenclKernelSource[];  // shaders/pyr_opencl.cl with its incl
 namespace pyrseg::opencl {
 namespace {
 
-std::string device_string(cl_device_id device, cl_device_info what) {
+// A string property through one of the clGet*Info functions: query the size, then the text.
+template <class Object, class Info>
+std::string info_string(cl_int (*get)(Object, Info, size_t, void*, size_t*), Object object, Info what) {
     size_t size = 0;
-    if (clGetDeviceInfo(device, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "?";
+    if (get(object, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "?";
     std::string s(size, '\0');
-    clGetDeviceInfo(device, what, size, s.data(), nullptr);
+    get(object, what, size, s.data(), nullptr);
     while (!s.empty() && s.back() == '\0') s.pop_back();
     return s;
 }
 
+std::string device_string(cl_device_id device, cl_device_info what) {
+    return info_string(clGetDeviceInfo, device, what);
+}
+
 std::string platform_name(cl_platform_id platform) {
-    size_t size = 0;
-    if (clGetPlatformInfo(platform, CL_PLATFORM_NAME, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "?";
-    std::string s(size, '\0');
-    clGetPlatformInfo(platform, CL_PLATFORM_NAME, size, s.data(), nullptr);
-    while (!s.empty() && s.back() == '\0') s.pop_back();
-    return s;
+    return info_string(clGetPlatformInfo, platform, cl_platform_info{CL_PLATFORM_NAME});
 }
 
 const char* type_name(cl_device_id device) {
