@@ -9,7 +9,6 @@
 #include "backends/opencl/opencl_backend.hpp"
 #endif
 #include "core/backend_registry.hpp"
-#include "core/backends_config.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 

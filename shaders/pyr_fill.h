@@ -23,6 +23,12 @@ PYR_FN pyr_u32 pyr_fill_once(pyr_u32 self_label, pyr_u32 nb_label, pyr_u32 nb_ma
     return (self_label == 0u && (nb_mask & PYR_MASK_FILLABLE) != 0u) ? nb_label : self_label;
 }
 
+/* One update of a fillable texel from the neighbour before it in a sweep: step 6 (once != 0) or steps 2 and 4. */
+PYR_FN pyr_u32 pyr_fill_step(pyr_u32 self_label, pyr_u32 self_mask, pyr_u32 nb_label, pyr_u32 nb_mask, pyr_u32 once) {
+    return once != 0u ? pyr_fill_once(self_label, nb_label, nb_mask)
+                      : pyr_fill_relax(self_label, self_mask, nb_label, nb_mask);
+}
+
 /* One sweep along a line of `count` texels starting at buffer index `start`, `step` apart (step may be the
  * two's-complement of a negative stride: unsigned arithmetic wraps). Each update is visible to the next texel.
  * Needs PYR_MASK, PYR_LABEL, PYR_STORE_LABEL. Returns 1 when a label changed. once != 0 selects step 6. */
@@ -36,8 +42,7 @@ PYR_FN pyr_u32 pyr_sweep_line(PYR_CTX_PARAM, pyr_u32 start, pyr_u32 step, pyr_u3
         pyr_u32 mask = PYR_MASK(i);
         pyr_u32 label = PYR_LABEL(i);
         if ((mask & PYR_MASK_FILLABLE) != 0u) {
-            pyr_u32 next = once != 0u ? pyr_fill_once(label, prev_label, prev_mask)
-                                      : pyr_fill_relax(label, mask, prev_label, prev_mask);
+            pyr_u32 next = pyr_fill_step(label, mask, prev_label, prev_mask, once);
             if (next != label) {
                 PYR_STORE_LABEL(i, next);
                 label = next;

@@ -1,14 +1,14 @@
 #include "backends/cpu/cpu_backend.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
-#include <vector>
-
-#include <unistd.h>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/thread_pool.hpp"
@@ -289,8 +289,7 @@ private:
         for (uint32_t x = x0; x < x1; ++x) {
             if ((m[row + x] & PYR_MASK_FILLABLE) == 0) continue;
             const uint32_t cur = l[row + x];
-            const uint32_t next = once ? kernels::pyr_fill_once(cur, l[from + x], m[from + x])
-                                       : kernels::pyr_fill_relax(cur, m[row + x], l[from + x], m[from + x]);
+            const uint32_t next = kernels::pyr_fill_step(cur, m[row + x], l[from + x], m[from + x], once ? 1u : 0u);
             if (next != cur) {
                 l[row + x] = next;
                 ch = true;
@@ -322,8 +321,7 @@ size_t physical_memory_bytes() {
     return pages > 0 && page > 0 ? size_t(pages) * size_t(page) : 0;
 }
 
-}  // namespace
-
+// Bytes a CpuExecutor allocates (estimated normals counted: they are allocated on the first frame without normals).
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
     return pixels * (sizeof(QuantPixel) + 3 * sizeof(float)) +  // quantized pixels, estimated normals
@@ -331,6 +329,8 @@ size_t memory_needed(const core::Plan& plan) {
            (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
            2 * fill_scratch_size(plan) * sizeof(uint32_t);                          // union-find
 }
+
+}  // namespace
 
 std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
     const size_t needed = memory_needed(plan);

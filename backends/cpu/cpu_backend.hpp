@@ -10,7 +10,4 @@ namespace pyrseg::cpu {
 // Throws pyrseg::Error(out_of_memory) when the buffers would not fit in this machine's memory.
 [[nodiscard]] std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan);
 
-// Bytes the CPU backend allocates for a plan.
-[[nodiscard]] std::size_t memory_needed(const core::Plan& plan);
-
 }  // namespace pyrseg::cpu
