@@ -44,15 +44,17 @@ endif()
 _pyrseg_backend(cuda PYRSEG_WITH_CUDA ${_cuda_found} "a CUDA compiler (nvcc)" OFF
                 "the CUDA backend is not implemented in this version (issue #5)")
 
-find_package(Vulkan QUIET COMPONENTS glslangValidator)
+find_package(Vulkan 1.1 QUIET COMPONENTS glslangValidator)
+find_program(PYRSEG_SPIRV_VAL spirv-val DOC "spirv-val (SPIRV-Tools), which checks the embedded SPIR-V")
 set(_vk_found OFF)
-if(Vulkan_FOUND AND Vulkan_glslangValidator_FOUND)
+if(Vulkan_FOUND AND Vulkan_glslangValidator_FOUND AND PYRSEG_SPIRV_VAL)
   set(_vk_found ON)
 endif()
-_pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and glslangValidator" OFF
-                "the Vulkan backend is not implemented in this version (issue #4)")
+_pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and headers, glslangValidator and spirv-val"
+                ON "")
 
 find_package(OpenCL QUIET)
 _pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" ON "")
 
 set(PYRSEG_HAVE_OPENCL ${PYRSEG_BUILD_opencl})
+set(PYRSEG_HAVE_VULKAN ${PYRSEG_BUILD_vulkan})

@@ -8,6 +8,9 @@
 #if PYRSEG_HAVE_OPENCL
 #include "backends/opencl/opencl_backend.hpp"
 #endif
+#if PYRSEG_HAVE_VULKAN
+#include "backends/vulkan/vulkan_backend.hpp"
+#endif
 #include "core/backend_registry.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
@@ -18,7 +21,15 @@ std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;
     // Preference order for "auto": GPUs first, the CPU always last and always there.
     all.push_back({"cuda", false, kWhyCuda, {}});
+#if PYRSEG_HAVE_VULKAN
+    {
+        BackendInfo vulkan{"vulkan", false, "", {}};
+        vulkan.devices = vulkan::describe_devices(&vulkan.reason, &vulkan.available);
+        all.push_back(vulkan);
+    }
+#else
     all.push_back({"vulkan", false, kWhyVulkan, {}});
+#endif
 #if PYRSEG_HAVE_OPENCL
     {
         BackendInfo opencl{"opencl", false, "", {}};
@@ -73,6 +84,9 @@ namespace core {
 
 std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
     if (backend == "cpu") return cpu::make_executor(plan);
+#if PYRSEG_HAVE_VULKAN
+    if (backend == "vulkan") return vulkan::make_executor(plan);
+#endif
 #if PYRSEG_HAVE_OPENCL
     if (backend == "opencl") return opencl::make_executor(plan);
 #endif

@@ -2,9 +2,11 @@
 // What a backend implements: one method per pass of the contract. core/pipeline.cpp calls them in the contract's
 // order; a backend holds only the code that runs a pass on its device (the per-pixel logic is in shaders/).
 #include <cstdint>
+#include <vector>
 
 #include "pyrseg/cloud.hpp"
 #include "pyrseg/result.hpp"
+#include "pyrseg/segmenter.hpp"
 
 namespace pyrseg::core {
 
@@ -28,9 +30,17 @@ public:
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4
     virtual void fill_once(int level) = 0;                                      // step 6 a and b
     virtual void label_edges() = 0;                                             // step 6 c
-    // Step 7: counts the distinct labels of level N (the segment count K) and, when apply, renumbers them.
-    virtual std::uint32_t compact(bool apply) = 0;
+    // Step 7: counts the distinct labels of level N (the segment count K, reported by read_back) and, when apply,
+    // renumbers them.
+    virtual void compact(bool apply) = 0;
+    // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
+
+    // Called before each pass the pipeline times, with the pass's name ("normals", ..., "compact").
+    virtual void begin_pass(const char* /*pass*/) {}
+    // A backend whose passes run asynchronously overwrites the host's times in `timings` (same names) with the
+    // times its device measured, and returns true. Called after read_back.
+    virtual bool device_timings(std::vector<PassTiming>& /*timings*/) { return false; }
 };
 
 }  // namespace pyrseg::core

@@ -9,10 +9,11 @@ namespace {
 
 class PassClock {
 public:
-    explicit PassClock(std::vector<PassTiming>& timings) : timings_(timings) { timings_.clear(); }
+    PassClock(std::vector<PassTiming>& timings, PassExecutor& ex) : timings_(timings), ex_(ex) { timings_.clear(); }
 
     template <class F>
     void run(const char* pass, F&& body) {
+        ex_.begin_pass(pass);
         const auto start = std::chrono::steady_clock::now();
         body();
         const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
@@ -27,12 +28,13 @@ public:
 
 private:
     std::vector<PassTiming>& timings_;
+    PassExecutor& ex_;
 };
 
 }  // namespace
 
 void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vector<PassTiming>& timings) {
-    PassClock clock(timings);
+    PassClock clock(timings, ex);
     const int n = plan.level_count;
     if (input != InputKind::mask) {
         if (input == InputKind::cloud_without_normals) clock.run("normals", [&] { ex.estimate_normals(); });

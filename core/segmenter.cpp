@@ -64,6 +64,7 @@ void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, R
     impl.executor->read_back(out, impl.outputs);
     impl.timings.push_back(PassTiming{"upload", upload_ms});
     impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
+    impl.executor->device_timings(impl.timings);
 }
 
 }  // namespace

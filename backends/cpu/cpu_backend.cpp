@@ -172,7 +172,7 @@ public:
         });
     }
 
-    uint32_t compact(bool apply) override {
+    void compact(bool apply) override {
         std::fill(lut_.begin(), lut_.end(), 0u);
         const uint32_t* full = labels_.data() + plan_.full().offset;
         const size_t w = size_t(plan_.width);
@@ -188,7 +188,6 @@ public:
         }
         segment_count_ = count;
         compacted_ = apply;
-        return count;
     }
 
     void read_back(Result& out, const Outputs& outputs) override {

@@ -210,7 +210,7 @@ public:
         finish();
     }
 
-    uint32_t compact(bool apply) override {
+    void compact(bool apply) override {
         const cl_uint count = cl_uint(lut_size());
         const cl_uint chunk = cl_uint(kScanChunk);
         const cl_uint chunks = cl_uint(scan_chunks());
@@ -230,7 +230,6 @@ public:
                                   &segment_count_, 0, nullptr, nullptr),
               "clEnqueueReadBuffer(segment count)");
         finish();
-        return segment_count_;
     }
 
     void read_back(Result& out, const Outputs& outputs) override {

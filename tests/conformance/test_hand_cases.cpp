@@ -239,6 +239,24 @@ TEST_P(HandCases, AnEmptyMaskHasNoSegments) {
     EXPECT_TRUE(std::all_of(r.labels.begin(), r.labels.end(), [](std::uint32_t l) { return l == 0; }));
 }
 
+// A staircase corridor from the top-left to the bottom-right: each round of row and column sweeps carries the
+// smallest label down only one step, so the fixed point takes about as many rounds as there are steps (63). Backends
+// that run a fixed number of rounds between convergence checks (OpenCL, Vulkan) must keep going until it is reached.
+TEST_P(HandCases, AFillNeedingManyRoundsReachesTheFixedPoint) {
+    Mask m(512, 512);
+    for (int step = 0; step < 63; ++step) {
+        const int x = step * 8;
+        const int y = step * 8;
+        m.fill_rect(x, y, x + 11, y + 3);       // across, 4 px thick
+        m.fill_rect(x + 8, y, x + 11, y + 11);  // down
+    }
+    ASSERT_EQ(plain_components(m), 1);
+    Params params;
+    params.bridge_levels = 1;  // new labels on level N - 1, where the corridor is 2 texels wide
+    const Result first = run(m, params);
+    EXPECT_EQ(first.labels[m.at(0, 0)], first.labels[m.at(500, 500)]) << "the corridor is one segment";
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, HandCases, ::testing::ValuesIn(available_backend_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 

@@ -1,0 +1,99 @@
+#pragma once
+// The Vulkan instance, physical devices and the device choice, and per device the logical device, queue,
+// descriptor set layout, pipeline layout and one compute pipeline per entry point, shared by every Segmenter of the
+// process. With PYRSEG_VULKAN_VALIDATION=1 the Khronos validation layer is on and its messages are collected.
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace pyrseg::vulkan {
+
+// The entry points of shaders/pyr_vulkan.comp, in the order of the runtime's pipelines.
+enum Entry : std::size_t {
+    kNormals,
+    kQuantize,
+    kMetric,
+    kBindMask,
+    kMip,
+    kInitLabels,
+    kAnchor,
+    kSweepRows,
+    kSweepColumns,
+    kEdges,
+    kLutMark,
+    kScanCount,
+    kScanSums,
+    kScanNumber,
+    kCompact,
+    kEntryCount
+};
+inline constexpr std::array<const char*, kEntryCount> kEntryNames = {
+    "NORMALS", "QUANTIZE",   "METRIC", "BIND_MASK",  "MIP",        "INIT_LABELS", "ANCHOR",  "SWEEP_ROWS",
+    "SWEEP_COLUMNS", "EDGES", "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT"};
+
+inline constexpr std::uint32_t kBindingCount = 9;      // the storage buffers of shaders/pyr_vulkan.comp
+inline constexpr std::uint32_t kPushConstantBytes = 32;  // the largest PyrArgs block (INIT_LABELS)
+
+struct DeviceRef {
+    VkPhysicalDevice physical = VK_NULL_HANDLE;
+    std::uint32_t index = 0;
+    std::string description;  // "0 llvmpipe (LLVM 15.0.6, 256 bits) (CPU, Vulkan 1.3.230, Mesa 22.3.6)"
+    std::string unusable;     // why pyrseg cannot use it (empty when it can)
+    int preference = 0;       // discrete GPU first, then integrated, virtual, CPU
+};
+
+// Every physical device; when none is usable, *why_none says why. Never throws.
+[[nodiscard]] std::vector<DeviceRef> enumerate_devices(std::string* why_none);
+
+// $PYRSEG_VULKAN_DEVICE (an index, or text found in the description), else the most preferred usable device.
+// Throws pyrseg::Error(backend_unavailable) naming the reason.
+[[nodiscard]] DeviceRef choose_device();
+
+struct Runtime {
+    VkPhysicalDevice physical = VK_NULL_HANDLE;
+    VkDevice device = VK_NULL_HANDLE;
+    VkQueue queue = VK_NULL_HANDLE;
+    std::uint32_t queue_family = 0;
+    std::mutex queue_mutex;  // vkQueueSubmit needs the queue externally synchronised
+    VkPhysicalDeviceProperties properties{};
+    VkPhysicalDeviceMemoryProperties memory{};
+    VkDeviceSize max_allocation = 0;  // maxMemoryAllocationSize (Vulkan 1.1)
+    bool timestamps = false;          // the queue family writes timestamps
+    std::string description;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    std::array<VkPipeline, kEntryCount> pipelines{};
+
+    Runtime() = default;
+    Runtime(const Runtime&) = delete;
+    Runtime& operator=(const Runtime&) = delete;
+    ~Runtime();
+};
+
+// The shared runtime of a device, created on first use.
+[[nodiscard]] std::shared_ptr<Runtime> runtime_for(const DeviceRef& device);
+
+// With PYRSEG_VULKAN_VALIDATION=1: throws pyrseg::Error quoting the validation messages reported since the last
+// call (each is also printed to stderr as it arrives). Without validation it does nothing.
+void throw_on_validation_messages(const char* during);
+
+// A Vulkan info struct, zeroed, with its sType.
+template <class T>
+[[nodiscard]] T make_info(VkStructureType type) {
+    T info{};
+    info.sType = type;
+    return info;
+}
+
+[[nodiscard]] const char* result_name(VkResult result);
+[[noreturn]] void fail(VkResult result, const char* what);
+inline void check(VkResult result, const char* what) {
+    if (result != VK_SUCCESS) fail(result, what);
+}
+
+}  // namespace pyrseg::vulkan
