@@ -8,6 +8,7 @@ packages=(
   liblzf-dev libpng-dev                         # PCD binary_compressed, PNG pictures
   clang clang-format glslang-tools spirv-tools  # shaders/ compile checks as OpenCL C and GLSL; style
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd  # the OpenCL backend, and PoCL to run it on in CI
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers  # the Vulkan backend, lavapipe, the validation layer
 )
 
 missing=()

@@ -20,13 +20,13 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr uint32_t kGroup1D = 64;         // PYR_GROUP_1D in shaders/pyr_vulkan.comp
-constexpr uint32_t kGroup2D = 8;          // PYR_GROUP_2D
-constexpr uint32_t kScanChunk = 1024;     // LUT entries numbered by one invocation in the compaction scan
-constexpr uint32_t kFillsPerFrame = 2;    // steps 2 and 4 (or the small-image fallback's one)
-constexpr uint32_t kFirstBudget = 8;      // fill rounds recorded per fill until a frame needs more
-constexpr size_t kMaxOps = 128;           // commands of one frame, kept to record it again
-constexpr uint32_t kMaxTimestamps = 64;   // pass boundaries per frame
+constexpr uint32_t kGroup1D = 64;        // PYR_GROUP_1D in shaders/pyr_vulkan.comp
+constexpr uint32_t kGroup2D = 8;         // PYR_GROUP_2D
+constexpr uint32_t kScanChunk = 1024;    // LUT entries numbered by one invocation in the compaction scan
+constexpr uint32_t kFillsPerFrame = 2;   // steps 2 and 4 (or the small-image fallback's one)
+constexpr uint32_t kFirstBudget = 8;     // fill rounds recorded per fill until a frame needs more
+constexpr size_t kMaxOps = 128;          // commands of one frame, kept to record it again
+constexpr uint32_t kMaxTimestamps = 64;  // pass boundaries per frame
 
 enum Binding : uint32_t { kPoints, kNormalsBuf, kQuant, kMask, kLabels, kLut, kSums, kFlags, kOut };
 
@@ -37,8 +37,20 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 // One command of a frame, as the pipeline asked for it. A frame whose fills did not converge within the recorded
 // rounds is recorded again from these with more rounds.
 struct Op {
-    enum Kind { upload_cloud, upload_mask, pass_start, normals, quantize, metric, mip, init_labels, fill, fill_once,
-                edges, compact } kind;
+    enum Kind {
+        upload_cloud,
+        upload_mask,
+        pass_start,
+        normals,
+        quantize,
+        metric,
+        mip,
+        init_labels,
+        fill,
+        fill_once,
+        edges,
+        compact
+    } kind;
     uint32_t a = 0;
     uint32_t b = 0;
     const char* name = nullptr;
@@ -387,8 +399,9 @@ private:
         b.srcAccessMask = src_access;
         b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
                           VK_ACCESS_TRANSFER_WRITE_BIT;
-        vkCmdPipelineBarrier(commands_, src_stage, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             0, 1, &b, 0, nullptr, 0, nullptr);
+        vkCmdPipelineBarrier(commands_, src_stage,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &b, 0,
+                             nullptr, 0, nullptr);
     }
 
     void copy(VkBuffer src, VkDeviceSize src_offset, VkBuffer dst, VkDeviceSize dst_offset, VkDeviceSize bytes) {
@@ -476,8 +489,8 @@ private:
         max_groups_x_ = lim.maxComputeWorkGroupCount[0];
         const auto mib = [](VkDeviceSize b) { return std::to_string(b >> 20) + " MiB"; };
         const std::string image = "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image";
-        const VkDeviceSize largest = std::max<VkDeviceSize>(16 * VkDeviceSize(plan_.pixel_count()),
-                                                            4 * VkDeviceSize(plan_.total_texels));
+        const VkDeviceSize largest =
+            std::max<VkDeviceSize>(16 * VkDeviceSize(plan_.pixel_count()), 4 * VkDeviceSize(plan_.total_texels));
         if (largest > lim.maxStorageBufferRange) {
             throw Error(ErrorCode::out_of_memory, image + " needs a storage buffer of " + mib(largest) + " but " +
                                                       rt_->description + " binds at most " +
@@ -490,14 +503,17 @@ private:
                                                       mib(rt_->max_allocation) + " (maxMemoryAllocationSize)");
         }
         VkDeviceSize heap = 0;
-        for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h) heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
+        for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
+            heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
         const VkDeviceSize total = 92 * VkDeviceSize(plan_.pixel_count()) + 8 * VkDeviceSize(plan_.total_texels) +
                                    4 * VkDeviceSize(lut_size());
         if (total > heap) {
-            throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) + " of buffers but the largest heap of " +
-                                                      rt_->description + " has " + mib(heap));
+            throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) +
+                                                      " of buffers but the largest heap of " + rt_->description +
+                                                      " has " + mib(heap));
         }
-        const uint64_t groups_1d = (uint64_t(std::max<size_t>(plan_.pixel_count(), lut_size())) + kGroup1D - 1) / kGroup1D;
+        const uint64_t groups_1d =
+            (uint64_t(std::max<size_t>(plan_.pixel_count(), lut_size())) + kGroup1D - 1) / kGroup1D;
         const uint64_t rows_1d = (groups_1d + max_groups_x_ - 1) / max_groups_x_;
         const uint64_t gx = (uint64_t(plan_.width) + kGroup2D - 1) / kGroup2D;
         const uint64_t gy = (uint64_t(plan_.height) + kGroup2D - 1) / kGroup2D;

@@ -25,7 +25,8 @@ VulkanBuffer::VulkanBuffer(const Runtime& rt, VkDeviceSize bytes, Memory memory,
     : device_(rt.device), size_(bytes < 4 ? 4 : bytes) {
     auto info = make_info<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
     info.size = size_;
-    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    info.usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     try {
         check(vkCreateBuffer(device_, &info, nullptr, &buffer_), what);
@@ -33,10 +34,10 @@ VulkanBuffer::VulkanBuffer(const Runtime& rt, VkDeviceSize bytes, Memory memory,
         vkGetBufferMemoryRequirements(device_, buffer_, &req);
         const bool host = memory == Memory::host;
         const VkMemoryPropertyFlags need =
-            host ? VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) : 0;
-        const VkMemoryPropertyFlags want =
-            host ? need | VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-                 : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+            host ? VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
+                 : 0;
+        const VkMemoryPropertyFlags want = host ? need | VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                                                : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
         auto alloc = make_info<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
         alloc.allocationSize = req.size;
         alloc.memoryTypeIndex = memory_type(rt.memory, req.memoryTypeBits, want, need, what);

@@ -33,8 +33,7 @@ ValidationLog& validation_log() {
 
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                      VkDebugUtilsMessageTypeFlagsEXT /*types*/,
-                                                     const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                                     void* /*user*/) {
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* /*user*/) {
     const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) != 0 ? "error" : "warning";
     std::string text = std::string("[") + level + "] " + (data->pMessage != nullptr ? data->pMessage : "?");
     std::fprintf(stderr, "pyrseg: Vulkan validation %s\n", text.c_str());
@@ -74,7 +73,8 @@ struct Instance {
         app.pApplicationName = "pyrseg";
         app.pEngineName = "pyrseg";
         app.apiVersion = VK_API_VERSION_1_1;
-        auto messenger_info = make_info<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
+        auto messenger_info =
+            make_info<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
         messenger_info.messageSeverity =
             VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
         messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
@@ -344,7 +344,8 @@ void create_pipelines(Runtime& rt) {
             if (std::strcmp(kSpirvModules[m].entry, kEntryNames[e]) == 0) found = &kSpirvModules[m];
         }
         if (found == nullptr) {
-            throw Error(ErrorCode::internal, std::string("Vulkan: no SPIR-V was built for PYR_ENTRY_") + kEntryNames[e]);
+            throw Error(ErrorCode::internal,
+                        std::string("Vulkan: no SPIR-V was built for PYR_ENTRY_") + kEntryNames[e]);
         }
         auto module_info = make_info<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
         module_info.codeSize = found->word_count * sizeof(std::uint32_t);
@@ -378,7 +379,8 @@ std::shared_ptr<Runtime> runtime_for(const DeviceRef& device) {
     rt->description = device.description;
     vkGetPhysicalDeviceProperties(device.physical, &rt->properties);
     vkGetPhysicalDeviceMemoryProperties(device.physical, &rt->memory);
-    auto maintenance3 = make_info<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
+    auto maintenance3 =
+        make_info<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
     auto properties2 = make_info<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
     properties2.pNext = &maintenance3;
     vkGetPhysicalDeviceProperties2(device.physical, &properties2);

@@ -33,10 +33,10 @@ enum Entry : std::size_t {
     kEntryCount
 };
 inline constexpr std::array<const char*, kEntryCount> kEntryNames = {
-    "NORMALS", "QUANTIZE",   "METRIC", "BIND_MASK",  "MIP",        "INIT_LABELS", "ANCHOR",  "SWEEP_ROWS",
-    "SWEEP_COLUMNS", "EDGES", "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT"};
+    "NORMALS",       "QUANTIZE", "METRIC",   "BIND_MASK",  "MIP",       "INIT_LABELS", "ANCHOR", "SWEEP_ROWS",
+    "SWEEP_COLUMNS", "EDGES",    "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT"};
 
-inline constexpr std::uint32_t kBindingCount = 9;      // the storage buffers of shaders/pyr_vulkan.comp
+inline constexpr std::uint32_t kBindingCount = 9;        // the storage buffers of shaders/pyr_vulkan.comp
 inline constexpr std::uint32_t kPushConstantBytes = 32;  // the largest PyrArgs block (INIT_LABELS)
 
 struct DeviceRef {

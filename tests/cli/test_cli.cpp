@@ -136,6 +136,33 @@ TEST(Cli, NoOpenclPlatformIsExplainedAndAnError) {
     fs::remove_all(dir);
 }
 
+// With no Vulkan driver (the loader pointed at a driver manifest that does not exist), `pyrseg backends` says why
+// and choosing the backend is a clear error.
+TEST(Cli, NoVulkanDriverIsExplainedAndAnError) {
+    const std::string listing = run("backends").output;
+    const std::size_t entry = listing.find("vulkan  ");
+    ASSERT_NE(entry, std::string::npos) << listing;
+    const std::string vulkan = listing.substr(entry, listing.find("\n", listing.find("\n", entry) + 1) - entry);
+    if (vulkan.find("not built") != std::string::npos || vulkan.find("disabled") != std::string::npos) {
+        GTEST_SKIP() << "this build has no Vulkan backend: " << vulkan;
+    }
+    const fs::path dir = temp_dir();
+    const std::string manifest = (dir / "no-driver.json").string();
+    const std::string no_driver = "VK_ICD_FILENAMES=" + manifest + " VK_DRIVER_FILES=" + manifest + " ";
+    CliRun r = run_with_env(no_driver, "backends");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("no Vulkan driver found"), std::string::npos) << r.output;
+    if (fs::exists(mug_scan())) {
+        r = run_with_env(no_driver, "segment " + mug_scan().string() + " --unit-mm 1000 --backend vulkan --labels " +
+                                        (dir / "o.npy").string());
+        EXPECT_EQ(r.status, 1) << r.output;
+        EXPECT_NE(r.output.find("backend 'vulkan' (requested) is unavailable: no Vulkan driver found"),
+                  std::string::npos)
+            << r.output;
+    }
+    fs::remove_all(dir);
+}
+
 // The acceptance case: the PCL mug scan, in metres, with default parameters.
 TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
     if (!fs::exists(mug_scan())) GTEST_SKIP() << "sample scan not present: " << mug_scan().string();

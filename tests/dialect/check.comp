@@ -1,6 +1,7 @@
 #version 450
 // Compiles every shared pass function as GLSL (glslangValidator -> SPIR-V, then spirv-val), with accessors over
-// storage buffers, to keep shaders/ within the dialect. Not a backend: Vulkan entry points come with issue #4.
+// storage buffers, to keep shaders/ within the dialect. The Vulkan backend's entry points (shaders/pyr_vulkan.comp)
+// are compiled and checked by the build itself (cmake/CompileSpirv.cmake).
 #extension GL_GOOGLE_include_directive : require
 #define PYR_GLSL 1
 layout(local_size_x = 8, local_size_y = 8) in;
