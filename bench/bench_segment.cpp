@@ -27,7 +27,8 @@ const pyrseg::synthetic::Scene& scene(int width, int height) {
     return *slot;
 }
 
-// Total and per-pass host time of a whole frame; counters are milliseconds per frame for each pass.
+// Total time of a whole frame; counters are milliseconds per frame for each pass, as Segmenter::last_timings()
+// reports them (host times, or the device's timestamps for backends that queue a frame, such as Vulkan).
 void segment(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals) {
     const pyrseg::synthetic::Scene& s = scene(width, height);
     pyrseg::Segmenter segmenter(width, height, {}, backend);

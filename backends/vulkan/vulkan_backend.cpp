@@ -50,7 +50,7 @@ struct Op {
         fill_once,
         edges,
         compact
-    } kind;
+    } kind = upload_cloud;
     uint32_t a = 0;
     uint32_t b = 0;
     const char* name = nullptr;
@@ -352,7 +352,7 @@ private:
     [[nodiscard]] bool fills_converged() const {
         const auto* flags = static_cast<const uint32_t*>(readback_.mapped()) + 1;
         for (uint32_t f = 0; f < fills_in_frame_; ++f) {
-            const uint32_t* begin = flags + f * fill_budget_;
+            const uint32_t* begin = flags + size_t(f) * fill_budget_;
             if (std::find(begin, begin + fill_budget_, 0u) == begin + fill_budget_) return false;
         }
         return true;
