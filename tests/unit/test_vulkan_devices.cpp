@@ -2,7 +2,9 @@
 // the validation layer's messages turning into errors, as the whole suite relies on.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <memory>
 #include <string>
 
 #include "pyrseg/backend.hpp"
@@ -58,6 +60,28 @@ TEST_F(VulkanDevices, ADeviceThatMatchesNothingIsAnErrorListingTheDevices) {
 }
 
 #if PYRSEG_TEST_VULKAN_INTERNALS
+// A frame whose buffers exceed what the device binds is refused up front with an error naming the limit; one
+// that fits is accepted (lavapipe binds at most 128 MiB, which a 4128 x 3088 frame's quantized normals exceed).
+TEST_F(VulkanDevices, ImagesBeyondTheStorageBufferRangeAreRefusedNamingTheLimit) {
+    const std::shared_ptr<vulkan::Runtime> rt = vulkan::runtime_for(vulkan::choose_device());
+    const std::uint64_t range = rt->properties.limits.maxStorageBufferRange;
+    const int w = 4128;
+    const int h = 3088;
+    const std::uint64_t quant_bytes = 16ull * std::uint64_t(w) * std::uint64_t(h);  // the largest buffer
+    if (quant_bytes <= range) {
+        EXPECT_NO_THROW(Segmenter(w, h, {}, "vulkan")) << "the device binds " << range << " bytes";
+        return;
+    }
+    try {
+        Segmenter s(w, h, {}, "vulkan");
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::out_of_memory);
+        EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(Segmenter(2064, 1544, {}, "vulkan"));
+}
+
 // With PYRSEG_VULKAN_VALIDATION=1 (ctest sets it for every test) a misuse of the API is reported by the Khronos
 // layer, and pyrseg turns the report into an error: a frame with a validation message fails its test.
 TEST_F(VulkanDevices, ValidationMessagesBecomeErrors) {
