@@ -25,7 +25,8 @@ constexpr const char* kUsage =
     "  --version           print the version\n"
     "\n"
     "Environment: PYRSEG_BACKEND picks the backend when --backend is not given; PYRSEG_THREADS sets the CPU\n"
-    "backend's thread count.\n";
+    "backend's thread count; PYRSEG_OPENCL_DEVICE and PYRSEG_VULKAN_DEVICE pick a device (an index or part of\n"
+    "its name, as `pyrseg backends` lists them); PYRSEG_VULKAN_VALIDATION=1 turns the Vulkan validation layer on.\n";
 
 }  // namespace
 
