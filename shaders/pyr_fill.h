@@ -56,4 +56,19 @@ PYR_FN pyr_u32 pyr_sweep_line(PYR_CTX_PARAM, pyr_u32 start, pyr_u32 step, pyr_u3
     return changed;
 }
 
+/* Row y of a level, there and back (left to right, then right to left). Returns 1 when a label changed. */
+PYR_FN pyr_u32 pyr_sweep_row(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 y, pyr_u32 once) {
+    pyr_u32 start = lv.offset + y * lv.width;
+    pyr_u32 changed = pyr_sweep_line(PYR_CTX_ARG, start, 1u, lv.width, once);
+    changed |= pyr_sweep_line(PYR_CTX_ARG, start + lv.width - 1u, 0xffffffffu, lv.width, once);
+    return changed;
+}
+
+/* Column x of a level, there and back (down, then up). Returns 1 when a label changed. */
+PYR_FN pyr_u32 pyr_sweep_column(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 once) {
+    pyr_u32 changed = pyr_sweep_line(PYR_CTX_ARG, lv.offset + x, lv.width, lv.height, once);
+    changed |= pyr_sweep_line(PYR_CTX_ARG, lv.offset + (lv.height - 1u) * lv.width + x, 0u - lv.width, lv.height, once);
+    return changed;
+}
+
 #endif /* PYR_FILL_H */

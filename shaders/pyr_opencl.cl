@@ -14,6 +14,7 @@
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
 #define PYR_VALID(p) ((uint)pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
+#define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 
 #include "pyr_compact.h"
 #include "pyr_edges.h"
@@ -23,6 +24,7 @@
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_scan.h"
 
 PYR_FN PyrLevel pyr_level(uint width, uint height, uint offset) {
     PyrLevel lv;
@@ -98,10 +100,7 @@ __kernel void pyr_k_sweep_rows(PYR_CTX_PARAM, uint lw, uint lh, uint loffset, ui
                                uint slot) {
     uint y = (uint)get_global_id(0);
     if (y >= lh) return;
-    uint start = loffset + y * lw;
-    uint ch = pyr_sweep_line(PYR_CTX_ARG, start, 1u, lw, once);
-    ch |= pyr_sweep_line(PYR_CTX_ARG, start + lw - 1u, 0xffffffffu, lw, once);
-    if (ch != 0u) changed[slot] = 1;
+    if (pyr_sweep_row(PYR_CTX_ARG, pyr_level(lw, lh, loffset), y, once) != 0u) changed[slot] = 1;
 }
 
 /* One work-item per column (neighbouring work-items read neighbouring texels): down, then up. */
@@ -109,9 +108,7 @@ __kernel void pyr_k_sweep_columns(PYR_CTX_PARAM, uint lw, uint lh, uint loffset,
                                   uint slot) {
     uint x = (uint)get_global_id(0);
     if (x >= lw) return;
-    uint ch = pyr_sweep_line(PYR_CTX_ARG, loffset + x, lw, lh, once);
-    ch |= pyr_sweep_line(PYR_CTX_ARG, loffset + (lh - 1u) * lw + x, 0u - lw, lh, once);
-    if (ch != 0u) changed[slot] = 1;
+    if (pyr_sweep_column(PYR_CTX_ARG, pyr_level(lw, lh, loffset), x, once) != 0u) changed[slot] = 1;
 }
 
 /* In place: only valid, non-fillable, unlabelled pixels change, and no pixel reads those. */
@@ -142,10 +139,7 @@ __kernel void pyr_k_scan_count(PYR_CTX_PARAM, uint count, uint chunk, __global u
     uint c = (uint)get_global_id(0);
     uint begin = c * chunk;
     if (begin >= count) return;
-    uint end = min(count, begin + chunk);
-    uint n = 0u;
-    for (uint i = begin; i < end; ++i) n += pyr_buf_lut[i] != 0u ? 1u : 0u;
-    sums[c] = n;
+    sums[c] = pyr_count_marks(PYR_CTX_ARG, begin, min(count, begin + chunk));
 }
 
 __kernel void pyr_k_scan_sums(__global uint *sums, uint chunks) {
@@ -163,11 +157,7 @@ __kernel void pyr_k_scan_number(PYR_CTX_PARAM, uint count, uint chunk, __global 
     uint c = (uint)get_global_id(0);
     uint begin = c * chunk;
     if (begin >= count) return;
-    uint end = min(count, begin + chunk);
-    uint running = sums[c];
-    for (uint i = begin; i < end; ++i) {
-        if (pyr_buf_lut[i] != 0u) pyr_buf_lut[i] = ++running;
-    }
+    pyr_number_marks(PYR_CTX_ARG, begin, min(count, begin + chunk), sums[c]);
 }
 
 __kernel void pyr_k_compact(PYR_CTX_PARAM, uint pixels, uint offset, uint apply, __global uint *out) {

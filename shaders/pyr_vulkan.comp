@@ -29,6 +29,7 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
 #define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
+#define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 
 #include "pyr_compact.h"
 #include "pyr_edges.h"
@@ -38,6 +39,7 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_scan.h"
 
 PyrLevel pyr_level(uint width, uint height, uint offset) {
     PyrLevel lv;
@@ -158,15 +160,13 @@ void main() {
     uint pyr_w = args.w;
     uint line = PYR_LINEAR_ID;
     if (args.slot != args.first && pyr_buf_flags[args.slot - 1u] == 0u) return;
+    PyrLevel lv = pyr_level(args.lw, args.lh, args.loffset);
 #if defined(PYR_ENTRY_SWEEP_ROWS)
     if (line >= args.lh) return;
-    uint start = args.loffset + line * args.lw;
-    uint ch = pyr_sweep_line(PYR_CTX_ARG, start, 1u, args.lw, args.once);
-    ch |= pyr_sweep_line(PYR_CTX_ARG, start + args.lw - 1u, 0xffffffffu, args.lw, args.once);
+    uint ch = pyr_sweep_row(PYR_CTX_ARG, lv, line, args.once);
 #else
     if (line >= args.lw) return;
-    uint ch = pyr_sweep_line(PYR_CTX_ARG, args.loffset + line, args.lw, args.lh, args.once);
-    ch |= pyr_sweep_line(PYR_CTX_ARG, args.loffset + (args.lh - 1u) * args.lw + line, 0u - args.lw, args.lh, args.once);
+    uint ch = pyr_sweep_column(PYR_CTX_ARG, lv, line, args.once);
 #endif
     if (ch != 0u) pyr_buf_flags[args.slot] = 1u;
 }
@@ -201,13 +201,11 @@ void main() {
 layout(local_size_x = PYR_GROUP_1D) in;
 layout(push_constant) uniform PyrArgs { uint w; uint count; uint chunk; uint chunks; } args;
 void main() {
+    uint pyr_w = args.w;
     uint c = PYR_LINEAR_ID;
     if (c >= args.chunks) return;
     uint begin = c * args.chunk;
-    uint end = min(args.count, begin + args.chunk);
-    uint n = 0u;
-    for (uint i = begin; i < end; ++i) n += pyr_buf_lut[i] != 0u ? 1u : 0u;
-    pyr_buf_sums[c] = n;
+    pyr_buf_sums[c] = pyr_count_marks(PYR_CTX_ARG, begin, min(args.count, begin + args.chunk));
 }
 
 #elif defined(PYR_ENTRY_SCAN_SUMS)
@@ -227,14 +225,11 @@ void main() {
 layout(local_size_x = PYR_GROUP_1D) in;
 layout(push_constant) uniform PyrArgs { uint w; uint count; uint chunk; uint chunks; } args;
 void main() {
+    uint pyr_w = args.w;
     uint c = PYR_LINEAR_ID;
     if (c >= args.chunks) return;
     uint begin = c * args.chunk;
-    uint end = min(args.count, begin + args.chunk);
-    uint running = pyr_buf_sums[c];
-    for (uint i = begin; i < end; ++i) {
-        if (pyr_buf_lut[i] != 0u) pyr_buf_lut[i] = ++running;
-    }
+    pyr_number_marks(PYR_CTX_ARG, begin, min(args.count, begin + args.chunk), pyr_buf_sums[c]);
 }
 
 #elif defined(PYR_ENTRY_COMPACT)

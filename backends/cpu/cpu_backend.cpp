@@ -260,10 +260,7 @@ private:
         const uint32_t onceu = once ? 1u : 0u;
         std::atomic<bool> changed{false};
         rows(lv.height, [&](size_t y) {
-            const uint32_t start = lv.offset + uint32_t(y) * lv.width;
-            uint32_t ch = kernels::pyr_sweep_line(c, start, 1u, lv.width, onceu);
-            ch |= kernels::pyr_sweep_line(c, start + lv.width - 1u, ~0u, lv.width, onceu);
-            if (ch != 0u) changed.store(true, std::memory_order_relaxed);
+            if (kernels::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u) changed.store(true, std::memory_order_relaxed);
         });
         const size_t blocks = (size_t(lv.width) + kColumnBlock - 1) / kColumnBlock;
         pool_.parallel_for(blocks, 1, [&](size_t b0, size_t b1) {

@@ -1,7 +1,7 @@
 /* Compiles every shared pass function as OpenCL C 1.2 (clang), with accessors over global buffers, to keep
  * shaders/ within the dialect. Not a backend: the OpenCL backend's entry points are shaders/pyr_opencl.cl. */
 #define PYR_CTX_PARAM __global const float* pyr_buf_points, __global const int* pyr_buf_quant, __global uint* pyr_buf_mask, \
-    __global uint* pyr_buf_labels, __global const uint* pyr_buf_lut
+    __global uint* pyr_buf_labels, __global uint* pyr_buf_lut
 #define PYR_CTX_ARG pyr_buf_points, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut
 #define PYR_PT(x, y, c) pyr_buf_points[((y) * 64u + (x)) * 3u + (c)]
 #define PYR_Q_VALID(i) ((uint)pyr_buf_quant[(i) * 4u + 3u])
@@ -12,6 +12,7 @@
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
 #define PYR_VALID(p) ((uint)pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
+#define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -20,6 +21,7 @@
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_scan.h"
 
 __kernel void all_passes(PYR_CTX_PARAM, __global int* out) {
     uint x = (uint)get_global_id(0);
@@ -37,5 +39,8 @@ __kernel void all_passes(PYR_CTX_PARAM, __global int* out) {
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
     r += pyr_edge_label(PYR_CTX_ARG, lv, x, y);
     r += pyr_compact_label(PYR_CTX_ARG, 3u);
+    r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
+    r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);
+    pyr_number_marks(PYR_CTX_ARG, 0u, 64u, r);
     out[y * 64u + x] = q.x + qu.qz + (int)r;
 }

@@ -9,7 +9,7 @@ layout(std430, binding = 0) readonly buffer Points { float pyr_buf_points[]; };
 layout(std430, binding = 1) readonly buffer Quant { int pyr_buf_quant[]; };
 layout(std430, binding = 2) buffer Mask { uint pyr_buf_mask[]; };
 layout(std430, binding = 3) buffer Labels { uint pyr_buf_labels[]; };
-layout(std430, binding = 4) readonly buffer Lut { uint pyr_buf_lut[]; };
+layout(std430, binding = 4) buffer Lut { uint pyr_buf_lut[]; };
 layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #define PYR_CTX_PARAM uint pyr_ctx_unused
 #define PYR_CTX_ARG 0u
@@ -22,6 +22,7 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
 #define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
+#define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -30,6 +31,7 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_scan.h"
 
 void main() {
     uint x = gl_GlobalInvocationID.x;
@@ -47,5 +49,8 @@ void main() {
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
     r += pyr_edge_label(PYR_CTX_ARG, lv, x, y);
     r += pyr_compact_label(PYR_CTX_ARG, 3u);
+    r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
+    r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);
+    pyr_number_marks(PYR_CTX_ARG, 0u, 64u, r);
     outv[y * 64u + x] = q.x + qu.qz + int(r);
 }

@@ -5,7 +5,7 @@ struct Ctx {
     const int* quant;
     unsigned* mask;
     unsigned* labels;
-    const unsigned* lut;
+    unsigned* lut;
 };
 #define PYR_CTX_PARAM const Ctx& ctx
 #define PYR_CTX_ARG ctx
@@ -18,6 +18,7 @@ struct Ctx {
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
 #define PYR_VALID(p) static_cast<unsigned>(ctx.quant[(p) * 4u + 3u])
 #define PYR_LUT(l) ctx.lut[l]
+#define PYR_STORE_LUT(l, v) (ctx.lut[l] = (v))
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -26,6 +27,7 @@ struct Ctx {
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_scan.h"
 
 __global__ void all_passes(Ctx ctx, int* out) {
     const unsigned x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -40,5 +42,8 @@ __global__ void all_passes(Ctx ctx, int* out) {
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
     r += pyr_edge_label(ctx, lv, x, y);
     r += pyr_compact_label(ctx, 3u);
+    r += pyr_sweep_row(ctx, lv, y, 0u) + pyr_sweep_column(ctx, lv, x, 1u);
+    r += pyr_count_marks(ctx, 0u, 64u);
+    pyr_number_marks(ctx, 0u, 64u, r);
     out[y * 64u + x] = q.x + qu.qz + static_cast<int>(r);
 }
