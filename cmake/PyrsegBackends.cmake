@@ -41,8 +41,21 @@ set(_cuda_found OFF)
 if(CMAKE_CUDA_COMPILER)
   set(_cuda_found ON)
 endif()
-_pyrseg_backend(cuda PYRSEG_WITH_CUDA ${_cuda_found} "a CUDA compiler (nvcc)" OFF
-                "the CUDA backend is not implemented in this version (issue #5)")
+_pyrseg_backend(cuda PYRSEG_WITH_CUDA ${_cuda_found} "a CUDA compiler (nvcc)" ON "")
+if(PYRSEG_BUILD_cuda)
+  # Jetson Orin (sm_87), H100 (sm_90), Jetson Thor (sm_110) as machine code, plus PTX for sm_75 that the driver
+  # compiles for any other GPU CUDA 13 supports. Override with -DCMAKE_CUDA_ARCHITECTURES=...
+  if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+    set(CMAKE_CUDA_ARCHITECTURES 87-real 90-real 110-real 75-virtual)
+  endif()
+  enable_language(CUDA)
+  # CMake 3.25 does not know nvcc's C++20 flag; CUDA 12+ has it.
+  set(CMAKE_CUDA20_STANDARD_COMPILE_OPTION "-std=c++20")
+  set(CMAKE_CUDA20_EXTENSION_COMPILE_OPTION "-std=c++20")
+  set(CMAKE_CUDA_STANDARD 20)
+  set(CMAKE_CUDA_STANDARD_REQUIRED ON)
+  find_package(CUDAToolkit REQUIRED)
+endif()
 
 find_package(Vulkan 1.1 QUIET COMPONENTS glslangValidator)
 find_program(PYRSEG_SPIRV_VAL spirv-val DOC "spirv-val (SPIRV-Tools), which checks the embedded SPIR-V")
@@ -57,4 +70,5 @@ find_package(OpenCL QUIET)
 _pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" ON "")
 
 set(PYRSEG_HAVE_OPENCL ${PYRSEG_BUILD_opencl})
+set(PYRSEG_HAVE_CUDA ${PYRSEG_BUILD_cuda})
 set(PYRSEG_HAVE_VULKAN ${PYRSEG_BUILD_vulkan})

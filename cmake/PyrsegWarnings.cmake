@@ -3,8 +3,12 @@ add_library(pyrseg_build_flags INTERFACE)
 target_compile_options(pyrseg_build_flags INTERFACE
   $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
                             -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough -ffp-contract=off>)
+# CUDA: no fused multiply-add (float results decide outcomes), host code warned like the C++.
+target_compile_options(pyrseg_build_flags INTERFACE
+  $<$<COMPILE_LANGUAGE:CUDA>:--fmad=false -Xcompiler=-Wall,-Wextra,-ffp-contract=off>)
 if(PYRSEG_WERROR)
-  target_compile_options(pyrseg_build_flags INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Werror>)
+  target_compile_options(pyrseg_build_flags INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Werror>
+                                                      $<$<COMPILE_LANGUAGE:CUDA>:-Werror=all-warnings>)
 endif()
 if(PYRSEG_SANITIZE)
   target_compile_options(pyrseg_build_flags INTERFACE

@@ -5,6 +5,9 @@
 
 #include "backends/cpu/cpu_backend.hpp"
 #include "core/backends_config.hpp"
+#if PYRSEG_HAVE_CUDA
+#include "backends/cuda/cuda_backend.hpp"
+#endif
 #if PYRSEG_HAVE_OPENCL
 #include "backends/opencl/opencl_backend.hpp"
 #endif
@@ -20,7 +23,16 @@ namespace pyrseg {
 std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;
     // Preference order for "auto": GPUs first, the CPU always last and always there.
+#if PYRSEG_HAVE_CUDA
+    {
+        BackendInfo cuda{"cuda", false, "", {}};
+        cuda.devices = cuda::describe_devices(&cuda.reason);
+        cuda.available = !cuda.devices.empty();
+        all.push_back(cuda);
+    }
+#else
     all.push_back({"cuda", false, kWhyCuda, {}});
+#endif
 #if PYRSEG_HAVE_VULKAN
     {
         BackendInfo vulkan{"vulkan", false, "", {}};
@@ -84,6 +96,9 @@ namespace core {
 
 std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
     if (backend == "cpu") return cpu::make_executor(plan);
+#if PYRSEG_HAVE_CUDA
+    if (backend == "cuda") return cuda::make_executor(plan);
+#endif
 #if PYRSEG_HAVE_VULKAN
     if (backend == "vulkan") return vulkan::make_executor(plan);
 #endif

@@ -1,5 +1,5 @@
 // Compiles every shared pass function as CUDA device code (nvcc), with accessors over device pointers, to keep
-// shaders/ within the dialect. Not a backend: the CUDA kernels come with issue #5.
+// shaders/ within the dialect. The backend's own kernels (shaders/pyr_cuda.cuh) are compiled by the build.
 struct Ctx {
     const float* pts;
     const int* quant;
