@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null || scripts/deps.sh
-mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cu' ':!tests/dialect/check.*')
+mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cu' '*.cuh' ':!tests/dialect/check.*')
 if [ "${1:-}" = "--fix" ]; then
   clang-format -i "${files[@]}"
 else

@@ -16,14 +16,14 @@ struct PyrCudaCtx {
 
 #define PYR_CTX_PARAM const PyrCudaCtx& pyr_ctx
 #define PYR_CTX_ARG pyr_ctx
-#define PYR_PT(x, y, c) pyr_ctx.points[((y) * pyr_ctx.w + (x)) * 3u + (c)]
-#define PYR_Q_VALID(i) static_cast<unsigned>(pyr_ctx.quant[(i) * 4u + 3u])
-#define PYR_QN(i, c) pyr_ctx.quant[(i) * 4u + (c)]
-#define PYR_QZ(i) pyr_ctx.points[(i) * 3u + 2u]
+#define PYR_PT(x, y, c) pyr_ctx.points[((y)*pyr_ctx.w + (x)) * 3u + (c)]
+#define PYR_Q_VALID(i) static_cast<unsigned>(pyr_ctx.quant[(i)*4u + 3u])
+#define PYR_QN(i, c) pyr_ctx.quant[(i)*4u + (c)]
+#define PYR_QZ(i) pyr_ctx.points[(i)*3u + 2u]
 #define PYR_MASK(i) static_cast<unsigned>(pyr_ctx.mask[i])
 #define PYR_LABEL(i) pyr_ctx.labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_ctx.labels[i] = (v))
-#define PYR_VALID(p) static_cast<unsigned>(pyr_ctx.quant[(p) * 4u + 3u])
+#define PYR_VALID(p) static_cast<unsigned>(pyr_ctx.quant[(p)*4u + 3u])
 #define PYR_LUT(l) pyr_ctx.lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_ctx.lut[l] = (v))
 

@@ -111,9 +111,9 @@ public:
         staging_out_ = Memory<true>(24 * pixels, "cudaMallocHost(download staging)");
         host_flags_ = Memory<true>(4 * (kMaxBatch + 1), "cudaMallocHost(flags)");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
-        ctx_ = PyrCudaCtx{points_.as<const float>(), normals_.as<float>(),    quant_.as<int>(),
-                          mask_.as<unsigned char>(), labels_.as<unsigned>(), lut_.as<unsigned>(),
-                          uint32_t(plan.width)};
+        ctx_ =
+            PyrCudaCtx{points_.as<const float>(), normals_.as<float>(), quant_.as<int>(),    mask_.as<unsigned char>(),
+                       labels_.as<unsigned>(),    lut_.as<unsigned>(),  uint32_t(plan.width)};
     }
 
     ~CudaExecutor() override {
@@ -181,8 +181,8 @@ public:
 
     void metric() override {
         const Launch l = planar(width(), height());
-        pyr_k_metric<<<l.grid, l.block, 0, stream_>>>(ctx_, height(), plan_.full().offset,
-                                                      plan_.thresholds.curvature, plan_.thresholds.depth);
+        pyr_k_metric<<<l.grid, l.block, 0, stream_>>>(ctx_, height(), plan_.full().offset, plan_.thresholds.curvature,
+                                                      plan_.thresholds.depth);
         launched("pyr_k_metric");
     }
 
@@ -352,11 +352,10 @@ private:
         check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
         const size_t needed = 44 * pixels + 5 * texels + 4 * size_t(lut_size());
         if (needed > free_bytes) {
-            throw Error(ErrorCode::out_of_memory, "a " + std::to_string(plan_.width) + " x " +
-                                                      std::to_string(plan_.height) + " image needs " +
-                                                      std::to_string(needed >> 20) + " MiB on CUDA device " +
-                                                      std::to_string(device_) + ", which has " +
-                                                      std::to_string(free_bytes >> 20) + " MiB free");
+            throw Error(ErrorCode::out_of_memory,
+                        "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image needs " +
+                            std::to_string(needed >> 20) + " MiB on CUDA device " + std::to_string(device_) +
+                            ", which has " + std::to_string(free_bytes >> 20) + " MiB free");
         }
     }
 
