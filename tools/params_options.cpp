@@ -15,7 +15,7 @@ const char* const kParameterHelp =
     "  --bridge-levels B     pyramid levels below full resolution at which seeds stop being created (default 2;\n"
     "                        3 for scenes with many bridges).\n"
     "  --unjoinable-gap G    levels between the seeding level and the level whose regions never merge (default 2).\n"
-    "  --normal-radius R     neighbour distance in pixels for estimated normals (default 1); larger smooths noise.\n"
+    "  --normal-radius R     neighbour distance in pixels for estimated normals (default 2); larger smooths noise.\n"
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pyrseg/params.hpp"
 #include "pyrseg/io.hpp"
 
 namespace {
@@ -54,6 +55,14 @@ TEST(Cli, EveryCommandExplainsItselfWithHelp) {
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << command << "\n" << r.output;
     }
     EXPECT_NE(run("segment --help").output.find("--unit-mm"), std::string::npos);
+}
+
+// The defaults --help states are the library's (the normal radius once read 1 after the default became 2).
+TEST(Cli, HelpStatesTheLibrarysDefaults) {
+    const std::string help = run("segment --help").output;
+    EXPECT_NE(help.find("estimated normals (default " + std::to_string(pyrseg::kDefaultNormalRadius) + ")"),
+              std::string::npos)
+        << help;
 }
 
 TEST(Cli, UsageErrorsExitWithTwoAndSayWhat) {
