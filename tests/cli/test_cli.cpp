@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "pyrseg/params.hpp"
 #include "pyrseg/io.hpp"
+#include "pyrseg/params.hpp"
 
 namespace {
 
