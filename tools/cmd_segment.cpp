@@ -20,8 +20,7 @@ constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
     "                      [--backend NAME] [parameters]\n"
     "\n"
-    "Segments one organized point cloud. INPUT: a PCD file (ascii, binary or binary_compressed) with fields\n"
-    "x y z and, optionally, normal_x normal_y normal_z (otherwise normals are estimated). At least one output:\n"
+    "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments)\n"
     "  --png OUT.png         the segments in colour\n"
     "  --mask-png OUT.png    the fillable mask (white) the pyramid labels\n"
@@ -33,12 +32,13 @@ constexpr const char* kSegmentUsage =
 
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
+    values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
     values.insert({"labels", "png", "mask-png", "figure", "backend"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
     if (args.flag("help")) {
-        std::printf("%s%s", kSegmentUsage, kParameterHelp);
+        std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
         return 0;
     }
     if (args.positional().size() != 1) throw UsageError{"expects exactly one INPUT file"};
@@ -51,15 +51,10 @@ int cmd_segment(const std::vector<std::string>& argv) {
     }
     const Params params = parse_params(args);
     const std::filesystem::path input = args.positional()[0];
-    std::string ext = input.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".pcd") {
-        throw Error(ErrorCode::format, input.string() + ": unsupported input format '" + ext +
-                                           "' (this version reads organized .pcd files)");
-    }
-    const io::PointCloud cloud = io::read_pcd(input);
+    const LoadedInput loaded = load_input(input, args);
+    const io::PointCloud& cloud = loaded.cloud;
     const double median_z = median_depth(cloud.points);
-    if (params.unit_mm == 1.0 && median_z > 0 && median_z < 20.0) {
+    if (!loaded.millimetres && params.unit_mm == 1.0 && median_z > 0 && median_z < 20.0) {
         std::fprintf(stderr,
                      "pyrseg: note: %s: median depth is %.3g units; if the cloud is in metres, pass --unit-mm 1000\n",
                      input.string().c_str(), median_z);
@@ -81,9 +76,9 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (png_path) write_png(*png_path, colorize(result.labels, result.width, result.height));
     if (mask_path) write_png(*mask_path, mask_picture(result.fillable_mask, result.width, result.height));
     if (figure_path) write_png(*figure_path, comparison_figure(result));
-    std::printf("%s: %d x %d, normals %s, %u segments, %.1f ms on %s\n", input.string().c_str(), result.width,
-                result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
-                segmenter.backend_name().c_str());
+    std::printf("%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s\n", input.string().c_str(),
+                loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
+                result.segment_count, elapsed.count(), segmenter.backend_name().c_str());
     return 0;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
+#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "pyrseg/io.hpp"
 #include "pyrseg/params.hpp"
 #include "tools/args.hpp"
 
@@ -19,5 +21,16 @@ extern const char* const kParameterHelp;
 extern const std::set<std::string> kParameterValueOptions;
 extern const std::set<std::string> kParameterFlagOptions;
 [[nodiscard]] Params parse_params(const Args& args);
+
+// The inputs `segment` reads: organized PCD, or a depth image with intrinsics (--intrinsics, --calib,
+// --depth-scale), turned into a cloud in millimetres.
+extern const char* const kInputHelp;
+extern const std::set<std::string> kInputValueOptions;
+struct LoadedInput {
+    io::PointCloud cloud;
+    std::string kind;  // "PCD", "depth image"
+    bool millimetres;  // the cloud is in millimetres whatever --unit-mm says
+};
+[[nodiscard]] LoadedInput load_input(const std::filesystem::path& path, const Args& args);
 
 }  // namespace pyrseg::cli

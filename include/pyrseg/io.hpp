@@ -53,6 +53,32 @@ struct Image {
 // Palette images come back as RGB (RGBA with transparency), gray below 8 bits as 8-bit; bit_depth is 8 or 16.
 Image read_png(const std::filesystem::path& path);
 
+// A depth image: one sample per pixel in the file's units, row-major. 0, NaN, infinite or negative: no data.
+struct DepthImage {
+    int width = 0, height = 0;
+    std::vector<float> depth;
+    bool floating = false;  // float samples (usually metres) rather than integers (usually millimetres)
+};
+// A 16-bit grayscale PNG (as depth cameras and TUM/CAPE datasets store millimetres or 1/5000 m), or a
+// single-channel TIFF of 16-bit unsigned or 32-bit float samples (libtiff).
+DepthImage read_depth_image(const std::filesystem::path& path);
+void write_tiff_float(const std::filesystem::path& path, const float* depth, int width, int height);
+
+// Pinhole intrinsics in pixels.
+struct Intrinsics {
+    double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+// "fx,fy,cx,cy" (four numbers, fx and fy > 0). Throws ErrorCode::invalid_argument naming the problem.
+Intrinsics parse_intrinsics(const std::string& text);
+// An OpenCV FileStorage file (XML, YAML or JSON), read by OpenCV. `node` names either a 3x3 camera matrix
+// [fx 0 cx; 0 fy cy; 0 0 1] or a map with keys fx, fy, cx, cy. With an empty `node` the file's top level must hold
+// fx fy cx cy, or exactly one 3x3 matrix. The message of a failure names the file and the node.
+Intrinsics read_intrinsics(const std::filesystem::path& path, const std::string& node = {});
+
+// An organized cloud in millimetres from a depth image: z = depth * mm_per_unit, x = (u - cx) * z / fx,
+// y = (v - cy) * z / fy (computed in double, stored as float); pixels without data are NaN.
+PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit);
+
 // Colour-coded segmentation: label 0 black, other labels distinct saturated colours (a fixed hash of the label so
 // the same label is the same colour in every picture; neighbouring label values clearly different).
 std::array<std::uint8_t, 3> label_color(std::uint32_t label);

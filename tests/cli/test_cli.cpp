@@ -172,6 +172,34 @@ TEST(Cli, NoVulkanDriverIsExplainedAndAnError) {
     fs::remove_all(dir);
 }
 
+// A depth image with its calibration: back-projected and segmented; without intrinsics a clear error; a point
+// cloud's unit option on a depth image is a usage error.
+TEST(Cli, DepthImagesNeedIntrinsicsAndSegment) {
+    const fs::path data(PYRSEG_SHARED_DATA_DIR);
+    const fs::path depth = data / "cape_depth_0.png";
+    if (!fs::exists(depth)) GTEST_SKIP() << "sample depth image not present: " << depth.string();
+    const fs::path dir = temp_dir();
+    const std::string out = " --labels " + (dir / "d.npy").string();
+    CliRun r = run("segment " + depth.string() + " --calib " + (data / "cape_calib_params.xml").string() +
+                   ":IR_intrinsic_params" + out);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("depth image, 640 x 480"), std::string::npos) << r.output;
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(dir / "d.npy");
+    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+    r = run("segment " + depth.string() + " --intrinsics 575.93,576.41,315.15,230.59 --depth-scale 1000" + out);
+    EXPECT_EQ(r.status, 0) << r.output;
+    r = run("segment " + depth.string() + out);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("cape_depth_0.png: a depth image needs the camera's intrinsics"), std::string::npos)
+        << r.output;
+    r = run("segment " + depth.string() + " --calib " + (data / "cape_calib_params.xml").string() + out);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("name one, as FILE:NODE"), std::string::npos) << r.output;
+    r = run("segment " + depth.string() + " --intrinsics 1,2,3,4 --unit-mm 1000" + out);
+    EXPECT_EQ(r.status, 2) << r.output;
+    fs::remove_all(dir);
+}
+
 // The acceptance case: the PCL mug scan, in metres, with default parameters.
 TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
     if (!fs::exists(mug_scan())) GTEST_SKIP() << "sample scan not present: " << mug_scan().string();

@@ -1,0 +1,85 @@
+// What `pyrseg segment` reads: organized PCD clouds, and depth images back-projected with pinhole intrinsics.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "pyrseg/error.hpp"
+#include "tools/commands.hpp"
+
+namespace pyrseg::cli {
+
+const char* const kInputHelp =
+    "Inputs:\n"
+    "  .pcd                  organized PCD (ascii, binary or binary_compressed), fields x y z and optionally\n"
+    "                        normal_x normal_y normal_z (otherwise normals are estimated)\n"
+    "  .png, .tif, .tiff     a depth image: 16-bit PNG, or a TIFF of 16-bit or 32-bit float samples; 0 = no data.\n"
+    "                        Needs the camera's intrinsics, one of:\n"
+    "  --intrinsics FX,FY,CX,CY   focal lengths and principal point in pixels\n"
+    "  --calib FILE[:NODE]   an OpenCV FileStorage file (XML/YAML/JSON) with a 3x3 camera matrix or fx fy cx cy;\n"
+    "                        NODE names the matrix when the file has several (e.g. IR_intrinsic_params)\n"
+    "  --depth-scale S       depth units per metre: 1000 for millimetres (default for 16-bit images), 5000 for\n"
+    "                        TUM RGB-D, 1 for metres (default for float images)\n"
+    "\n";
+
+const std::set<std::string> kInputValueOptions = {"intrinsics", "calib", "depth-scale"};
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+io::Intrinsics intrinsics_from(const Args& args, const std::filesystem::path& input) {
+    const auto text = args.value("intrinsics");
+    const auto calib = args.value("calib");
+    if (text && calib) throw UsageError{"give --intrinsics or --calib, not both"};
+    if (text) return io::parse_intrinsics(*text);
+    if (!calib) {
+        throw Error(ErrorCode::invalid_argument,
+                    input.string() +
+                        ": a depth image needs the camera's intrinsics: --intrinsics FX,FY,CX,CY or "
+                        "--calib FILE[:NODE]");
+    }
+    // FILE:NODE, unless the whole text names an existing file.
+    std::string file = *calib;
+    std::string node;
+    const std::size_t colon = calib->rfind(':');
+    if (colon != std::string::npos && !std::filesystem::exists(*calib)) {
+        file = calib->substr(0, colon);
+        node = calib->substr(colon + 1);
+    }
+    return io::read_intrinsics(file, node);
+}
+
+}  // namespace
+
+LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
+    const std::string ext = lower_extension(path);
+    if (ext == ".pcd") {
+        for (const std::string& option : kInputValueOptions) {
+            if (args.value(option)) {
+                std::string message = "--" + option;
+                message += " applies to depth images, not to " + ext;
+                throw UsageError{message};
+            }
+        }
+        return {io::read_pcd(path), "PCD", false};
+    }
+    if (ext == ".png" || ext == ".tif" || ext == ".tiff") {
+        if (args.value("unit-mm")) {
+            throw UsageError{"--unit-mm applies to point clouds; a depth image's units are set by --depth-scale"};
+        }
+        const io::Intrinsics k = intrinsics_from(args, path);
+        const io::DepthImage depth = io::read_depth_image(path);
+        double per_metre = depth.floating ? 1.0 : 1000.0;
+        if (auto s = args.number("depth-scale")) per_metre = *s;
+        if (!(per_metre > 0)) throw UsageError{"--depth-scale must be > 0"};
+        return {io::depth_to_cloud(depth, k, 1000.0 / per_metre), "depth image", true};
+    }
+    throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +
+                                       "' (pyrseg reads .pcd clouds and .png/.tif/.tiff depth images)");
+}
+
+}  // namespace pyrseg::cli
