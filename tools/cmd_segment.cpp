@@ -1,8 +1,14 @@
+#include <glob.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -12,13 +18,17 @@
 #include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
+#include "tools/progress.hpp"
 
 namespace pyrseg::cli {
 namespace {
 
+namespace fs = std::filesystem;
+
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
-    "                      [--backend NAME] [parameters]\n"
+    "                      [--backend NAME] [input options] [parameters]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure] [--progress auto|bar|lines|none]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments)\n"
@@ -26,31 +36,27 @@ constexpr const char* kSegmentUsage =
     "  --mask-png OUT.png    the fillable mask (white) the pyramid labels\n"
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
+    "\n"
+    "Batches: several INPUTs, folders (their .pcd/.png/.tif/.tiff files, in name order) or quoted glob patterns,\n"
+    "with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png as --write\n"
+    "asks (default labels,png). A frame that fails is reported and skipped; the exit status is 1 if any failed.\n"
+    "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
     "\n";
 
-}  // namespace
+struct OutputPaths {
+    std::optional<fs::path> labels, png, mask, figure;
+    [[nodiscard]] bool any() const { return labels || png || mask || figure; }
+};
 
-int cmd_segment(const std::vector<std::string>& argv) {
-    std::set<std::string> values = kParameterValueOptions;
-    values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
-    values.insert({"labels", "png", "mask-png", "figure", "backend"});
-    std::set<std::string> flags = kParameterFlagOptions;
-    flags.insert("help");
-    const Args args(argv, values, flags);
-    if (args.flag("help")) {
-        std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
-        return 0;
-    }
-    if (args.positional().size() != 1) throw UsageError{"expects exactly one INPUT file"};
-    const auto labels_path = args.value("labels");
-    const auto png_path = args.value("png");
-    const auto mask_path = args.value("mask-png");
-    const auto figure_path = args.value("figure");
-    if (!labels_path && !png_path && !mask_path && !figure_path) {
-        throw UsageError{"nothing to write: give --labels, --png, --mask-png or --figure"};
-    }
-    const Params params = parse_params(args);
-    const std::filesystem::path input = args.positional()[0];
+struct FrameReport {
+    std::string line;
+    std::uint32_t segments = 0;
+    double milliseconds = 0;
+};
+
+// One frame: read, segment (reusing the Segmenter while the size stays the same), write what was asked.
+FrameReport segment_frame(const fs::path& input, const Args& args, const Params& params, const OutputPaths& out,
+                          std::unique_ptr<Segmenter>& segmenter) {
     const LoadedInput loaded = load_input(input, args);
     const io::PointCloud& cloud = loaded.cloud;
     const double median_z = median_depth(cloud.points);
@@ -59,26 +65,158 @@ int cmd_segment(const std::vector<std::string>& argv) {
                      "pyrseg: note: %s: median depth is %.3g units; if the cloud is in metres, pass --unit-mm 1000\n",
                      input.string().c_str(), median_z);
     }
-
-    Outputs outputs;
-    outputs.fillable_mask = mask_path.has_value() || figure_path.has_value();
-    Segmenter segmenter(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
+    if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height) {
+        Outputs outputs;
+        outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
+        segmenter = std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""),
+                                                outputs);
+    }
     CloudView view;
     view.points = cloud.points.data();
     view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();
     view.width = cloud.width;
     view.height = cloud.height;
     const auto start = std::chrono::steady_clock::now();
-    const Result result = segmenter.segment(view);
+    const Result result = segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
 
-    if (labels_path) io::write_npy(*labels_path, result.labels.data(), result.height, result.width);
-    if (png_path) write_png(*png_path, colorize(result.labels, result.width, result.height));
-    if (mask_path) write_png(*mask_path, mask_picture(result.fillable_mask, result.width, result.height));
-    if (figure_path) write_png(*figure_path, comparison_figure(result));
-    std::printf("%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s\n", input.string().c_str(),
-                loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
-                result.segment_count, elapsed.count(), segmenter.backend_name().c_str());
+    if (out.labels) io::write_npy(*out.labels, result.labels.data(), result.height, result.width);
+    if (out.png) write_png(*out.png, colorize(result.labels, result.width, result.height));
+    if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
+    if (out.figure) write_png(*out.figure, comparison_figure(result));
+    char line[512];
+    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s",
+                  input.string().c_str(), loaded.kind.c_str(), result.width, result.height,
+                  cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
+                  segmenter->backend_name().c_str());
+    return {line, result.segment_count, elapsed.count()};
+}
+
+bool supported_input(const fs::path& p) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".pcd" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+}
+
+// Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
+std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
+    std::vector<fs::path> inputs;
+    for (const std::string& name : names) {
+        std::error_code ec;
+        if (fs::is_directory(name, ec)) {
+            std::vector<fs::path> found;
+            for (const fs::directory_entry& e : fs::directory_iterator(name, ec)) {
+                if (e.is_regular_file(ec) && supported_input(e.path())) found.push_back(e.path());
+            }
+            std::sort(found.begin(), found.end());
+            if (found.empty()) std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.png/.tif/.tiff file\n", name.c_str());
+            inputs.insert(inputs.end(), found.begin(), found.end());
+        } else if (name.find_first_of("*?[") != std::string::npos && !fs::exists(name, ec)) {
+            glob_t matches{};
+            if (::glob(name.c_str(), 0, nullptr, &matches) == 0) {
+                for (std::size_t i = 0; i < matches.gl_pathc; ++i) inputs.emplace_back(matches.gl_pathv[i]);
+            } else {
+                std::fprintf(stderr, "pyrseg: note: pattern '%s' matches nothing\n", name.c_str());
+            }
+            globfree(&matches);
+        } else {
+            inputs.emplace_back(name);
+        }
+    }
+    return inputs;
+}
+
+std::set<std::string> parse_write_list(const std::string& text) {
+    std::set<std::string> kinds;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        if (item != "labels" && item != "png" && item != "mask" && item != "figure") {
+            throw UsageError{"--write expects a list of labels, png, mask, figure; got '" + item + "'"};
+        }
+        kinds.insert(item);
+    }
+    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure"};
+    return kinds;
+}
+
+int run_batch(const Args& args, const Params& params) {
+    const fs::path out_dir = *args.value("out-dir");
+    const std::set<std::string> kinds = parse_write_list(args.value("write").value_or("labels,png"));
+    const std::vector<fs::path> inputs = expand_inputs(args.positional());
+    if (inputs.empty()) throw Error(ErrorCode::io, "the batch has no input file");
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (!fs::is_directory(out_dir)) throw Error(ErrorCode::io, out_dir.string() + ": cannot create the output folder");
+
+    Progress progress(inputs.size(), Progress::style_for(args.value("progress").value_or("auto"), stderr), stderr);
+    std::unique_ptr<Segmenter> segmenter;
+    std::set<std::string> stems;
+    std::vector<std::string> failures;
+    double total_ms = 0;
+    std::uint64_t total_segments = 0;
+    for (const fs::path& input : inputs) {
+        // Distinct output names even when two inputs share a name in different folders.
+        std::string stem = input.stem().string();
+        for (int n = 2; !stems.insert(stem).second; ++n) stem = input.stem().string() + "_" + std::to_string(n);
+        OutputPaths out;
+        if (kinds.count("labels") != 0) out.labels = out_dir / (stem + ".labels.npy");
+        if (kinds.count("png") != 0) out.png = out_dir / (stem + ".png");
+        if (kinds.count("mask") != 0) out.mask = out_dir / (stem + ".mask.png");
+        if (kinds.count("figure") != 0) out.figure = out_dir / (stem + ".figure.png");
+        try {
+            const FrameReport r = segment_frame(input, args, params, out, segmenter);
+            total_ms += r.milliseconds;
+            total_segments += r.segments;
+            progress.frame_done(r.line, false);
+        } catch (const Error& e) {
+            failures.push_back(e.what());
+            progress.frame_done(std::string("failed: ") + e.what(), true);
+        }
+    }
+    progress.finish();
+    const std::size_t ok = inputs.size() - failures.size();
+    const double seconds = progress.elapsed_seconds();
+    std::printf("batch: %zu frames, %zu segmented, %zu failed, %.1f s (%.1f frames/s); segmentation %.1f ms per frame, "
+                "%.1f segments per frame; outputs in %s\n",
+                inputs.size(), ok, failures.size(), seconds, seconds > 0 ? double(inputs.size()) / seconds : 0.0,
+                ok > 0 ? total_ms / double(ok) : 0.0, ok > 0 ? double(total_segments) / double(ok) : 0.0,
+                out_dir.string().c_str());
+    for (const std::string& f : failures) std::printf("  failed: %s\n", f.c_str());
+    return failures.empty() ? 0 : 1;
+}
+
+}  // namespace
+
+int cmd_segment(const std::vector<std::string>& argv) {
+    std::set<std::string> values = kParameterValueOptions;
+    values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
+    values.insert({"labels", "png", "mask-png", "figure", "backend", "out-dir", "write", "progress"});
+    std::set<std::string> flags = kParameterFlagOptions;
+    flags.insert("help");
+    const Args args(argv, values, flags);
+    if (args.flag("help")) {
+        std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
+        return 0;
+    }
+    OutputPaths out;
+    if (auto v = args.value("labels")) out.labels = *v;
+    if (auto v = args.value("png")) out.png = *v;
+    if (auto v = args.value("mask-png")) out.mask = *v;
+    if (auto v = args.value("figure")) out.figure = *v;
+    const Params params = parse_params(args);
+    if (args.value("out-dir")) {
+        if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
+        if (out.any()) throw UsageError{"in a batch (--out-dir), choose the outputs with --write, not file names"};
+        return run_batch(args, params);
+    }
+    if (args.value("write") || args.value("progress")) throw UsageError{"--write and --progress need --out-dir"};
+    if (args.positional().size() != 1) {
+        throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
+    }
+    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png or --figure"};
+    std::unique_ptr<Segmenter> segmenter;
+    std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter).line.c_str());
     return 0;
 }
 

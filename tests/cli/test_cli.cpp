@@ -13,6 +13,7 @@
 
 #include "pyrseg/io.hpp"
 #include "pyrseg/params.hpp"
+#include "pyrseg/synthetic.hpp"
 
 namespace {
 
@@ -196,6 +197,59 @@ TEST(Cli, DepthImagesNeedIntrinsicsAndSegment) {
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("name one, as FILE:NODE"), std::string::npos) << r.output;
     r = run("segment " + depth.string() + " --intrinsics 1,2,3,4 --unit-mm 1000" + out);
+    EXPECT_EQ(r.status, 2) << r.output;
+    fs::remove_all(dir);
+}
+
+// A batch of 50 frames from a folder plus one broken file: every good frame is segmented and written, the broken one
+// is reported by name without stopping the batch, and a summary ends it; then the same frames by glob pattern with
+// the progress bar.
+TEST(Cli, BatchOfFiftyFramesReportsProgressFailuresAndASummary) {
+    const fs::path dir = temp_dir();
+    const fs::path in = dir / "frames";
+    fs::create_directories(in);
+    for (int i = 0; i < 50; ++i) {
+        pyrseg::synthetic::SceneOptions o;
+        o.width = 96;
+        o.height = 72;
+        o.seed = std::uint64_t(i + 1);
+        o.object_count = 4;
+        const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
+        pyrseg::io::PointCloud cloud;
+        cloud.width = o.width;
+        cloud.height = o.height;
+        cloud.points = scene.points;
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%02d.pcd", i);
+        pyrseg::io::write_pcd(in / name, cloud, pyrseg::io::PcdEncoding::binary);
+    }
+    {
+        std::FILE* f = std::fopen((in / "frame_99.pcd").c_str(), "w");
+        ASSERT_NE(f, nullptr);
+        std::fputs("VERSION 0.7\nFIELDS x y z\n", f);  // cut short
+        std::fclose(f);
+    }
+    const fs::path out = dir / "out";
+    CliRun r = run("segment " + in.string() + " --out-dir " + out.string() + " --progress lines --backend cpu");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("[1/51] "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("[51/51] failed: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("batch: 51 frames, 50 segmented, 1 failed"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("frame_99.pcd"), std::string::npos) << r.output;
+    for (int i = 0; i < 50; ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%02d", i);
+        EXPECT_TRUE(fs::exists(out / (std::string(name) + ".labels.npy"))) << name;
+        EXPECT_TRUE(fs::exists(out / (std::string(name) + ".png"))) << name;
+    }
+    r = run("segment '" + (in / "frame_[0-4]?.pcd").string() + "' --out-dir " + out.string() +
+            " --write labels,figure --progress bar --backend cpu");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("] 50/50 frames"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("fps  ETA"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("batch: 50 frames, 50 segmented, 0 failed"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(out / "frame_49.figure.png"));
+    r = run("segment " + in.string() + " --labels x.npy --out-dir " + out.string());
     EXPECT_EQ(r.status, 2) << r.output;
     fs::remove_all(dir);
 }
