@@ -68,8 +68,8 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height) {
         Outputs outputs;
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
-        segmenter = std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""),
-                                                outputs);
+        segmenter =
+            std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
     CloudView view;
     view.points = cloud.points.data();
@@ -85,10 +85,9 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));
     char line[512];
-    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s",
-                  input.string().c_str(), loaded.kind.c_str(), result.width, result.height,
-                  cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
-                  segmenter->backend_name().c_str());
+    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s", input.string().c_str(),
+                  loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
+                  result.segment_count, elapsed.count(), segmenter->backend_name().c_str());
     return {line, result.segment_count, elapsed.count()};
 }
 
@@ -109,7 +108,8 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
                 if (e.is_regular_file(ec) && supported_input(e.path())) found.push_back(e.path());
             }
             std::sort(found.begin(), found.end());
-            if (found.empty()) std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.png/.tif/.tiff file\n", name.c_str());
+            if (found.empty())
+                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.png/.tif/.tiff file\n", name.c_str());
             inputs.insert(inputs.end(), found.begin(), found.end());
         } else if (name.find_first_of("*?[") != std::string::npos && !fs::exists(name, ec)) {
             glob_t matches{};
@@ -177,11 +177,12 @@ int run_batch(const Args& args, const Params& params) {
     progress.finish();
     const std::size_t ok = inputs.size() - failures.size();
     const double seconds = progress.elapsed_seconds();
-    std::printf("batch: %zu frames, %zu segmented, %zu failed, %.1f s (%.1f frames/s); segmentation %.1f ms per frame, "
-                "%.1f segments per frame; outputs in %s\n",
-                inputs.size(), ok, failures.size(), seconds, seconds > 0 ? double(inputs.size()) / seconds : 0.0,
-                ok > 0 ? total_ms / double(ok) : 0.0, ok > 0 ? double(total_segments) / double(ok) : 0.0,
-                out_dir.string().c_str());
+    std::printf(
+        "batch: %zu frames, %zu segmented, %zu failed, %.1f s (%.1f frames/s); segmentation %.1f ms per frame, "
+        "%.1f segments per frame; outputs in %s\n",
+        inputs.size(), ok, failures.size(), seconds, seconds > 0 ? double(inputs.size()) / seconds : 0.0,
+        ok > 0 ? total_ms / double(ok) : 0.0, ok > 0 ? double(total_segments) / double(ok) : 0.0,
+        out_dir.string().c_str());
     for (const std::string& f : failures) std::printf("  failed: %s\n", f.c_str());
     return failures.empty() ? 0 : 1;
 }
