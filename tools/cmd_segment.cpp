@@ -37,7 +37,7 @@ constexpr const char* kSegmentUsage =
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n"
-    "Batches: several INPUTs, folders (their .pcd/.png/.tif/.tiff files, in name order) or quoted glob patterns,\n"
+    "Batches: several INPUTs, folders (their .pcd/.npy/.png/.tif/.tiff files, by name) or quoted glob patterns,\n"
     "with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png as --write\n"
     "asks (default labels,png). A frame that fails is reported and skipped; the exit status is 1 if any failed.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
@@ -94,7 +94,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
 bool supported_input(const fs::path& p) {
     std::string ext = p.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".pcd" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+    return ext == ".pcd" || ext == ".npy" || ext == ".png" || ext == ".tif" || ext == ".tiff";
 }
 
 // Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
@@ -109,7 +109,7 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
             }
             std::sort(found.begin(), found.end());
             if (found.empty())
-                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.png/.tif/.tiff file\n", name.c_str());
+                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.npy/.png/.tif/.tiff file\n", name.c_str());
             inputs.insert(inputs.end(), found.begin(), found.end());
         } else if (name.find_first_of("*?[") != std::string::npos && !fs::exists(name, ec)) {
             glob_t matches{};

@@ -53,6 +53,10 @@ struct Image {
 // Palette images come back as RGB (RGBA with transparency), gray below 8 bits as 8-bit; bit_depth is 8 or 16.
 Image read_png(const std::filesystem::path& path);
 
+// An organized cloud stored as a NumPy array: H x W x 3 (points) or H x W x 6 (points, then normals), float32 or
+// float64 ('<f4', '<f8'), C order.
+PointCloud read_npy_cloud(const std::filesystem::path& path);
+
 // A depth image: one sample per pixel in the file's units, row-major. 0, NaN, infinite or negative: no data.
 struct DepthImage {
     int width = 0, height = 0;

@@ -201,6 +201,27 @@ TEST(Cli, DepthImagesNeedIntrinsicsAndSegment) {
     fs::remove_all(dir);
 }
 
+// A NumPy cloud with normals (H x W x 6), as a Python pipeline would save it.
+TEST(Cli, NumpyCloudsWithNormalsAreSegmented) {
+    pyrseg::synthetic::SceneOptions o;
+    o.width = 64;
+    o.height = 48;
+    const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
+    std::vector<float> six(std::size_t(o.width) * std::size_t(o.height) * 6);
+    for (std::size_t i = 0; i < six.size() / 6; ++i) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            six[6 * i + c] = scene.points[3 * i + c];
+            six[6 * i + 3 + c] = scene.normals[3 * i + c];
+        }
+    }
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_npy(dir / "cloud.npy", six.data(), o.height, o.width, 6);
+    const CliRun r = run("segment " + (dir / "cloud.npy").string() + " --labels " + (dir / "l.npy").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("NumPy cloud, 64 x 48, normals from file"), std::string::npos) << r.output;
+    fs::remove_all(dir);
+}
+
 // A batch of 50 frames from a folder plus one broken file: every good frame is segmented and written, the broken one
 // is reported by name without stopping the batch, and a summary ends it; then the same frames by glob pattern with
 // the progress bar.

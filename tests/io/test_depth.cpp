@@ -178,3 +178,69 @@ TEST(Intrinsics, TheSharedCapeCalibrationGivesTheIrCamera) {
 
 }  // namespace
 }  // namespace pyrseg::io::test
+
+namespace pyrseg::io::test {
+namespace {
+
+// A '<f8' .npy written by hand (pyrseg's writer only writes float32), the way numpy.save lays it out.
+std::string npy_f8(const std::vector<double>& values, const std::string& shape, const std::string& descr = "<f8") {
+    std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': " + shape + ", }";
+    while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+    header += '\n';
+    std::string out = "\x93NUMPY";
+    out += '\x01';
+    out += '\x00';
+    out += char(header.size() & 0xff);
+    out += char(header.size() >> 8);
+    out += header;
+    out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+    return out;
+}
+
+TEST(NpyCloud, PointsAndNormalsRoundTrip) {
+    ScratchDir dir;
+    const int w = 4;
+    const int h = 3;
+    std::vector<float> six(std::size_t(w) * h * 6);
+    for (std::size_t i = 0; i < six.size(); ++i) six[i] = float(i) * 0.25f - 3.0f;
+    write_npy(dir / "six.npy", six.data(), h, w, 6);
+    const PointCloud c = read_npy_cloud(dir / "six.npy");
+    ASSERT_EQ(c.width, w);
+    ASSERT_EQ(c.height, h);
+    ASSERT_EQ(c.normals.size(), c.points.size());
+    for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
+        for (std::size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ(c.points[3 * i + k], six[6 * i + k]);
+            EXPECT_EQ(c.normals[3 * i + k], six[6 * i + 3 + k]);
+        }
+    }
+    write_npy(dir / "three.npy", six.data(), h, w * 2, 3);
+    const PointCloud p = read_npy_cloud(dir / "three.npy");
+    EXPECT_EQ(p.width, 2 * w);
+    EXPECT_TRUE(p.normals.empty());
+    EXPECT_EQ(0, std::memcmp(p.points.data(), six.data(), six.size() * sizeof(float)));
+    write_bytes(dir / "f8.npy", npy_f8({1.5, -2.25, 1000.0, 0.0, 0.0, 1e-3}, "(1, 2, 3)"));
+    const PointCloud d = read_npy_cloud(dir / "f8.npy");
+    ASSERT_EQ(d.width, 2);
+    EXPECT_EQ(d.points[1], -2.25f);
+    EXPECT_EQ(d.points[5], 1e-3f);
+}
+
+TEST(NpyCloud, ArraysThatAreNotCloudsAreRefusedNamingTheShape) {
+    ScratchDir dir;
+    const std::vector<std::uint32_t> labels(12, 1);
+    write_npy(dir / "labels.npy", labels.data(), 3, 4);
+    std::string message;
+    EXPECT_EQ(error_of([&] { (void)read_npy_cloud(dir / "labels.npy"); }, &message), ErrorCode::format);
+    EXPECT_NE(message.find("this one is 3 x 4"), std::string::npos) << message;
+    const std::vector<float> four(3 * 4 * 4, 1.0f);
+    write_npy(dir / "four.npy", four.data(), 3, 4, 4);
+    EXPECT_EQ(error_of([&] { (void)read_npy_cloud(dir / "four.npy"); }, &message), ErrorCode::format);
+    EXPECT_NE(message.find("3 x 4 x 4"), std::string::npos) << message;
+    write_bytes(dir / "i8.npy", npy_f8({1, 2, 3}, "(1, 1, 3)", "<i8"));
+    EXPECT_EQ(error_of([&] { (void)read_npy_cloud(dir / "i8.npy"); }, &message), ErrorCode::format);
+    EXPECT_NE(message.find("'<i8'"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace pyrseg::io::test
