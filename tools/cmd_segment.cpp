@@ -31,7 +31,8 @@ constexpr const char* kSegmentUsage =
     "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure] [--progress auto|bar|lines|none]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
-    "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments)\n"
+    "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments);\n"
+    "  --labels OUT.png      or as a 16-bit grayscale PNG, when every label fits in 16 bits\n"
     "  --png OUT.png         the segments in colour\n"
     "  --mask-png OUT.png    the fillable mask (white) the pyramid labels\n"
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
@@ -53,6 +54,24 @@ struct FrameReport {
     std::uint32_t segments = 0;
     double milliseconds = 0;
 };
+
+// .npy (uint32) or, when every label fits, a 16-bit PNG that image viewers and OpenCV read directly.
+void write_labels(const fs::path& path, const Result& result) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".png") {
+        io::write_npy(path, result.labels.data(), result.height, result.width);
+        return;
+    }
+    const std::uint32_t largest =
+        result.labels.empty() ? 0u : *std::max_element(result.labels.begin(), result.labels.end());
+    if (largest > 65535u) {
+        throw Error(ErrorCode::invalid_argument, path.string() + ": label " + std::to_string(largest) +
+                                                     " does not fit a 16-bit PNG; write .npy instead");
+    }
+    std::vector<std::uint16_t> gray(result.labels.begin(), result.labels.end());
+    io::write_png_gray16(path, gray.data(), result.width, result.height);
+}
 
 // One frame: read, segment (reusing the Segmenter while the size stays the same), write what was asked.
 FrameReport segment_frame(const fs::path& input, const Args& args, const Params& params, const OutputPaths& out,
@@ -80,7 +99,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     const Result result = segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
 
-    if (out.labels) io::write_npy(*out.labels, result.labels.data(), result.height, result.width);
+    if (out.labels) write_labels(*out.labels, result);
     if (out.png) write_png(*out.png, colorize(result.labels, result.width, result.height));
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));

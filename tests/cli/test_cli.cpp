@@ -219,6 +219,20 @@ TEST(Cli, NumpyCloudsWithNormalsAreSegmented) {
     const CliRun r = run("segment " + (dir / "cloud.npy").string() + " --labels " + (dir / "l.npy").string());
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("NumPy cloud, 64 x 48, normals from file"), std::string::npos) << r.output;
+    // The same labels as a 16-bit PNG.
+    ASSERT_EQ(run("segment " + (dir / "cloud.npy").string() + " --labels " + (dir / "l.png").string()).status, 0);
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(dir / "l.npy");
+    const pyrseg::io::Image png = pyrseg::io::read_png(dir / "l.png");
+    ASSERT_EQ(png.bit_depth, 16);
+    ASSERT_EQ(png.channels, 1);
+    ASSERT_EQ(npy.bytes.size(), 2 * png.data.size());
+    for (std::size_t i = 0; i < png.data.size() / 2; ++i) {
+        std::uint32_t a = 0;
+        std::uint16_t b = 0;
+        std::memcpy(&a, npy.bytes.data() + 4 * i, 4);
+        std::memcpy(&b, png.data.data() + 2 * i, 2);
+        ASSERT_EQ(a, b) << "pixel " << i;
+    }
     fs::remove_all(dir);
 }
 
