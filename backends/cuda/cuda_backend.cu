@@ -390,8 +390,19 @@ std::vector<std::string> describe_devices(std::string* why_none) {
     const cudaError_t err = cudaGetDeviceCount(&count);
     if (err != cudaSuccess || count == 0) {
         if (why_none != nullptr) {
-            *why_none = std::string("no CUDA device (cudaGetDeviceCount: ") +
-                        (err != cudaSuccess ? cudaGetErrorString(err) : "0 devices") + ")";
+            int driver = 0;
+            cudaDriverGetVersion(&driver);
+            if (driver == 0) {
+                *why_none = "no CUDA device: no NVIDIA driver is installed (libcuda not found)";
+            } else if (err == cudaErrorInsufficientDriver) {
+                *why_none = "no CUDA device: the NVIDIA driver supports CUDA " + std::to_string(driver / 1000) + "." +
+                            std::to_string(driver % 1000 / 10) + ", older than the CUDA " +
+                            std::to_string(CUDART_VERSION / 1000) + "." + std::to_string(CUDART_VERSION % 1000 / 10) +
+                            " runtime pyrseg was built with";
+            } else {
+                *why_none = std::string("no CUDA device (cudaGetDeviceCount: ") +
+                            (err != cudaSuccess ? cudaGetErrorString(err) : "0 devices") + ")";
+            }
         }
         cudaGetLastError();  // clear the sticky-free error state for later calls
         return out;
