@@ -37,14 +37,6 @@ struct PyrCudaCtx {
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
 
-PYR_FN PyrLevel pyr_level(unsigned width, unsigned height, unsigned offset) {
-    PyrLevel lv;
-    lv.width = width;
-    lv.height = height;
-    lv.offset = offset;
-    return lv;
-}
-
 /* 1D kernels index over blockIdx.y * gridDim.x blocks too: a grid may hold at most 65535 blocks in y, but the
  * host keeps x below 2^31 - 1, so any frame pyrseg accepts fits. */
 __device__ __forceinline__ unsigned pyr_linear_id() {

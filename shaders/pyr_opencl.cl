@@ -26,14 +26,6 @@
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
 
-PYR_FN PyrLevel pyr_level(uint width, uint height, uint offset) {
-    PyrLevel lv;
-    lv.width = width;
-    lv.height = height;
-    lv.offset = offset;
-    return lv;
-}
-
 __kernel void pyr_k_normals(PYR_CTX_PARAM, uint h, uint radius) {
     uint x = (uint)get_global_id(0);
     uint y = (uint)get_global_id(1);

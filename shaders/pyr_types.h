@@ -12,6 +12,15 @@ struct PyrLevel {
     pyr_u32 offset;
 };
 
+/* A level from its size and offset (GLSL has no brace initialisers for structs in every version). */
+PYR_FN PyrLevel pyr_level(pyr_u32 width, pyr_u32 height, pyr_u32 offset) {
+    PyrLevel lv;
+    lv.width = width;
+    lv.height = height;
+    lv.offset = offset;
+    return lv;
+}
+
 PYR_TYPEDEF(PyrIVec3)
 struct PyrIVec3 {
     pyr_i32 x;

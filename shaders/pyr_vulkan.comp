@@ -41,14 +41,6 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
 
-PyrLevel pyr_level(uint width, uint height, uint offset) {
-    PyrLevel lv;
-    lv.width = width;
-    lv.height = height;
-    lv.offset = offset;
-    return lv;
-}
-
 #define PYR_GROUP_1D 64u
 #define PYR_GROUP_2D 8u
 #define PYR_LINEAR_ID (gl_GlobalInvocationID.y * gl_NumWorkGroups.x * PYR_GROUP_1D + gl_GlobalInvocationID.x)

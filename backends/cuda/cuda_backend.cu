@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_cuda.cuh"
 
@@ -133,12 +134,12 @@ public:
         event_count_ = 0;
         record_event("upload");
         const size_t bytes = 12 * plan_.pixel_count();
-        stage(cloud, cloud.points, staging_in_.as<float>());
+        core::pack_xyz(cloud, cloud.points, staging_in_.as<float>());
         copy_in(points_.as<void>(), staging_in_.as<void>(), bytes);
         from_mask_ = false;
         if (cloud.normals != nullptr) {
             auto* normals = staging_in_.as<unsigned char>() + bytes;
-            stage(cloud, cloud.normals, reinterpret_cast<float*>(normals));
+            core::pack_xyz(cloud, cloud.normals, reinterpret_cast<float*>(normals));
             copy_in(normals_.as<void>(), normals, bytes);
         }
     }
@@ -327,23 +328,6 @@ private:
 
     void copy_out(void* dst, const void* src, size_t bytes) {
         check(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyDeviceToHost, stream_), "cudaMemcpyAsync(download)");
-    }
-
-    // Into pinned staging: packed clouds in one copy, strided ones point by point.
-    void stage(const CloudView& cloud, const float* data, float* dst) const {
-        const size_t w = size_t(plan_.width);
-        const size_t h = size_t(plan_.height);
-        const size_t row_stride = cloud.row_stride == 0 ? w : cloud.row_stride;
-        const size_t ps = size_t(cloud.point_stride);
-        if (ps == 3 && row_stride == w) {
-            std::memcpy(dst, data, 3 * w * h * sizeof(float));
-            return;
-        }
-        for (size_t y = 0; y < h; ++y) {
-            for (size_t x = 0; x < w; ++x) {
-                std::memcpy(dst + 3 * (y * w + x), data + (y * row_stride + x) * ps, 3 * sizeof(float));
-            }
-        }
     }
 
     void check_fits(size_t pixels, size_t texels) const {

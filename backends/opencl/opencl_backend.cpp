@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "backends/opencl/opencl_runtime.hpp"
+#include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_types.h"
 
@@ -331,16 +332,10 @@ private:
     void upload(const CloudView& cloud, const float* data, const Buffer& buffer, std::vector<float>& staging) {
         const size_t w = size_t(plan_.width);
         const size_t h = size_t(plan_.height);
-        const size_t row_stride = cloud.row_stride == 0 ? w : cloud.row_stride;
-        const size_t ps = size_t(cloud.point_stride);
         const float* src = data;
-        if (ps != 3 || row_stride != w) {
+        if (!core::is_packed_xyz(cloud)) {
             if (staging.empty()) staging.resize(3 * w * h);
-            for (size_t y = 0; y < h; ++y) {
-                for (size_t x = 0; x < w; ++x) {
-                    std::memcpy(&staging[3 * (y * w + x)], data + (y * row_stride + x) * ps, 3 * sizeof(float));
-                }
-            }
+            core::pack_xyz(cloud, data, staging.data());
             src = staging.data();
         }
         check(

@@ -11,6 +11,7 @@
 
 #include "backends/vulkan/vulkan_buffer.hpp"
 #include "backends/vulkan/vulkan_runtime.hpp"
+#include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_types.h"
 
@@ -94,9 +95,9 @@ public:
         start_frame();
         const auto start = std::chrono::steady_clock::now();
         auto* staging = static_cast<float*>(upload_.mapped());
-        stage(cloud, cloud.points, staging);
+        core::pack_xyz(cloud, cloud.points, staging);
         normals_given_ = cloud.normals != nullptr;
-        if (normals_given_) stage(cloud, cloud.normals, staging + 3 * plan_.pixel_count());
+        if (normals_given_) core::pack_xyz(cloud, cloud.normals, staging + 3 * plan_.pixel_count());
         from_mask_ = false;
         host_upload_ms_ = ms_since(start);
         push({Op::upload_cloud, normals_given_ ? 1u : 0u});
@@ -417,23 +418,6 @@ private:
     }
 
     // --- host side ---
-
-    // Packed clouds are copied straight into staging; strided ones point by point.
-    void stage(const CloudView& cloud, const float* data, float* dst) const {
-        const size_t w = size_t(plan_.width);
-        const size_t h = size_t(plan_.height);
-        const size_t row_stride = cloud.row_stride == 0 ? w : cloud.row_stride;
-        const size_t ps = size_t(cloud.point_stride);
-        if (ps == 3 && row_stride == w) {
-            std::memcpy(dst, data, 3 * w * h * sizeof(float));
-            return;
-        }
-        for (size_t y = 0; y < h; ++y) {
-            for (size_t x = 0; x < w; ++x) {
-                std::memcpy(dst + 3 * (y * w + x), data + (y * row_stride + x) * ps, 3 * sizeof(float));
-            }
-        }
-    }
 
     void create_command_objects() {
         const VkDevice d = rt_->device;

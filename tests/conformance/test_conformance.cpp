@@ -13,6 +13,7 @@
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
 #include "support/oracle.hpp"
 
 namespace pyrseg::test {
@@ -113,6 +114,55 @@ TEST_P(TinyDepths, SubnormalDepthsFollowIeee) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, TinyDepths, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
+// Clouds in the caller's own layout: PCL's PointNormal (x y z pad nx ny nz pad curvature pad pad pad, 12 floats)
+// in rows padded to a larger stride. Every backend must read them exactly as the packed arrays.
+class StridedClouds : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(StridedClouds, MatchTheReferenceLikePackedOnes) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    o.seed = 7;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const std::size_t w = std::size_t(o.width);
+    const std::size_t h = std::size_t(o.height);
+    const std::size_t row_stride = w + 13;  // points per row in memory
+    const int point_stride = 12;            // floats per point
+    std::vector<float> interleaved(h * row_stride * std::size_t(point_stride), -12345.0f);
+    for (std::size_t y = 0; y < h; ++y) {
+        for (std::size_t x = 0; x < w; ++x) {
+            float* p = &interleaved[(y * row_stride + x) * std::size_t(point_stride)];
+            for (std::size_t c = 0; c < 3; ++c) {
+                p[c] = scene.points[3 * (y * w + x) + c];
+                p[4 + c] = scene.normals[3 * (y * w + x) + c];
+            }
+        }
+    }
+    for (const bool given_normals : {false, true}) {
+        const pyrseg_ref::Output ref = pyrseg_ref::segment(
+            scene.points.data(), given_normals ? scene.normals.data() : nullptr, o.width, o.height, to_reference({}));
+        ASSERT_TRUE(ref.ok) << ref.error;
+        Segmenter segmenter(o.width, o.height, {}, GetParam(), everything());
+        CloudView view;
+        view.points = interleaved.data();
+        view.normals = given_normals ? interleaved.data() + 4 : nullptr;
+        view.width = o.width;
+        view.height = o.height;
+        view.row_stride = row_stride;
+        view.point_stride = point_stride;
+        Result result;
+        segmenter.segment(view, result);
+        EXPECT_TRUE(same_bytes("fillable mask", result.fillable_mask, ref.fillable, o.width));
+        EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, o.width, 3));
+        EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width));
+        EXPECT_EQ(result.segment_count, ref.segment_count) << (given_normals ? "given normals" : "estimated normals");
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, StridedClouds, ::testing::ValuesIn(available_backend_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
