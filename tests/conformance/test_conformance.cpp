@@ -192,5 +192,29 @@ INSTANTIATE_TEST_SUITE_P(Backends, RealScans,
                              return std::get<0>(param_info.param) + "_" + file;
                          });
 
+// A real depth image (Kinect-style, integer millimetres) back-projected with its calibration: quantized depth is
+// the input depth cameras give most often.
+class RealDepthImages : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RealDepthImages, MatchesReference) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    const std::filesystem::path data(shared_data_dir());
+    if (!std::filesystem::exists(data / "cape_depth_0.png")) {
+        GTEST_SKIP() << "sample depth image not present: " << (data / "cape_depth_0.png").string();
+    }
+    const io::PointCloud cloud =
+        io::depth_to_cloud(io::read_depth_image(data / "cape_depth_0.png"),
+                           io::read_intrinsics(data / "cape_calib_params.xml", "IR_intrinsic_params"), 1.0);
+    Params params;
+    expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+    params.normal_radius = 4;
+    params.dt = 20.0;
+    params.ct = 0.35;
+    expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RealDepthImages, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
 }  // namespace
 }  // namespace pyrseg::test
