@@ -4,7 +4,10 @@
 #include <cstddef>
 #include <cstring>
 
+#include <cstdint>
+
 #include "pyrseg/cloud.hpp"
+#include "pyrseg/result.hpp"
 
 namespace pyrseg::core {
 
@@ -28,6 +31,48 @@ inline void pack_xyz(const CloudView& cloud, const float* data, float* dst) {
 // Whether pack_xyz would only copy (the backend may then upload straight from the caller's memory).
 inline bool is_packed_xyz(const CloudView& cloud) {
     return cloud.point_stride == 3 && (cloud.row_stride == 0 || cloud.row_stride == std::size_t(cloud.width));
+}
+
+// Where a frame's results lie in a backend's download staging memory (bytes from its start): labels, raw labels,
+// the fillable mask (4 bytes per pixel: one byte used, or one uint32 per texel) and normals.
+struct StagedResults {
+    static constexpr std::size_t labels = 0;
+    static constexpr std::size_t raw_labels = 4;  // times the pixel count, as below
+    static constexpr std::size_t mask = 8;
+    static constexpr std::size_t normals = 12;
+    static constexpr std::size_t bytes_per_pixel = 24;
+};
+
+// Copies the staged results into `out` (the Result's buffers are sized once and reused). mask_as_uint32: the
+// device wrote one uint32 per texel rather than one byte.
+inline void unstage_results(const unsigned char* staged, std::size_t pixels, bool mask_as_uint32,
+                            const Outputs& outputs, bool have_normals, Result& out) {
+    out.labels.resize(pixels);
+    std::memcpy(out.labels.data(), staged + StagedResults::labels * pixels, 4 * pixels);
+    out.raw_labels.clear();
+    if (outputs.raw_labels) {
+        out.raw_labels.resize(pixels);
+        std::memcpy(out.raw_labels.data(), staged + StagedResults::raw_labels * pixels, 4 * pixels);
+    }
+    out.fillable_mask.clear();
+    if (outputs.fillable_mask) {
+        out.fillable_mask.resize(pixels);
+        const unsigned char* mask = staged + StagedResults::mask * pixels;
+        if (mask_as_uint32) {
+            for (std::size_t i = 0; i < pixels; ++i) {
+                std::uint32_t v = 0;
+                std::memcpy(&v, mask + 4 * i, 4);
+                out.fillable_mask[i] = static_cast<std::uint8_t>(v);
+            }
+        } else {
+            std::memcpy(out.fillable_mask.data(), mask, pixels);
+        }
+    }
+    out.normals.clear();
+    if (outputs.normals && have_normals) {
+        out.normals.resize(3 * pixels);
+        std::memcpy(out.normals.data(), staged + StagedResults::normals * pixels, 12 * pixels);
+    }
 }
 
 }  // namespace pyrseg::core

@@ -109,7 +109,7 @@ public:
         flags_ = Memory<false>(4 * kMaxBatch, "cudaMalloc(flags)");
         out_ = Memory<false>(4 * pixels, "cudaMalloc(labels out)");
         staging_in_ = Memory<true>(24 * pixels, "cudaMallocHost(upload staging)");
-        staging_out_ = Memory<true>(24 * pixels, "cudaMallocHost(download staging)");
+        staging_out_ = Memory<true>(core::StagedResults::bytes_per_pixel * pixels, "cudaMallocHost(download staging)");
         host_flags_ = Memory<true>(4 * (kMaxBatch + 1), "cudaMallocHost(flags)");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
         ctx_ =
@@ -259,33 +259,18 @@ public:
         record_event("download");
         const size_t px = plan_.pixel_count();
         const size_t full = plan_.full().offset;
+        using S = core::StagedResults;
         auto* staged = staging_out_.as<unsigned char>();
-        copy_out(staged, out_.as<void>(), 4 * px);
-        if (outputs.raw_labels) copy_out(staged + 4 * px, labels_.as<uint32_t>() + full, 4 * px);
-        if (outputs.fillable_mask) copy_out(staged + 8 * px, mask_.as<unsigned char>() + full, px);
-        if (outputs.normals && !from_mask_) copy_out(staged + 12 * px, normals_.as<void>(), 12 * px);
+        copy_out(staged + S::labels * px, out_.as<void>(), 4 * px);
+        if (outputs.raw_labels) copy_out(staged + S::raw_labels * px, labels_.as<uint32_t>() + full, 4 * px);
+        if (outputs.fillable_mask) copy_out(staged + S::mask * px, mask_.as<unsigned char>() + full, px);
+        if (outputs.normals && !from_mask_) copy_out(staged + S::normals * px, normals_.as<void>(), 12 * px);
         record_event(nullptr);
         check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize(frame)");
         out.width = plan_.width;
         out.height = plan_.height;
         out.segment_count = host_flags_.as<uint32_t>()[kMaxBatch];
-        out.labels.resize(px);
-        std::memcpy(out.labels.data(), staged, 4 * px);
-        out.raw_labels.clear();
-        if (outputs.raw_labels) {
-            out.raw_labels.resize(px);
-            std::memcpy(out.raw_labels.data(), staged + 4 * px, 4 * px);
-        }
-        out.fillable_mask.clear();
-        if (outputs.fillable_mask) {
-            out.fillable_mask.resize(px);
-            std::memcpy(out.fillable_mask.data(), staged + 8 * px, px);
-        }
-        out.normals.clear();
-        if (outputs.normals && !from_mask_) {
-            out.normals.resize(3 * px);
-            std::memcpy(out.normals.data(), staged + 12 * px, 12 * px);
-        }
+        core::unstage_results(staged, px, false, outputs, !from_mask_, out);
     }
 
     // The events' times per pass: each pass runs from its event to the next one.

@@ -73,7 +73,8 @@ public:
         buffers_[kSums] = VulkanBuffer(*rt_, 4 * (VkDeviceSize(scan_chunks()) + 1), M::device, "the scan sums");
         buffers_[kOut] = VulkanBuffer(*rt_, 4 * pixels, M::device, "the labels output");
         upload_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the upload staging buffer");
-        download_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the download staging buffer");
+        download_ =
+            VulkanBuffer(*rt_, core::StagedResults::bytes_per_pixel * pixels, M::host, "the download staging buffer");
         create_command_objects();
         size_flags(kFirstBudget);
         throw_on_validation_messages("the creation of a Vulkan Segmenter");
@@ -151,24 +152,7 @@ public:
         out.width = plan_.width;
         out.height = plan_.height;
         out.segment_count = readback[0];
-        out.labels.resize(pixels);
-        std::memcpy(out.labels.data(), staged, 4 * pixels);
-        out.raw_labels.clear();
-        if (outputs.raw_labels) {
-            out.raw_labels.resize(pixels);
-            std::memcpy(out.raw_labels.data(), staged + 4 * pixels, 4 * pixels);
-        }
-        out.fillable_mask.clear();
-        if (outputs.fillable_mask) {
-            out.fillable_mask.resize(pixels);
-            const auto* mask = reinterpret_cast<const uint32_t*>(staged + 8 * pixels);
-            for (size_t i = 0; i < pixels; ++i) out.fillable_mask[i] = static_cast<std::uint8_t>(mask[i]);
-        }
-        out.normals.clear();
-        if (outputs.normals && !from_mask_) {
-            out.normals.resize(3 * pixels);
-            std::memcpy(out.normals.data(), staged + 12 * pixels, 12 * pixels);
-        }
+        core::unstage_results(staged, pixels, true, outputs, !from_mask_, out);
         host_download_ms_ = ms_since(start);
     }
 
@@ -317,13 +301,14 @@ private:
     // and the fill flags into the small readback buffer.
     void record_download(const Outputs& outputs) {
         timestamp("download");
+        using S = core::StagedResults;
         const VkDeviceSize px = pixels();
         const VkDeviceSize full = plan_.full().offset;
         const VkBuffer staged = download_.get();
-        copy(buffers_[kOut].get(), 0, staged, 0, 4 * px);
-        if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, 4 * px, 4 * px);
-        if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, 8 * px, 4 * px);
-        if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, 12 * px, 12 * px);
+        copy(buffers_[kOut].get(), 0, staged, S::labels * px, 4 * px);
+        if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, S::raw_labels * px, 4 * px);
+        if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, S::mask * px, 4 * px);
+        if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::normals * px, 12 * px);
         copy(buffers_[kSums].get(), 4 * VkDeviceSize(scan_chunks()), readback_.get(), 0, 4);
         copy(buffers_[kFlags].get(), 0, readback_.get(), 4, 4 * VkDeviceSize(kFillsPerFrame) * fill_budget_);
         auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
