@@ -36,11 +36,11 @@ inline bool is_packed_xyz(const CloudView& cloud) {
 // Where a frame's results lie in a backend's download staging memory (bytes from its start): labels, raw labels,
 // the fillable mask (4 bytes per pixel: one byte used, or one uint32 per texel) and normals.
 struct StagedResults {
-    static constexpr std::size_t labels = 0;
-    static constexpr std::size_t raw_labels = 4;  // times the pixel count, as below
-    static constexpr std::size_t mask = 8;
-    static constexpr std::size_t normals = 12;
-    static constexpr std::size_t bytes_per_pixel = 24;
+    static constexpr std::size_t kLabels = 0;
+    static constexpr std::size_t kRawLabels = 4;  // times the pixel count, as below
+    static constexpr std::size_t kMask = 8;
+    static constexpr std::size_t kNormals = 12;
+    static constexpr std::size_t kBytesPerPixel = 24;
 };
 
 // Copies the staged results into `out` (the Result's buffers are sized once and reused). mask_as_uint32: the
@@ -48,16 +48,16 @@ struct StagedResults {
 inline void unstage_results(const unsigned char* staged, std::size_t pixels, bool mask_as_uint32,
                             const Outputs& outputs, bool have_normals, Result& out) {
     out.labels.resize(pixels);
-    std::memcpy(out.labels.data(), staged + StagedResults::labels * pixels, 4 * pixels);
+    std::memcpy(out.labels.data(), staged + StagedResults::kLabels * pixels, 4 * pixels);
     out.raw_labels.clear();
     if (outputs.raw_labels) {
         out.raw_labels.resize(pixels);
-        std::memcpy(out.raw_labels.data(), staged + StagedResults::raw_labels * pixels, 4 * pixels);
+        std::memcpy(out.raw_labels.data(), staged + StagedResults::kRawLabels * pixels, 4 * pixels);
     }
     out.fillable_mask.clear();
     if (outputs.fillable_mask) {
         out.fillable_mask.resize(pixels);
-        const unsigned char* mask = staged + StagedResults::mask * pixels;
+        const unsigned char* mask = staged + StagedResults::kMask * pixels;
         if (mask_as_uint32) {
             for (std::size_t i = 0; i < pixels; ++i) {
                 std::uint32_t v = 0;
@@ -71,7 +71,7 @@ inline void unstage_results(const unsigned char* staged, std::size_t pixels, boo
     out.normals.clear();
     if (outputs.normals && have_normals) {
         out.normals.resize(3 * pixels);
-        std::memcpy(out.normals.data(), staged + StagedResults::normals * pixels, 12 * pixels);
+        std::memcpy(out.normals.data(), staged + StagedResults::kNormals * pixels, 12 * pixels);
     }
 }
 

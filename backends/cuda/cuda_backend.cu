@@ -109,7 +109,7 @@ public:
         flags_ = Memory<false>(4 * kMaxBatch, "cudaMalloc(flags)");
         out_ = Memory<false>(4 * pixels, "cudaMalloc(labels out)");
         staging_in_ = Memory<true>(24 * pixels, "cudaMallocHost(upload staging)");
-        staging_out_ = Memory<true>(core::StagedResults::bytes_per_pixel * pixels, "cudaMallocHost(download staging)");
+        staging_out_ = Memory<true>(core::StagedResults::kBytesPerPixel * pixels, "cudaMallocHost(download staging)");
         host_flags_ = Memory<true>(4 * (kMaxBatch + 1), "cudaMallocHost(flags)");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
         ctx_ =
@@ -261,10 +261,10 @@ public:
         const size_t full = plan_.full().offset;
         using S = core::StagedResults;
         auto* staged = staging_out_.as<unsigned char>();
-        copy_out(staged + S::labels * px, out_.as<void>(), 4 * px);
-        if (outputs.raw_labels) copy_out(staged + S::raw_labels * px, labels_.as<uint32_t>() + full, 4 * px);
-        if (outputs.fillable_mask) copy_out(staged + S::mask * px, mask_.as<unsigned char>() + full, px);
-        if (outputs.normals && !from_mask_) copy_out(staged + S::normals * px, normals_.as<void>(), 12 * px);
+        copy_out(staged + S::kLabels * px, out_.as<void>(), 4 * px);
+        if (outputs.raw_labels) copy_out(staged + S::kRawLabels * px, labels_.as<uint32_t>() + full, 4 * px);
+        if (outputs.fillable_mask) copy_out(staged + S::kMask * px, mask_.as<unsigned char>() + full, px);
+        if (outputs.normals && !from_mask_) copy_out(staged + S::kNormals * px, normals_.as<void>(), 12 * px);
         record_event(nullptr);
         check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize(frame)");
         out.width = plan_.width;

@@ -74,7 +74,7 @@ public:
         buffers_[kOut] = VulkanBuffer(*rt_, 4 * pixels, M::device, "the labels output");
         upload_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the upload staging buffer");
         download_ =
-            VulkanBuffer(*rt_, core::StagedResults::bytes_per_pixel * pixels, M::host, "the download staging buffer");
+            VulkanBuffer(*rt_, core::StagedResults::kBytesPerPixel * pixels, M::host, "the download staging buffer");
         create_command_objects();
         size_flags(kFirstBudget);
         throw_on_validation_messages("the creation of a Vulkan Segmenter");
@@ -305,10 +305,10 @@ private:
         const VkDeviceSize px = pixels();
         const VkDeviceSize full = plan_.full().offset;
         const VkBuffer staged = download_.get();
-        copy(buffers_[kOut].get(), 0, staged, S::labels * px, 4 * px);
-        if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, S::raw_labels * px, 4 * px);
-        if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, S::mask * px, 4 * px);
-        if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::normals * px, 12 * px);
+        copy(buffers_[kOut].get(), 0, staged, S::kLabels * px, 4 * px);
+        if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, S::kRawLabels * px, 4 * px);
+        if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, S::kMask * px, 4 * px);
+        if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::kNormals * px, 12 * px);
         copy(buffers_[kSums].get(), 4 * VkDeviceSize(scan_chunks()), readback_.get(), 0, 4);
         copy(buffers_[kFlags].get(), 0, readback_.get(), 4, 4 * VkDeviceSize(kFillsPerFrame) * fill_budget_);
         auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
