@@ -36,6 +36,9 @@ struct Plan {
     [[nodiscard]] std::size_t pixel_count() const {
         return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     }
+    // Compaction's label table (indexed by raw label, 0..max_label) and its scan's chunks (PYR_SCAN_CHUNK each).
+    [[nodiscard]] std::uint32_t lut_size() const { return max_label + 1; }
+    [[nodiscard]] std::uint32_t scan_chunks() const { return (lut_size() + PYR_SCAN_CHUNK - 1) / PYR_SCAN_CHUNK; }
 };
 
 // Validates everything before anything is allocated. Throws pyrseg::Error.

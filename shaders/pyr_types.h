@@ -45,6 +45,10 @@ struct PyrQuant {
 #define PYR_MASK_FILLABLE 1u
 #define PYR_MASK_ANCHORED 2u
 
+/* Compaction's scan numbers the label table in chunks of this many entries, one invocation per chunk
+ * (shaders/pyr_scan.h; core/plan.hpp sizes the table and the chunk sums once for every backend). */
+#define PYR_SCAN_CHUNK 1024u
+
 /* Label init modes (contract section 5). */
 #define PYR_INIT_NEW 0u         /* steps 1: parent's label, else a new one */
 #define PYR_INIT_INHERIT 1u     /* steps 3 and 5: parent's label, maybe 0 */

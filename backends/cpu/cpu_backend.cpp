@@ -43,7 +43,7 @@ public:
           quant_(plan.pixel_count()),
           mask_(plan.total_texels),
           labels_(plan.total_texels),
-          lut_(size_t(plan.max_label) + 1),
+          lut_(plan.lut_size()),
           parent_(fill_scratch_size(plan)),
           best_(fill_scratch_size(plan)),
           sweeps_(use_sweeps_for_fixed_points()) {}

@@ -7,11 +7,11 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <utility>
 
+#include "core/device_choice.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_cuda.cuh"
@@ -25,7 +25,6 @@ using std::uint32_t;
 constexpr uint32_t kBlock1D = 256;
 constexpr uint32_t kBlock2DX = 32;  // a warp along a row: coalesced loads
 constexpr uint32_t kBlock2DY = 8;
-constexpr uint32_t kScanChunk = 1024;
 constexpr uint32_t kMaxBatch = 64;  // fill rounds between two reads of the convergence flags
 constexpr uint32_t kMaxEvents = 64;
 
@@ -104,8 +103,8 @@ public:
         quant_ = Memory<false>(16 * pixels, "cudaMalloc(quant)");
         mask_ = Memory<false>(texels, "cudaMalloc(mask)");
         labels_ = Memory<false>(4 * texels, "cudaMalloc(labels)");
-        lut_ = Memory<false>(4 * size_t(lut_size()), "cudaMalloc(lut)");
-        sums_ = Memory<false>(4 * (size_t(scan_chunks()) + 1), "cudaMalloc(scan sums)");
+        lut_ = Memory<false>(4 * size_t(plan_.lut_size()), "cudaMalloc(lut)");
+        sums_ = Memory<false>(4 * (size_t(plan_.scan_chunks()) + 1), "cudaMalloc(scan sums)");
         flags_ = Memory<false>(4 * kMaxBatch, "cudaMalloc(flags)");
         out_ = Memory<false>(4 * pixels, "cudaMalloc(labels out)");
         staging_in_ = Memory<true>(24 * pixels, "cudaMallocHost(upload staging)");
@@ -233,18 +232,18 @@ public:
     }
 
     void compact(bool apply) override {
-        const uint32_t count = lut_size();
-        const uint32_t chunks = scan_chunks();
+        const uint32_t count = plan_.lut_size();
+        const uint32_t chunks = plan_.scan_chunks();
         check(cudaMemsetAsync(lut_.as<void>(), 0, 4 * size_t(count), stream_), "cudaMemsetAsync(lut)");
         Launch l = linear(pixels());
         pyr_k_lut_mark<<<l.grid, l.block, 0, stream_>>>(ctx_, pixels(), plan_.full().offset);
         launched("pyr_k_lut_mark");
         l = linear(chunks);
-        pyr_k_scan_count<<<l.grid, l.block, 0, stream_>>>(ctx_, count, kScanChunk, chunks, sums_.as<unsigned>());
+        pyr_k_scan_count<<<l.grid, l.block, 0, stream_>>>(ctx_, count, PYR_SCAN_CHUNK, chunks, sums_.as<unsigned>());
         launched("pyr_k_scan_count");
         pyr_k_scan_sums<<<1, 1, 0, stream_>>>(sums_.as<unsigned>(), chunks);
         launched("pyr_k_scan_sums");
-        pyr_k_scan_number<<<l.grid, l.block, 0, stream_>>>(ctx_, count, kScanChunk, chunks, sums_.as<unsigned>());
+        pyr_k_scan_number<<<l.grid, l.block, 0, stream_>>>(ctx_, count, PYR_SCAN_CHUNK, chunks, sums_.as<unsigned>());
         launched("pyr_k_scan_number");
         l = linear(pixels());
         pyr_k_compact<<<l.grid, l.block, 0, stream_>>>(ctx_, pixels(), plan_.full().offset, apply ? 1u : 0u,
@@ -319,7 +318,7 @@ private:
         size_t free_bytes = 0;
         size_t total_bytes = 0;
         check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
-        const size_t needed = 44 * pixels + 5 * texels + 4 * size_t(lut_size());
+        const size_t needed = 44 * pixels + 5 * texels + 4 * size_t(plan_.lut_size());
         if (needed > free_bytes) {
             throw Error(ErrorCode::out_of_memory,
                         "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image needs " +
@@ -331,8 +330,6 @@ private:
     [[nodiscard]] uint32_t width() const { return uint32_t(plan_.width); }
     [[nodiscard]] uint32_t height() const { return uint32_t(plan_.height); }
     [[nodiscard]] uint32_t pixels() const { return uint32_t(plan_.pixel_count()); }
-    [[nodiscard]] uint32_t lut_size() const { return plan_.max_label + 1; }
-    [[nodiscard]] uint32_t scan_chunks() const { return (lut_size() + kScanChunk - 1) / kScanChunk; }
 
     const core::Plan& plan_;
     int device_;
@@ -387,21 +384,10 @@ std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
     std::string why;
     const std::vector<std::string> devices = describe_devices(&why);
     if (devices.empty()) throw Error(ErrorCode::backend_unavailable, "backend 'cuda' is unavailable: " + why);
-    int device = 0;
-    if (const char* env = std::getenv("PYRSEG_CUDA_DEVICE"); env != nullptr && *env != '\0') {
-        const std::string want(env);
-        device = -1;
-        for (size_t d = 0; d < devices.size() && device < 0; ++d) {
-            if (want == std::to_string(d) || devices[d].find(want) != std::string::npos) device = int(d);
-        }
-        if (device < 0) {
-            std::string list;
-            for (const std::string& d : devices) list += "\n  " + d;
-            throw Error(ErrorCode::backend_unavailable,
-                        "PYRSEG_CUDA_DEVICE='" + want + "' matches no CUDA device; the devices are:" + list);
-        }
-    }
-    return std::make_unique<CudaExecutor>(plan, device);
+    std::vector<std::string> ids;
+    for (size_t d = 0; d < devices.size(); ++d) ids.push_back(std::to_string(d));
+    const auto chosen = core::device_from_environment("PYRSEG_CUDA_DEVICE", "CUDA", ids, devices);
+    return std::make_unique<CudaExecutor>(plan, int(chosen.value_or(0)));
 }
 
 }  // namespace pyrseg::cuda

@@ -18,8 +18,7 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr size_t kScanChunk = 1024;  // LUT entries numbered by one work-item in the compaction scan
-constexpr uint32_t kMaxBatch = 64;   // fill iterations between two reads of the convergence flags
+constexpr uint32_t kMaxBatch = 64;  // fill iterations between two reads of the convergence flags
 
 // The kernels, in one place: their names and the per-dispatch argument count after the shared context.
 enum Kernel : size_t {
@@ -90,8 +89,8 @@ public:
         quant_ = Buffer(rt_->context, 4 * pixels * sizeof(cl_int), "clCreateBuffer(quant)");
         mask_ = Buffer(rt_->context, size_t(plan.total_texels), "clCreateBuffer(mask)");
         labels_ = Buffer(rt_->context, size_t(plan.total_texels) * sizeof(cl_uint), "clCreateBuffer(labels)");
-        lut_ = Buffer(rt_->context, lut_size() * sizeof(cl_uint), "clCreateBuffer(lut)");
-        sums_ = Buffer(rt_->context, (scan_chunks() + 1) * sizeof(cl_uint), "clCreateBuffer(scan sums)");
+        lut_ = Buffer(rt_->context, plan_.lut_size() * sizeof(cl_uint), "clCreateBuffer(lut)");
+        sums_ = Buffer(rt_->context, (plan_.scan_chunks() + 1) * sizeof(cl_uint), "clCreateBuffer(scan sums)");
         flags_ = Buffer(rt_->context, kMaxBatch * sizeof(cl_int), "clCreateBuffer(flags)");
         out_ = Buffer(rt_->context, pixels * sizeof(cl_uint), "clCreateBuffer(labels out)");
         for (size_t k = 0; k < kKernelCount; ++k) {
@@ -212,9 +211,9 @@ public:
     }
 
     void compact(bool apply) override {
-        const cl_uint count = cl_uint(lut_size());
-        const cl_uint chunk = cl_uint(kScanChunk);
-        const cl_uint chunks = cl_uint(scan_chunks());
+        const cl_uint count = cl_uint(plan_.lut_size());
+        const cl_uint chunk = PYR_SCAN_CHUNK;
+        const cl_uint chunks = cl_uint(plan_.scan_chunks());
         const cl_uint pixels = cl_uint(plan_.pixel_count());
         const cl_mem sums = sums_.get();
         run_1d(kLutClear, count, arg(count));
@@ -351,14 +350,11 @@ private:
     // Every pass ends with the queue drained, so that the pipeline's per-pass host timings are the passes' times.
     void finish() { check(clFinish(queue_), "clFinish"); }
 
-    [[nodiscard]] size_t lut_size() const { return size_t(plan_.max_label) + 1; }
-    [[nodiscard]] size_t scan_chunks() const { return (lut_size() + kScanChunk - 1) / kScanChunk; }
-
     void check_fits(size_t pixels) const {
         const size_t largest = std::max(
             {3 * pixels * sizeof(float), 4 * pixels * sizeof(cl_int), size_t(plan_.total_texels) * sizeof(cl_uint)});
         const size_t total = 6 * pixels * sizeof(float) + 4 * pixels * sizeof(cl_int) + pixels * sizeof(cl_uint) +
-                             size_t(plan_.total_texels) * (1 + sizeof(cl_uint)) + lut_size() * sizeof(cl_uint);
+                             size_t(plan_.total_texels) * (1 + sizeof(cl_uint)) + plan_.lut_size() * sizeof(cl_uint);
         const auto mib = [](size_t b) { return std::to_string(b >> 20) + " MiB"; };
         if (largest > rt_->max_alloc || total > rt_->global_mem) {
             throw Error(ErrorCode::out_of_memory,

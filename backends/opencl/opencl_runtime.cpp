@@ -1,10 +1,10 @@
 #include "backends/opencl/opencl_runtime.hpp"
 
-#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <string>
 
+#include "core/device_choice.hpp"
 #include "pyrseg/error.hpp"
 
 extern const char kOpenclKernelSource[];  // shaders/pyr_opencl.cl with its includes, embedded at build time
@@ -145,16 +145,14 @@ DeviceRef choose_device() {
     std::string why;
     const std::vector<DeviceRef> all = enumerate_devices(&why);
     if (all.empty()) throw Error(ErrorCode::backend_unavailable, "backend 'opencl' is unavailable: " + why);
-    if (const char* env = std::getenv("PYRSEG_OPENCL_DEVICE"); env != nullptr && *env != '\0') {
-        const std::string want(env);
-        for (const DeviceRef& d : all) {
-            const std::string index = std::to_string(d.platform_index) + ":" + std::to_string(d.device_index);
-            if (want == index || d.description.find(want) != std::string::npos) return d;
-        }
-        std::string list;
-        for (const DeviceRef& d : all) list += "\n  " + d.description;
-        throw Error(ErrorCode::backend_unavailable,
-                    "PYRSEG_OPENCL_DEVICE='" + want + "' matches no OpenCL device; the devices are:" + list);
+    std::vector<std::string> ids;
+    std::vector<std::string> descriptions;
+    for (const DeviceRef& d : all) {
+        ids.push_back(std::to_string(d.platform_index) + ":" + std::to_string(d.device_index));
+        descriptions.push_back(d.description);
+    }
+    if (const auto chosen = core::device_from_environment("PYRSEG_OPENCL_DEVICE", "OpenCL", ids, descriptions)) {
+        return all[*chosen];
     }
     for (const DeviceRef& d : all) {
         cl_device_type type = 0;

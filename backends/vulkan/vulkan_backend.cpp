@@ -23,7 +23,6 @@ using std::uint32_t;
 
 constexpr uint32_t kGroup1D = 64;        // PYR_GROUP_1D in shaders/pyr_vulkan.comp
 constexpr uint32_t kGroup2D = 8;         // PYR_GROUP_2D
-constexpr uint32_t kScanChunk = 1024;    // LUT entries numbered by one invocation in the compaction scan
 constexpr uint32_t kFillsPerFrame = 2;   // steps 2 and 4 (or the small-image fallback's one)
 constexpr uint32_t kFirstBudget = 8;     // fill rounds recorded per fill until a frame needs more
 constexpr size_t kMaxOps = 128;          // commands of one frame, kept to record it again
@@ -69,8 +68,8 @@ public:
         buffers_[kQuant] = VulkanBuffer(*rt_, 16 * pixels, M::device, "the quantized-normals buffer");
         buffers_[kMask] = VulkanBuffer(*rt_, 4 * texels, M::device, "the mask pyramid");
         buffers_[kLabels] = VulkanBuffer(*rt_, 4 * texels, M::device, "the label pyramid");
-        buffers_[kLut] = VulkanBuffer(*rt_, 4 * VkDeviceSize(lut_size()), M::device, "the compaction table");
-        buffers_[kSums] = VulkanBuffer(*rt_, 4 * (VkDeviceSize(scan_chunks()) + 1), M::device, "the scan sums");
+        buffers_[kLut] = VulkanBuffer(*rt_, 4 * VkDeviceSize(plan_.lut_size()), M::device, "the compaction table");
+        buffers_[kSums] = VulkanBuffer(*rt_, 4 * (VkDeviceSize(plan_.scan_chunks()) + 1), M::device, "the scan sums");
         buffers_[kOut] = VulkanBuffer(*rt_, 4 * pixels, M::device, "the labels output");
         upload_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the upload staging buffer");
         download_ =
@@ -286,14 +285,14 @@ private:
 
     // Step 7: mark the labels present, number the marks by a chunked scan (K lands after the chunk sums), map.
     void record_compact(uint32_t apply) {
-        const uint32_t count = lut_size();
-        const uint32_t chunks = scan_chunks();
+        const uint32_t count = plan_.lut_size();
+        const uint32_t chunks = plan_.scan_chunks();
         vkCmdFillBuffer(commands_, buffers_[kLut].get(), 0, VK_WHOLE_SIZE, 0);
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         dispatch_1d(kLutMark, pixels(), {pixels(), plan_.full().offset});
-        dispatch_1d(kScanCount, chunks, {count, kScanChunk, chunks});
+        dispatch_1d(kScanCount, chunks, {count, PYR_SCAN_CHUNK, chunks});
         dispatch_1d(kScanSums, 1, {chunks});
-        dispatch_1d(kScanNumber, chunks, {count, kScanChunk, chunks});
+        dispatch_1d(kScanNumber, chunks, {count, PYR_SCAN_CHUNK, chunks});
         dispatch_1d(kCompact, pixels(), {pixels(), plan_.full().offset, apply});
     }
 
@@ -309,7 +308,7 @@ private:
         if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, S::kRawLabels * px, 4 * px);
         if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, S::kMask * px, 4 * px);
         if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::kNormals * px, 12 * px);
-        copy(buffers_[kSums].get(), 4 * VkDeviceSize(scan_chunks()), readback_.get(), 0, 4);
+        copy(buffers_[kSums].get(), 4 * VkDeviceSize(plan_.scan_chunks()), readback_.get(), 0, 4);
         copy(buffers_[kFlags].get(), 0, readback_.get(), 4, 4 * VkDeviceSize(kFillsPerFrame) * fill_budget_);
         auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
         to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -475,14 +474,14 @@ private:
         for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
             heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
         const VkDeviceSize total = 92 * VkDeviceSize(plan_.pixel_count()) + 8 * VkDeviceSize(plan_.total_texels) +
-                                   4 * VkDeviceSize(lut_size());
+                                   4 * VkDeviceSize(plan_.lut_size());
         if (total > heap) {
             throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) +
                                                       " of buffers but the largest heap of " + rt_->description +
                                                       " has " + mib(heap));
         }
         const uint64_t groups_1d =
-            (uint64_t(std::max<size_t>(plan_.pixel_count(), lut_size())) + kGroup1D - 1) / kGroup1D;
+            (uint64_t(std::max<size_t>(plan_.pixel_count(), plan_.lut_size())) + kGroup1D - 1) / kGroup1D;
         const uint64_t rows_1d = (groups_1d + max_groups_x_ - 1) / max_groups_x_;
         const uint64_t gx = (uint64_t(plan_.width) + kGroup2D - 1) / kGroup2D;
         const uint64_t gy = (uint64_t(plan_.height) + kGroup2D - 1) / kGroup2D;
@@ -498,8 +497,6 @@ private:
     [[nodiscard]] uint32_t width() const { return uint32_t(plan_.width); }
     [[nodiscard]] uint32_t height() const { return uint32_t(plan_.height); }
     [[nodiscard]] uint32_t pixels() const { return uint32_t(plan_.pixel_count()); }
-    [[nodiscard]] uint32_t lut_size() const { return plan_.max_label + 1; }
-    [[nodiscard]] uint32_t scan_chunks() const { return (lut_size() + kScanChunk - 1) / kScanChunk; }
 
     const core::Plan& plan_;
     std::shared_ptr<Runtime> rt_;

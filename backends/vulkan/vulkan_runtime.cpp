@@ -8,6 +8,7 @@
 #include <string>
 
 #include "backends/vulkan/vulkan_modules.hpp"
+#include "core/device_choice.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::vulkan {
@@ -283,20 +284,20 @@ DeviceRef choose_device() {
     const std::vector<DeviceRef> all = enumerate_devices(&why);
     const bool any_usable = std::any_of(all.begin(), all.end(), [](const DeviceRef& d) { return d.unusable.empty(); });
     if (!any_usable) throw Error(ErrorCode::backend_unavailable, "backend 'vulkan' is unavailable: " + why);
-    if (const char* env = std::getenv("PYRSEG_VULKAN_DEVICE"); env != nullptr && *env != '\0') {
-        const std::string want(env);
-        for (const DeviceRef& d : all) {
-            if (want != std::to_string(d.index) && d.description.find(want) == std::string::npos) continue;
-            if (!d.unusable.empty()) {
-                throw Error(ErrorCode::backend_unavailable,
-                            "PYRSEG_VULKAN_DEVICE='" + want + "' selects " + d.description);
-            }
-            return d;
+    std::vector<std::string> ids;
+    std::vector<std::string> descriptions;
+    for (const DeviceRef& d : all) {
+        ids.push_back(std::to_string(d.index));
+        descriptions.push_back(d.description);
+    }
+    if (const auto chosen = core::device_from_environment("PYRSEG_VULKAN_DEVICE", "Vulkan", ids, descriptions)) {
+        const DeviceRef& d = all[*chosen];
+        if (!d.unusable.empty()) {
+            throw Error(ErrorCode::backend_unavailable, "PYRSEG_VULKAN_DEVICE='" +
+                                                            std::string(std::getenv("PYRSEG_VULKAN_DEVICE")) +
+                                                            "' selects " + d.description);
         }
-        std::string list;
-        for (const DeviceRef& d : all) list += "\n  " + d.description;
-        throw Error(ErrorCode::backend_unavailable,
-                    "PYRSEG_VULKAN_DEVICE='" + want + "' matches no Vulkan device; the devices are:" + list);
+        return d;
     }
     const DeviceRef* best = nullptr;
     for (const DeviceRef& d : all) {
