@@ -33,6 +33,9 @@ public:
     // Step 7: counts the distinct labels of level N (the segment count K, reported by read_back) and, when apply,
     // renumbers them.
     virtual void compact(bool apply) = 0;
+    // Per-segment statistics into plan.stats_slots slots (docs/algorithm.md section 10), after compact; read_back
+    // returns them (core/segment_stats.hpp decodes the words).
+    virtual void segment_stats() = 0;
     // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
 

@@ -64,6 +64,7 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
         if (plan.params.label_edges) clock.run("edges", [&] { ex.label_edges(); });     // step 6 c
     }
     clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7
+    if (plan.stats_slots != 0) clock.run("stats", [&] { ex.segment_stats(); });
 }
 
 }  // namespace pyrseg::core

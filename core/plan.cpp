@@ -1,5 +1,6 @@
 #include "core/plan.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -24,6 +25,16 @@ int ceil_log2(std::uint64_t v) {
     return n;
 }
 
+// The smallest e with 2^-e input units <= 1/16 mm (2^e >= 16 * unit_mm), within float's normal exponents so that
+// 2^e is an exact float. frexp is exact, unlike log2.
+int stats_point_shift(double unit_mm) {
+    int e = 0;
+    const double m = std::frexp(16.0 * unit_mm, &e);  // 16 * unit_mm = m * 2^e, 0.5 <= m < 1
+    if (std::isinf(m)) return 127;
+    const int shift = m == 0.5 ? e - 1 : e;
+    return std::clamp(shift, -126, 127);
+}
+
 }  // namespace
 
 Thresholds compute_thresholds(const Params& params) {
@@ -46,7 +57,7 @@ Thresholds compute_thresholds(const Params& params) {
     return t;
 }
 
-Plan make_plan(int width, int height, const Params& params) {
+Plan make_plan(int width, int height, const Params& params, const Outputs& outputs) {
     if (width < 1 || height < 1) {
         throw Error(ErrorCode::invalid_argument,
                     "image size " + std::to_string(width) + " x " + std::to_string(height) + " is empty");
@@ -109,13 +120,24 @@ Plan make_plan(int width, int height, const Params& params) {
         }
         plan.small_image = true;
         plan.max_label = std::uint32_t(pixels);
-        return plan;
+    } else {
+        plan.bridge_level = m;
+        plan.unjoinable_level = u;
+        plan.old_label_max = std::uint32_t(offsets[std::size_t(u) + 1]);
+        plan.max_label = std::uint32_t(offsets[std::size_t(m) + 1]);  // fits: total_texels does
     }
-    plan.bridge_level = m;
-    plan.unjoinable_level = u;
-    plan.old_label_max = std::uint32_t(offsets[std::size_t(u) + 1]);
-    plan.max_label = std::uint32_t(offsets[std::size_t(m) + 1]);  // fits: total_texels does
+    if (outputs.segment_stats) {
+        // Steps 3 to 6 only copy labels, so every final label lies on a fillable texel of level M and
+        // K <= w_M * h_M; the fallback's labels are pixels.
+        const PyrLevel& lm = plan.small_image ? plan.full() : plan.level(m);
+        plan.stats_slots = lm.width * lm.height;
+        plan.stats_point_shift = stats_point_shift(params.unit_mm);
+    }
     return plan;
+}
+
+float Plan::stats_point_scale() const {
+    return std::ldexp(1.0f, stats_point_shift);
 }
 
 }  // namespace pyrseg::core

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pyrseg/params.hpp"
+#include "pyrseg/result.hpp"
 #include "shaders/pyr_types.h"
 
 namespace pyrseg::core {
@@ -30,6 +31,10 @@ struct Plan {
     std::uint32_t old_label_max = 0;  // offset_{U+1}: labels 1..this are old
     std::uint32_t max_label = 0;      // the largest label any pass can create
     std::uint64_t total_texels = 0;   // offset_{N+1}, the size of the all-levels buffers
+    // Per-segment statistics (Outputs::segment_stats; docs/algorithm.md section 10): slots, 0 when not asked for;
+    // and the fixed point of the point sums, 2^stats_point_shift steps per input unit.
+    std::uint32_t stats_slots = 0;
+    int stats_point_shift = 0;
 
     [[nodiscard]] const PyrLevel& level(int k) const { return levels[static_cast<std::size_t>(k - 1)]; }
     [[nodiscard]] const PyrLevel& full() const { return levels.back(); }
@@ -39,9 +44,16 @@ struct Plan {
     // Compaction's label table (indexed by raw label, 0..max_label) and its scan's chunks (PYR_SCAN_CHUNK each).
     [[nodiscard]] std::uint32_t lut_size() const { return max_label + 1; }
     [[nodiscard]] std::uint32_t scan_chunks() const { return (lut_size() + PYR_SCAN_CHUNK - 1) / PYR_SCAN_CHUNK; }
+    // The statistics pass: its words (PYR_STATS_WORDS per slot), its invocations (runs of PYR_STATS_RUN pixels of
+    // a row) and the float it scales points by (2^stats_point_shift, exact).
+    [[nodiscard]] std::size_t stats_words() const { return std::size_t(stats_slots) * PYR_STATS_WORDS; }
+    [[nodiscard]] std::uint32_t stats_runs_per_row() const {
+        return (std::uint32_t(width) + PYR_STATS_RUN - 1) / PYR_STATS_RUN;
+    }
+    [[nodiscard]] float stats_point_scale() const;
 };
 
 // Validates everything before anything is allocated. Throws pyrseg::Error.
-[[nodiscard]] Plan make_plan(int width, int height, const Params& params);
+[[nodiscard]] Plan make_plan(int width, int height, const Params& params, const Outputs& outputs = {});
 
 }  // namespace pyrseg::core

@@ -71,7 +71,7 @@ void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, R
 
 Segmenter::Segmenter(int width, int height, const Params& params, std::string_view backend, const Outputs& outputs)
     : impl_(std::make_unique<Impl>()) {
-    impl_->plan = core::make_plan(width, height, params);
+    impl_->plan = core::make_plan(width, height, params, outputs);
     impl_->backend = resolve_backend_name(backend);
     impl_->outputs = outputs;
     impl_->executor = core::make_executor(impl_->backend, impl_->plan);

@@ -11,6 +11,7 @@ struct PyrCudaCtx {
     unsigned char* mask;
     unsigned* labels;
     unsigned* lut;
+    unsigned* stats; /* the statistics words, PYR_STATS_WORDS per slot */
     unsigned w;
 };
 
@@ -26,6 +27,8 @@ struct PyrCudaCtx {
 #define PYR_VALID(p) static_cast<unsigned>(pyr_ctx.quant[(p)*4u + 3u])
 #define PYR_LUT(l) pyr_ctx.lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_ctx.lut[l] = (v))
+#define PYR_STATS_ADD(w, v) pyr_cuda_atomic_add(&pyr_ctx.stats[w], (v))
+#define PYR_STATS_MAX(w, v) pyr_cuda_atomic_max(&pyr_ctx.stats[w], (v))
 
 #include "pyr_compact.h"
 #include "pyr_edges.h"
@@ -36,6 +39,7 @@ struct PyrCudaCtx {
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 /* 1D kernels index over blockIdx.y * gridDim.x blocks too: a grid may hold at most 65535 blocks in y, but the
  * host keeps x below 2^31 - 1, so any frame pyrseg accepts fits. */
@@ -168,6 +172,13 @@ __global__ void pyr_k_compact(PyrCudaCtx pyr_ctx, unsigned pixels, unsigned offs
     if (i >= pixels) return;
     const unsigned raw = pyr_ctx.labels[offset + i];
     out[i] = apply != 0u ? pyr_compact_label(PYR_CTX_ARG, raw) : raw;
+}
+
+__global__ void pyr_k_stats(PyrCudaCtx pyr_ctx, PyrLevel full, unsigned runs, unsigned with_points, float point_scale,
+                            unsigned slots) {
+    const unsigned run = pyr_linear_id();
+    if (run >= runs) return;
+    pyr_stats_run(PYR_CTX_ARG, full, run, with_points, point_scale, 0u, slots);
 }
 
 #endif /* PYR_CUDA_CUH */

@@ -15,6 +15,9 @@
 #define PYR_VALID(p) ((uint)pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
+/* The statistics words follow the label table in its buffer (the host passes where they start). */
+#define PYR_STATS_ADD(w, v) atomic_add(&pyr_buf_lut[w], (v))
+#define PYR_STATS_MAX(w, v) atomic_max(&pyr_buf_lut[w], (v))
 
 #include "pyr_compact.h"
 #include "pyr_edges.h"
@@ -25,6 +28,7 @@
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 __kernel void pyr_k_normals(PYR_CTX_PARAM, uint h, uint radius) {
     uint x = (uint)get_global_id(0);
@@ -157,4 +161,11 @@ __kernel void pyr_k_compact(PYR_CTX_PARAM, uint pixels, uint offset, uint apply,
     if (i >= pixels) return;
     uint raw = pyr_buf_labels[offset + i];
     out[i] = apply != 0u ? pyr_compact_label(PYR_CTX_ARG, raw) : raw;
+}
+
+__kernel void pyr_k_stats(PYR_CTX_PARAM, uint h, uint offset, uint runs, uint with_points, float point_scale,
+                          uint base, uint slots) {
+    uint run = (uint)get_global_id(0);
+    if (run >= runs) return;
+    pyr_stats_run(PYR_CTX_ARG, pyr_level(pyr_w, h, offset), run, with_points, point_scale, base, slots);
 }

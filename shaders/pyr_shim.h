@@ -68,6 +68,22 @@
 #define PYR_SQRT(f) sqrtf(f)
 #define PYR_PRECISE
 #define PYR_TYPEDEF(name)
+/* Atomics for accessor macros: shared functions are __host__ __device__, and CUDA's atomics are device-only. */
+#ifdef __CUDA_ARCH__
+#define pyr_cuda_atomic_add(p, v) atomicAdd((p), (v))
+#define pyr_cuda_atomic_max(p, v) atomicMax((p), (v))
+#else
+#include <atomic>
+#define pyr_cuda_atomic_add(p, v) std::atomic_ref<unsigned int>(*(p)).fetch_add((v))
+#define pyr_cuda_atomic_max(p, v) pyr_cuda_host_atomic_max((p), (v))
+static inline unsigned int pyr_cuda_host_atomic_max(unsigned int* p, unsigned int v) {
+    std::atomic_ref<unsigned int> a(*p);
+    unsigned int old = a.load();
+    while (old < v && !a.compare_exchange_weak(old, v)) {
+    }
+    return old;
+}
+#endif
 
 #else /* C++ (CPU backend, host code) */
 #include <bit>

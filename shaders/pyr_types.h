@@ -49,6 +49,24 @@ struct PyrQuant {
  * (shaders/pyr_scan.h; core/plan.hpp sizes the table and the chunk sums once for every backend). */
 #define PYR_SCAN_CHUNK 1024u
 
+/* Per-segment statistics (docs/algorithm.md section 10): one slot of PYR_STATS_WORDS uint32 words per compacted
+ * label, slot K-1 for label K, zeroed before the pass. Bounding-box minima are kept as the maximum of their
+ * complement, so that zero is the neutral start of every word and the pass needs only atomic add and max. Sums
+ * are 64-bit two's complement in two words, low word first. */
+#define PYR_STATS_COUNT 0u
+#define PYR_STATS_NOT_X_MIN 1u
+#define PYR_STATS_NOT_Y_MIN 2u
+#define PYR_STATS_X_MAX 3u
+#define PYR_STATS_Y_MAX 4u
+#define PYR_STATS_RAW_LABEL 5u
+#define PYR_STATS_POINT_SUM 6u   /* x, y, z: 6 words, sums of rint(p * 2^point_shift) */
+#define PYR_STATS_NORMAL_SUM 12u /* x, y, z: 6 words, sums of qn */
+#define PYR_STATS_WORDS 18u
+/* The statistics pass walks rows in runs of this many pixels, one invocation per run. */
+#define PYR_STATS_RUN 32u
+/* Points are clamped to +-(2^31 - 128), the largest float magnitude below 2^31, before rounding to int32. */
+#define PYR_STATS_POINT_LIMIT 2147483520.0f
+
 /* Label init modes (contract section 5). */
 #define PYR_INIT_NEW 0u         /* steps 1: parent's label, else a new one */
 #define PYR_INIT_INHERIT 1u     /* steps 3 and 5: parent's label, maybe 0 */

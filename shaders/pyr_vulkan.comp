@@ -13,7 +13,7 @@ layout(std430, set = 0, binding = 1) buffer PyrNormalsBuf { float pyr_buf_normal
 layout(std430, set = 0, binding = 2) buffer PyrQuantBuf { int pyr_buf_quant[]; };
 layout(std430, set = 0, binding = 3) buffer PyrMaskBuf { uint pyr_buf_mask[]; }; /* one uint per texel */
 layout(std430, set = 0, binding = 4) buffer PyrLabelsBuf { uint pyr_buf_labels[]; };
-layout(std430, set = 0, binding = 5) buffer PyrLutBuf { uint pyr_buf_lut[]; };
+layout(std430, set = 0, binding = 5) buffer PyrLutBuf { uint pyr_buf_lut[]; }; /* then the statistics words */
 layout(std430, set = 0, binding = 6) buffer PyrSumsBuf { uint pyr_buf_sums[]; };   /* compaction scan; K last */
 layout(std430, set = 0, binding = 7) buffer PyrFlagsBuf { uint pyr_buf_flags[]; }; /* fill convergence */
 layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };     /* compacted labels */
@@ -30,6 +30,8 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 #define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
+#define PYR_STATS_ADD(w, v) atomicAdd(pyr_buf_lut[w], (v))
+#define PYR_STATS_MAX(w, v) atomicMax(pyr_buf_lut[w], (v))
 
 #include "pyr_compact.h"
 #include "pyr_edges.h"
@@ -40,6 +42,7 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 #define PYR_GROUP_1D 64u
 #define PYR_GROUP_2D 8u
@@ -233,6 +236,27 @@ void main() {
     if (i >= args.pixels) return;
     uint raw = pyr_buf_labels[args.offset + i];
     pyr_buf_out[i] = args.apply != 0u ? pyr_compact_label(PYR_CTX_ARG, raw) : raw;
+}
+
+#elif defined(PYR_ENTRY_STATS)
+/* The statistics words follow the label table in binding 5, from word args.base. */
+layout(local_size_x = PYR_GROUP_1D) in;
+layout(push_constant) uniform PyrArgs {
+    uint w;
+    uint h;
+    uint offset;
+    uint runs;
+    uint with_points;
+    float point_scale;
+    uint base;
+    uint slots;
+} args;
+void main() {
+    uint pyr_w = args.w;
+    uint run = PYR_LINEAR_ID;
+    if (run >= args.runs) return;
+    pyr_stats_run(PYR_CTX_ARG, pyr_level(pyr_w, args.h, args.offset), run, args.with_points, args.point_scale,
+                  args.base, args.slots);
 }
 
 #else

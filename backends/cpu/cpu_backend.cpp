@@ -13,6 +13,7 @@
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
+#include "core/segment_stats.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::cpu {
@@ -46,6 +47,7 @@ public:
           lut_(plan.lut_size()),
           parent_(fill_scratch_size(plan)),
           best_(fill_scratch_size(plan)),
+          stats_(plan.stats_words()),
           sweeps_(use_sweeps_for_fixed_points()) {}
 
     void bind_cloud(const CloudView& cloud) override {
@@ -190,6 +192,18 @@ public:
         compacted_ = apply;
     }
 
+    // Rows in parallel, each in one run: a row adds each stretch of equal labels to its slot at once.
+    void segment_stats() override {
+        std::fill_n(stats_.begin(), std::min(stats_.size(), size_t(segment_count_) * PYR_STATS_WORDS), 0u);
+        const PassContext c = context();
+        const PyrLevel full = plan_.full();
+        const uint32_t with_points = from_mask_ ? 0u : 1u;
+        const float scale = plan_.stats_point_scale();
+        rows(full.height, [&](size_t y) {
+            kernels::pyr_stats_row_run(c, full, uint32_t(y), 0u, full.width, with_points, scale, 0u, plan_.stats_slots);
+        });
+    }
+
     void read_back(Result& out, const Outputs& outputs) override {
         const size_t pixels = plan_.pixel_count();
         const uint32_t* raw = labels_.data() + plan_.full().offset;
@@ -214,6 +228,9 @@ public:
         } else {
             out.fillable_mask.clear();
         }
+        out.segments.clear();
+        if (plan_.stats_slots != 0)
+            core::decode_segment_stats(stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
         out.normals.clear();
         if (outputs.normals && !from_mask_) {
             out.normals.resize(3 * pixels);
@@ -242,6 +259,7 @@ private:
         c.mask = mask_.data();
         c.labels = labels_.data();
         c.lut = lut_.data();
+        c.stats = stats_.data();
         return c;
     }
 
@@ -304,6 +322,7 @@ private:
     std::vector<uint32_t> lut_;       // raw label -> compacted label
     std::vector<uint32_t> parent_;    // union-find scratch
     std::vector<uint32_t> best_;
+    std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
     bool sweeps_;
     uint32_t segment_count_ = 0;
     bool compacted_ = false;
@@ -323,7 +342,8 @@ size_t memory_needed(const core::Plan& plan) {
     return pixels * (sizeof(QuantPixel) + 3 * sizeof(float)) +  // quantized pixels, estimated normals
            size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
            (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
-           2 * fill_scratch_size(plan) * sizeof(uint32_t);                          // union-find
+           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                         // union-find
+           plan.stats_words() * sizeof(uint32_t);                                   // statistics
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // The shared pass functions (shaders/) compiled as C++ for the CPU backend, with the accessor macros reading
 // the backend's buffers through a PassContext. They live in their own namespace so that another backend's
 // host-compiled copy with other accessors can never collide with them.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 
@@ -23,7 +24,15 @@ struct PassContext {
     std::uint8_t* mask = nullptr;     // all levels
     std::uint32_t* labels = nullptr;  // all levels
     const std::uint32_t* lut = nullptr;
+    std::uint32_t* stats = nullptr;  // the statistics words, PYR_STATS_WORDS per slot
 };
+
+inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
+    std::atomic_ref<std::uint32_t> a(word);
+    std::uint32_t old = a.load(std::memory_order_relaxed);
+    while (old < v && !a.compare_exchange_weak(old, v, std::memory_order_relaxed)) {
+    }
+}
 
 }  // namespace pyrseg::cpu
 
@@ -38,6 +47,8 @@ struct PassContext {
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
 #define PYR_VALID(p) static_cast<std::uint32_t>(ctx.quant[p].valid)
 #define PYR_LUT(l) (ctx.lut[l])
+#define PYR_STATS_ADD(w, v) std::atomic_ref<std::uint32_t>(ctx.stats[w]).fetch_add((v), std::memory_order_relaxed)
+#define PYR_STATS_MAX(w, v) ::pyrseg::cpu::atomic_max(ctx.stats[w], (v))
 
 namespace pyrseg::cpu::kernels {
 #include "shaders/pyr_compact.h"
@@ -48,4 +59,5 @@ namespace pyrseg::cpu::kernels {
 #include "shaders/pyr_mip.h"
 #include "shaders/pyr_normals.h"
 #include "shaders/pyr_quantize.h"
+#include "shaders/pyr_stats.h"
 }  // namespace pyrseg::cpu::kernels

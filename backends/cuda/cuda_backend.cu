@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/device_choice.hpp"
+#include "core/segment_stats.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_cuda.cuh"
@@ -107,13 +108,17 @@ public:
         sums_ = Memory<false>(4 * (size_t(plan_.scan_chunks()) + 1), "cudaMalloc(scan sums)");
         flags_ = Memory<false>(4 * kMaxBatch, "cudaMalloc(flags)");
         out_ = Memory<false>(4 * pixels, "cudaMalloc(labels out)");
+        if (plan_.stats_slots != 0) {
+            stats_ = Memory<false>(4 * plan_.stats_words(), "cudaMalloc(statistics)");
+            host_stats_ = Memory<true>(4 * plan_.stats_words(), "cudaMallocHost(statistics)");
+        }
         staging_in_ = Memory<true>(24 * pixels, "cudaMallocHost(upload staging)");
         staging_out_ = Memory<true>(core::StagedResults::kBytesPerPixel * pixels, "cudaMallocHost(download staging)");
         host_flags_ = Memory<true>(4 * (kMaxBatch + 1), "cudaMallocHost(flags)");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
-        ctx_ =
-            PyrCudaCtx{points_.as<const float>(), normals_.as<float>(), quant_.as<int>(),    mask_.as<unsigned char>(),
-                       labels_.as<unsigned>(),    lut_.as<unsigned>(),  uint32_t(plan.width)};
+        ctx_ = PyrCudaCtx{points_.as<const float>(), normals_.as<float>(),   quant_.as<int>(),
+                          mask_.as<unsigned char>(), labels_.as<unsigned>(), lut_.as<unsigned>(),
+                          stats_.as<unsigned>(),     uint32_t(plan.width)};
     }
 
     ~CudaExecutor() override {
@@ -254,6 +259,16 @@ public:
               "cudaMemcpyAsync(segment count)");
     }
 
+    // K is known on the device only: all slots are cleared, and read_back fetches the K used.
+    void segment_stats() override {
+        check(cudaMemsetAsync(stats_.as<void>(), 0, 4 * plan_.stats_words(), stream_), "cudaMemsetAsync(statistics)");
+        const uint32_t runs = plan_.stats_runs_per_row() * height();
+        const Launch l = linear(runs);
+        pyr_k_stats<<<l.grid, l.block, 0, stream_>>>(ctx_, plan_.full(), runs, from_mask_ ? 0u : 1u,
+                                                     plan_.stats_point_scale(), plan_.stats_slots);
+        launched("pyr_k_stats");
+    }
+
     void read_back(Result& out, const Outputs& outputs) override {
         record_event("download");
         const size_t px = plan_.pixel_count();
@@ -270,6 +285,13 @@ public:
         out.height = plan_.height;
         out.segment_count = host_flags_.as<uint32_t>()[kMaxBatch];
         core::unstage_results(staged, px, false, outputs, !from_mask_, out);
+        out.segments.clear();
+        if (plan_.stats_slots != 0) {
+            const size_t words = std::min(plan_.stats_words(), size_t(out.segment_count) * PYR_STATS_WORDS);
+            copy_out(host_stats_.as<void>(), stats_.as<void>(), 4 * words);
+            check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize(statistics)");
+            core::decode_segment_stats(host_stats_.as<uint32_t>(), out.segment_count, plan_, !from_mask_, out.segments);
+        }
     }
 
     // The events' times per pass: each pass runs from its event to the next one.
@@ -318,7 +340,7 @@ private:
         size_t free_bytes = 0;
         size_t total_bytes = 0;
         check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
-        const size_t needed = 44 * pixels + 5 * texels + 4 * size_t(plan_.lut_size());
+        const size_t needed = 44 * pixels + 5 * texels + 4 * size_t(plan_.lut_size()) + 4 * plan_.stats_words();
         if (needed > free_bytes) {
             throw Error(ErrorCode::out_of_memory,
                         "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image needs " +
@@ -334,8 +356,8 @@ private:
     const core::Plan& plan_;
     int device_;
     cudaStream_t stream_ = nullptr;
-    Memory<false> points_, normals_, quant_, mask_, labels_, lut_, sums_, flags_, out_;
-    Memory<true> staging_in_, staging_out_, host_flags_;
+    Memory<false> points_, normals_, quant_, mask_, labels_, lut_, sums_, flags_, out_, stats_;
+    Memory<true> staging_in_, staging_out_, host_flags_, host_stats_;
     PyrCudaCtx ctx_{};
     std::array<cudaEvent_t, kMaxEvents> events_{};
     std::array<const char*, kMaxEvents> event_names_{};

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "backends/opencl/opencl_runtime.hpp"
+#include "core/segment_stats.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_types.h"
@@ -38,13 +39,14 @@ enum Kernel : size_t {
     kScanSums,
     kScanNumber,
     kCompact,
+    kStats,
     kKernelCount
 };
 constexpr std::array<const char*, kKernelCount> kKernelNames = {
-    "pyr_k_normals",       "pyr_k_quantize",    "pyr_k_metric",      "pyr_k_bind_mask",
-    "pyr_k_mip",           "pyr_k_init_labels", "pyr_k_anchor",      "pyr_k_sweep_rows",
-    "pyr_k_sweep_columns", "pyr_k_edges",       "pyr_k_lut_clear",   "pyr_k_lut_mark",
-    "pyr_k_scan_count",    "pyr_k_scan_sums",   "pyr_k_scan_number", "pyr_k_compact"};
+    "pyr_k_normals",     "pyr_k_quantize", "pyr_k_metric",     "pyr_k_bind_mask",     "pyr_k_mip",
+    "pyr_k_init_labels", "pyr_k_anchor",   "pyr_k_sweep_rows", "pyr_k_sweep_columns", "pyr_k_edges",
+    "pyr_k_lut_clear",   "pyr_k_lut_mark", "pyr_k_scan_count", "pyr_k_scan_sums",     "pyr_k_scan_number",
+    "pyr_k_compact",     "pyr_k_stats"};
 constexpr cl_uint kContextArgs = 7;  // PYR_CTX_PARAM in shaders/pyr_opencl.cl
 
 class Buffer {
@@ -89,7 +91,8 @@ public:
         quant_ = Buffer(rt_->context, 4 * pixels * sizeof(cl_int), "clCreateBuffer(quant)");
         mask_ = Buffer(rt_->context, size_t(plan.total_texels), "clCreateBuffer(mask)");
         labels_ = Buffer(rt_->context, size_t(plan.total_texels) * sizeof(cl_uint), "clCreateBuffer(labels)");
-        lut_ = Buffer(rt_->context, plan_.lut_size() * sizeof(cl_uint), "clCreateBuffer(lut)");
+        // The statistics words, when asked for, follow the label table (shaders/pyr_opencl.cl).
+        lut_ = Buffer(rt_->context, (plan_.lut_size() + plan_.stats_words()) * sizeof(cl_uint), "clCreateBuffer(lut)");
         sums_ = Buffer(rt_->context, (plan_.scan_chunks() + 1) * sizeof(cl_uint), "clCreateBuffer(scan sums)");
         flags_ = Buffer(rt_->context, kMaxBatch * sizeof(cl_int), "clCreateBuffer(flags)");
         out_ = Buffer(rt_->context, pixels * sizeof(cl_uint), "clCreateBuffer(labels out)");
@@ -105,6 +108,7 @@ public:
             check(clSetKernelArg(kernels_[k], 6, sizeof(w), &w), "clSetKernelArg(width)");
         }
         host_flags_.resize(kMaxBatch);
+        host_stats_.resize(plan_.stats_words());
     }
 
     ~OpenclExecutor() override {
@@ -232,6 +236,22 @@ public:
         finish();
     }
 
+    void segment_stats() override {
+        const size_t base = plan_.lut_size();
+        const size_t words = std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
+        const cl_uint zero = 0;
+        if (words != 0) {
+            check(clEnqueueFillBuffer(queue_, lut_.get(), &zero, sizeof(zero), base * sizeof(cl_uint),
+                                      words * sizeof(cl_uint), 0, nullptr, nullptr),
+                  "clEnqueueFillBuffer(statistics)");
+        }
+        const cl_uint runs = plan_.stats_runs_per_row() * cl_uint(plan_.height);
+        run_1d(kStats, runs, arg(cl_uint(plan_.height)), arg(plan_.full().offset), arg(runs),
+               arg(cl_uint(from_mask_ ? 0 : 1)), arg(cl_float(plan_.stats_point_scale())), arg(cl_uint(base)),
+               arg(plan_.stats_slots));
+        finish();
+    }
+
     void read_back(Result& out, const Outputs& outputs) override {
         const size_t pixels = plan_.pixel_count();
         out.width = plan_.width;
@@ -256,6 +276,14 @@ public:
         if (outputs.normals && !from_mask_) {
             out.normals.resize(3 * pixels);
             read(normals_, 0, 3 * pixels * sizeof(float), out.normals.data(), "normals");
+        }
+        out.segments.clear();
+        if (plan_.stats_slots != 0) {
+            const size_t words = std::min(host_stats_.size(), size_t(segment_count_) * PYR_STATS_WORDS);
+            if (words != 0)
+                read(lut_, plan_.lut_size() * sizeof(cl_uint), words * sizeof(cl_uint), host_stats_.data(),
+                     "statistics");
+            core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
         }
     }
 
@@ -351,10 +379,12 @@ private:
     void finish() { check(clFinish(queue_), "clFinish"); }
 
     void check_fits(size_t pixels) const {
-        const size_t largest = std::max(
-            {3 * pixels * sizeof(float), 4 * pixels * sizeof(cl_int), size_t(plan_.total_texels) * sizeof(cl_uint)});
+        const size_t largest = std::max({3 * pixels * sizeof(float), 4 * pixels * sizeof(cl_int),
+                                         size_t(plan_.total_texels) * sizeof(cl_uint),
+                                         (plan_.lut_size() + plan_.stats_words()) * sizeof(cl_uint)});
         const size_t total = 6 * pixels * sizeof(float) + 4 * pixels * sizeof(cl_int) + pixels * sizeof(cl_uint) +
-                             size_t(plan_.total_texels) * (1 + sizeof(cl_uint)) + plan_.lut_size() * sizeof(cl_uint);
+                             size_t(plan_.total_texels) * (1 + sizeof(cl_uint)) +
+                             (plan_.lut_size() + plan_.stats_words()) * sizeof(cl_uint);
         const auto mib = [](size_t b) { return std::to_string(b >> 20) + " MiB"; };
         if (largest > rt_->max_alloc || total > rt_->global_mem) {
             throw Error(ErrorCode::out_of_memory,
@@ -373,6 +403,7 @@ private:
     std::vector<float> host_points_, host_normals_;  // staging for strided clouds
     std::vector<unsigned char> host_mask_;
     std::vector<cl_int> host_flags_;
+    std::vector<cl_uint> host_stats_;
     cl_uint segment_count_ = 0;
     bool normals_given_ = false;
     bool from_mask_ = false;

@@ -11,6 +11,7 @@
 
 #include "backends/vulkan/vulkan_buffer.hpp"
 #include "backends/vulkan/vulkan_runtime.hpp"
+#include "core/segment_stats.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_types.h"
@@ -49,7 +50,8 @@ struct Op {
         fill,
         fill_once,
         edges,
-        compact
+        compact,
+        stats
     } kind = upload_cloud;
     uint32_t a = 0;
     uint32_t b = 0;
@@ -68,12 +70,16 @@ public:
         buffers_[kQuant] = VulkanBuffer(*rt_, 16 * pixels, M::device, "the quantized-normals buffer");
         buffers_[kMask] = VulkanBuffer(*rt_, 4 * texels, M::device, "the mask pyramid");
         buffers_[kLabels] = VulkanBuffer(*rt_, 4 * texels, M::device, "the label pyramid");
-        buffers_[kLut] = VulkanBuffer(*rt_, 4 * VkDeviceSize(plan_.lut_size()), M::device, "the compaction table");
+        buffers_[kLut] = VulkanBuffer(*rt_, 4 * lut_words(), M::device, "the compaction table and statistics");
         buffers_[kSums] = VulkanBuffer(*rt_, 4 * (VkDeviceSize(plan_.scan_chunks()) + 1), M::device, "the scan sums");
         buffers_[kOut] = VulkanBuffer(*rt_, 4 * pixels, M::device, "the labels output");
         upload_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the upload staging buffer");
         download_ =
             VulkanBuffer(*rt_, core::StagedResults::kBytesPerPixel * pixels, M::host, "the download staging buffer");
+        if (plan_.stats_slots != 0) {
+            stats_download_ =
+                VulkanBuffer(*rt_, 4 * VkDeviceSize(plan_.stats_words()), M::host, "the statistics staging buffer");
+        }
         create_command_objects();
         size_flags(kFirstBudget);
         throw_on_validation_messages("the creation of a Vulkan Segmenter");
@@ -131,6 +137,7 @@ public:
     void fill_once(int level) override { push({Op::fill_once, uint32_t(level)}); }
     void label_edges() override { push({Op::edges}); }
     void compact(bool apply) override { push({Op::compact, apply ? 1u : 0u}); }
+    void segment_stats() override { push({Op::stats}); }
 
     // Runs the frame: one submission, unless a fill needed more rounds than were recorded; then the frame is
     // recorded again with twice the rounds (kept for the frames after) and run again.
@@ -152,6 +159,12 @@ public:
         out.height = plan_.height;
         out.segment_count = readback[0];
         core::unstage_results(staged, pixels, true, outputs, !from_mask_, out);
+        out.segments.clear();
+        if (plan_.stats_slots != 0) {
+            download_statistics(out.segment_count);
+            core::decode_segment_stats(static_cast<const uint32_t*>(stats_download_.mapped()), out.segment_count, plan_,
+                                       !from_mask_, out.segments);
+        }
         host_download_ms_ = ms_since(start);
     }
 
@@ -261,6 +274,14 @@ private:
             case Op::compact:
                 record_compact(op.a);
                 break;
+            case Op::stats:
+                vkCmdFillBuffer(commands_, buffers_[kLut].get(), 4 * VkDeviceSize(plan_.lut_size()),
+                                4 * VkDeviceSize(plan_.stats_words()), 0);
+                barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+                dispatch_1d(kStats, stats_runs(),
+                            {height(), plan_.full().offset, stats_runs(), from_mask_ ? 0u : 1u,
+                             std::bit_cast<uint32_t>(plan_.stats_point_scale()), plan_.lut_size(), plan_.stats_slots});
+                break;
         }
     }
 
@@ -287,7 +308,7 @@ private:
     void record_compact(uint32_t apply) {
         const uint32_t count = plan_.lut_size();
         const uint32_t chunks = plan_.scan_chunks();
-        vkCmdFillBuffer(commands_, buffers_[kLut].get(), 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(commands_, buffers_[kLut].get(), 0, 4 * VkDeviceSize(count), 0);
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         dispatch_1d(kLutMark, pixels(), {pixels(), plan_.full().offset});
         dispatch_1d(kScanCount, chunks, {count, PYR_SCAN_CHUNK, chunks});
@@ -310,13 +331,26 @@ private:
         if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::kNormals * px, 12 * px);
         copy(buffers_[kSums].get(), 4 * VkDeviceSize(plan_.scan_chunks()), readback_.get(), 0, 4);
         copy(buffers_[kFlags].get(), 0, readback_.get(), 4, 4 * VkDeviceSize(kFillsPerFrame) * fill_budget_);
-        auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                             nullptr, 0, nullptr);
+        to_host_barrier();
         timestamp(nullptr);  // the end of the last interval
         check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
+    }
+
+    // The K slots the frame used, in a second small submission once K is known (the whole table of slots can be
+    // far larger than what a frame fills).
+    void download_statistics(uint32_t segments) {
+        const VkDeviceSize bytes =
+            4 * VkDeviceSize(std::min<size_t>(plan_.stats_words(), size_t(segments) * PYR_STATS_WORDS));
+        if (bytes == 0) return;
+        check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
+        auto begin = make_info<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
+        copy(buffers_[kLut].get(), 4 * VkDeviceSize(plan_.lut_size()), stats_download_.get(), 0, bytes);
+        to_host_barrier();
+        check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
+        submit_and_wait();
+        throw_on_validation_messages("reading the segment statistics");
     }
 
     void submit_and_wait() {
@@ -376,6 +410,15 @@ private:
     void dispatch_2d(Entry e, uint32_t w, uint32_t h, std::initializer_list<uint32_t> args) {
         if (w == 0 || h == 0) return;
         dispatch(e, (w + kGroup2D - 1) / kGroup2D, (h + kGroup2D - 1) / kGroup2D, args);
+    }
+
+    // Copies made before are visible to the host after the fence.
+    void to_host_barrier() {
+        auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                             nullptr, 0, nullptr);
     }
 
     // Everything written before (at src_stage) is visible to the shaders and copies after.
@@ -458,7 +501,7 @@ private:
         const auto mib = [](VkDeviceSize b) { return std::to_string(b >> 20) + " MiB"; };
         const std::string image = "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image";
         const VkDeviceSize largest =
-            std::max<VkDeviceSize>(16 * VkDeviceSize(plan_.pixel_count()), 4 * VkDeviceSize(plan_.total_texels));
+            std::max({16 * VkDeviceSize(plan_.pixel_count()), 4 * VkDeviceSize(plan_.total_texels), 4 * lut_words()});
         if (largest > lim.maxStorageBufferRange) {
             throw Error(ErrorCode::out_of_memory, image + " needs a storage buffer of " + mib(largest) + " but " +
                                                       rt_->description + " binds at most " +
@@ -474,7 +517,7 @@ private:
         for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
             heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
         const VkDeviceSize total = 92 * VkDeviceSize(plan_.pixel_count()) + 8 * VkDeviceSize(plan_.total_texels) +
-                                   4 * VkDeviceSize(plan_.lut_size());
+                                   4 * lut_words() + 4 * VkDeviceSize(plan_.stats_words());
         if (total > heap) {
             throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) +
                                                       " of buffers but the largest heap of " + rt_->description +
@@ -497,11 +540,14 @@ private:
     [[nodiscard]] uint32_t width() const { return uint32_t(plan_.width); }
     [[nodiscard]] uint32_t height() const { return uint32_t(plan_.height); }
     [[nodiscard]] uint32_t pixels() const { return uint32_t(plan_.pixel_count()); }
+    [[nodiscard]] uint32_t stats_runs() const { return plan_.stats_runs_per_row() * height(); }
+    // The compaction table, then the statistics words when asked for (shaders/pyr_vulkan.comp, binding 5).
+    [[nodiscard]] VkDeviceSize lut_words() const { return VkDeviceSize(plan_.lut_size()) + plan_.stats_words(); }
 
     const core::Plan& plan_;
     std::shared_ptr<Runtime> rt_;
     std::array<VulkanBuffer, kBindingCount> buffers_;
-    VulkanBuffer upload_, download_, readback_;
+    VulkanBuffer upload_, download_, readback_, stats_download_;
     VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
     VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
     VkCommandPool command_pool_ = VK_NULL_HANDLE;

@@ -30,14 +30,15 @@ enum Entry : std::size_t {
     kScanSums,
     kScanNumber,
     kCompact,
+    kStats,
     kEntryCount
 };
 inline constexpr std::array<const char*, kEntryCount> kEntryNames = {
-    "NORMALS",       "QUANTIZE", "METRIC",   "BIND_MASK",  "MIP",       "INIT_LABELS", "ANCHOR", "SWEEP_ROWS",
-    "SWEEP_COLUMNS", "EDGES",    "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT"};
+    "NORMALS",       "QUANTIZE", "METRIC",   "BIND_MASK",  "MIP",       "INIT_LABELS", "ANCHOR",  "SWEEP_ROWS",
+    "SWEEP_COLUMNS", "EDGES",    "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT", "STATS"};
 
 inline constexpr std::uint32_t kBindingCount = 9;        // the storage buffers of shaders/pyr_vulkan.comp
-inline constexpr std::uint32_t kPushConstantBytes = 32;  // the largest PyrArgs block (INIT_LABELS)
+inline constexpr std::uint32_t kPushConstantBytes = 32;  // the largest PyrArgs blocks (INIT_LABELS, STATS)
 
 struct DeviceRef {
     VkPhysicalDevice physical = VK_NULL_HANDLE;

@@ -13,8 +13,8 @@
 namespace pyrseg {
 
 struct PassTiming {
-    // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact", then "upload"
-    // (the frame to the backend) and "download" (the results back).
+    // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact", "stats", then
+    // "upload" (the frame to the backend) and "download" (the results back).
     const char* pass;
     double milliseconds;
 };

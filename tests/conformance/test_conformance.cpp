@@ -24,6 +24,7 @@ Outputs everything() {
     o.raw_labels = true;
     o.fillable_mask = true;
     o.normals = true;
+    o.segment_stats = true;
     return o;
 }
 
@@ -53,6 +54,7 @@ void expect_conformance(const std::string& backend, const float* points, const f
     EXPECT_TRUE(same_bytes("raw labels", result.raw_labels, ref.raw_labels, width));
     EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, width));
     EXPECT_EQ(result.segment_count, ref.segment_count);
+    EXPECT_TRUE(same_segments(result.segments, ref.segments));
 }
 
 class SyntheticScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
@@ -113,6 +115,38 @@ TEST_P(TinyDepths, SubnormalDepthsFollowIeee) {
     expect_conformance(GetParam(), points.data(), normals.data(), w, h, params);
 }
 
+// Points far beyond the statistics' fixed-point range (about +-134 km in millimetres) saturate the same way on every
+// backend, and the 64-bit sums carry across their low words (every coordinate adds close to 2^35).
+class FarPoints : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FarPoints, SaturateInTheStatisticsLikeTheReference) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    const int w = 24;
+    const int h = 20;
+    std::vector<float> points(3 * std::size_t(w) * std::size_t(h));
+    std::vector<float> normals(points.size());
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            float* p = &points[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+            p[0] = float(x - w / 2) * 4e7f;  // saturates from |x - 12| = 4 on (16 * 1.6e8 > 2^31)
+            p[1] = -float(y) * 1e3f;
+            p[2] = 3e9f;
+            float* n = &normals[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+            n[0] = 0.0f;
+            n[1] = 0.6f;
+            n[2] = -0.8f;
+        }
+    }
+    const pyrseg_ref::Output ref = pyrseg_ref::segment(points.data(), normals.data(), w, h, to_reference({}));
+    ASSERT_TRUE(ref.ok);
+    ASSERT_EQ(ref.segments.size(), 1u);
+    ASSERT_EQ(ref.segments[0].point_sum[2], std::int64_t(2147483520) * w * h) << "z must saturate";
+    expect_conformance(GetParam(), points.data(), normals.data(), w, h, {});
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, FarPoints, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
 INSTANTIATE_TEST_SUITE_P(Backends, TinyDepths, ::testing::ValuesIn(available_backend_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
@@ -159,6 +193,7 @@ TEST_P(StridedClouds, MatchTheReferenceLikePackedOnes) {
         EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, o.width, 3));
         EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width));
         EXPECT_EQ(result.segment_count, ref.segment_count) << (given_normals ? "given normals" : "estimated normals");
+        EXPECT_TRUE(same_segments(result.segments, ref.segments));
     }
 }
 

@@ -67,6 +67,7 @@ protected:
         Outputs outputs;
         outputs.raw_labels = true;
         outputs.fillable_mask = true;
+        outputs.segment_stats = true;
         Segmenter segmenter(m.width, m.height, params, GetParam(), outputs);
         MaskView view;
         view.fillable = m.fillable.data();
@@ -81,6 +82,7 @@ protected:
         EXPECT_TRUE(same_bytes("raw labels", r.raw_labels, ref.raw_labels, m.width));
         EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, m.width));
         EXPECT_EQ(r.segment_count, ref.segment_count);
+        EXPECT_TRUE(same_segments(r.segments, ref.segments));
         EXPECT_EQ(r.fillable_mask, m.fillable);
         return r;
     }

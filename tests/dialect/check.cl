@@ -13,6 +13,8 @@
 #define PYR_VALID(p) ((uint)pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
+#define PYR_STATS_ADD(w, v) atomic_add(&pyr_buf_lut[w], v)
+#define PYR_STATS_MAX(w, v) atomic_max(&pyr_buf_lut[w], v)
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -22,6 +24,7 @@
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 __kernel void all_passes(PYR_CTX_PARAM, __global int* out) {
     uint x = (uint)get_global_id(0);
@@ -42,5 +45,7 @@ __kernel void all_passes(PYR_CTX_PARAM, __global int* out) {
     r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
     r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);
     pyr_number_marks(PYR_CTX_ARG, 0u, 64u, r);
+    pyr_stats_row_run(PYR_CTX_ARG, lv, y, 0u, 64u, 1u, 16.0f, 128u, 64u);
+    pyr_stats_run(PYR_CTX_ARG, lv, x, 0u, 16.0f, 128u, 64u);
     out[y * 64u + x] = q.x + qu.qz + (int)r;
 }

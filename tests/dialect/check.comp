@@ -23,6 +23,8 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
+#define PYR_STATS_ADD(w, v) atomicAdd(pyr_buf_lut[w], v)
+#define PYR_STATS_MAX(w, v) atomicMax(pyr_buf_lut[w], v)
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -32,6 +34,7 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 void main() {
     uint x = gl_GlobalInvocationID.x;
@@ -52,5 +55,7 @@ void main() {
     r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
     r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);
     pyr_number_marks(PYR_CTX_ARG, 0u, 64u, r);
+    pyr_stats_row_run(PYR_CTX_ARG, lv, y, 0u, 64u, 1u, 16.0f, 128u, 64u);
+    pyr_stats_run(PYR_CTX_ARG, lv, x, 0u, 16.0f, 128u, 64u);
     outv[y * 64u + x] = q.x + qu.qz + int(r);
 }

@@ -9,16 +9,18 @@ struct Ctx {
 };
 #define PYR_CTX_PARAM const Ctx& ctx
 #define PYR_CTX_ARG ctx
-#define PYR_PT(x, y, c) ctx.pts[((y) * 64u + (x)) * 3u + (c)]
-#define PYR_Q_VALID(i) static_cast<unsigned>(ctx.quant[(i) * 4u + 3u])
-#define PYR_QN(i, c) ctx.quant[(i) * 4u + (c)]
-#define PYR_QZ(i) ctx.pts[(i) * 3u + 2u]
+#define PYR_PT(x, y, c) ctx.pts[((y)*64u + (x)) * 3u + (c)]
+#define PYR_Q_VALID(i) static_cast<unsigned>(ctx.quant[(i)*4u + 3u])
+#define PYR_QN(i, c) ctx.quant[(i)*4u + (c)]
+#define PYR_QZ(i) ctx.pts[(i)*3u + 2u]
 #define PYR_MASK(i) ctx.mask[i]
 #define PYR_LABEL(i) ctx.labels[i]
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
-#define PYR_VALID(p) static_cast<unsigned>(ctx.quant[(p) * 4u + 3u])
+#define PYR_VALID(p) static_cast<unsigned>(ctx.quant[(p)*4u + 3u])
 #define PYR_LUT(l) ctx.lut[l]
 #define PYR_STORE_LUT(l, v) (ctx.lut[l] = (v))
+#define PYR_STATS_ADD(w, v) pyr_cuda_atomic_add(&ctx.lut[w], v)
+#define PYR_STATS_MAX(w, v) pyr_cuda_atomic_max(&ctx.lut[w], v)
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -28,6 +30,7 @@ struct Ctx {
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
 #include "pyr_scan.h"
+#include "pyr_stats.h"
 
 __global__ void all_passes(Ctx ctx, int* out) {
     const unsigned x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -45,5 +48,7 @@ __global__ void all_passes(Ctx ctx, int* out) {
     r += pyr_sweep_row(ctx, lv, y, 0u) + pyr_sweep_column(ctx, lv, x, 1u);
     r += pyr_count_marks(ctx, 0u, 64u);
     pyr_number_marks(ctx, 0u, 64u, r);
+    pyr_stats_row_run(ctx, lv, y, 0u, 64u, 1u, 16.0f, 128u, 64u);
+    pyr_stats_run(ctx, lv, x, 0u, 16.0f, 128u, 64u);
     out[y * 64u + x] = q.x + qu.qz + static_cast<int>(r);
 }

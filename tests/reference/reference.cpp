@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <numbers>
 #include <queue>
 #include <string>
@@ -481,6 +482,52 @@ void finish(std::vector<std::uint32_t> raw, const Params& p, Output& out) {
     out.raw_labels = std::move(raw);
 }
 
+// Section 10. The fixed point's exponent: the smallest e (within -126..127) with 2^e >= 16 * unit_mm.
+int point_shift(double unit_mm) {
+    int e = -126;
+    while (e < 127 && std::ldexp(1.0, e) < 16.0 * unit_mm) ++e;
+    return e;
+}
+
+// Section 10: per segment, in order of raw label (the compacted order), over the labelled pixels. points and
+// normals are null for a mask.
+std::vector<Segment> segment_statistics(const Output& out, const float* points, const float* normals, int width,
+                                        const Params& p) {
+    const int shift = point_shift(p.unit_mm);
+    const float scale = std::ldexp(1.0f, shift);
+    const float limit = 2147483520.0f;  // 2^31 - 128, the largest float below 2^31
+    std::map<std::uint32_t, Segment> by_raw;
+    for (std::size_t i = 0; i < out.raw_labels.size(); ++i) {
+        const std::uint32_t raw = out.raw_labels[i];
+        if (raw == 0) continue;
+        const int x = static_cast<int>(i % static_cast<std::size_t>(width));
+        const int y = static_cast<int>(i / static_cast<std::size_t>(width));
+        auto [it, added] = by_raw.try_emplace(raw);
+        Segment& s = it->second;
+        if (added) {
+            s.label = out.labels[i];
+            s.x_min = s.x_max = x;
+            s.y_min = s.y_max = y;
+            s.point_shift = shift;
+        }
+        ++s.pixel_count;
+        s.x_min = std::min(s.x_min, x);
+        s.x_max = std::max(s.x_max, x);
+        s.y_min = std::min(s.y_min, y);
+        s.y_max = std::max(s.y_max, y);
+        if (points == nullptr) continue;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const float v = std::clamp(points[3 * i + c] * scale, -limit, limit);
+            s.point_sum[c] += static_cast<std::int64_t>(std::nearbyint(v));
+            s.normal_sum[c] += quantize(normals[3 * i + c]);
+        }
+    }
+    std::vector<Segment> segments;
+    segments.reserve(by_raw.size());
+    for (const auto& entry : by_raw) segments.push_back(entry.second);
+    return segments;
+}
+
 Output failure(std::string why) {
     Output out;
     out.ok = false;
@@ -532,6 +579,7 @@ Output segment(const float* points, const float* normals, int width, int height,
     }
     std::vector<std::uint8_t> fillable = metric(points, used.data(), valid, width, height, params);
     Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan);
+    out.segments = segment_statistics(out, points, used.data(), width, params);
     out.normals = std::move(used);
     return out;
 }
@@ -549,7 +597,9 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
         mask[i] = fillable[i] != 0 ? 1 : 0;
         if (valid != nullptr) valid_mask[i] = valid[i] != 0 ? 1 : 0;
     }
-    return label_from_mask(std::move(mask), valid_mask, width, height, params, plan);
+    Output out = label_from_mask(std::move(mask), valid_mask, width, height, params, plan);
+    out.segments = segment_statistics(out, nullptr, nullptr, width, params);
+    return out;
 }
 
 }  // namespace pyrseg_ref

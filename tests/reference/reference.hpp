@@ -20,6 +20,16 @@ struct Params {
     int normal_radius = 1;
 };
 
+// One segment's statistics (docs/algorithm.md section 10), in compacted order: exact integer sums.
+struct Segment {
+    std::uint32_t label = 0;  // as in Output::labels
+    std::uint32_t pixel_count = 0;
+    int x_min = 0, y_min = 0, x_max = 0, y_max = 0;
+    std::int64_t point_sum[3] = {0, 0, 0};   // sum of rint(clamp(p * 2^point_shift)), zero for a mask
+    std::int64_t normal_sum[3] = {0, 0, 0};  // sum of qn, zero for a mask
+    int point_shift = 0;
+};
+
 struct Output {
     bool ok = true;
     std::string error;                      // why, when !ok (bad parameters, sizes, too large for 32-bit labels)
@@ -28,6 +38,7 @@ struct Output {
     std::vector<std::uint8_t> fillable;     // W*H mask B (1/0)
     std::vector<float> normals;             // 3*W*H: the normals the metric used (given ones copied, or estimated)
     std::uint32_t segment_count = 0;        // distinct non-zero labels
+    std::vector<Segment> segments;          // segment_count entries, by increasing raw label
 };
 
 // points: packed xyz float32, 3*W*H, row-major. normals: packed, or nullptr to estimate them (docs section 8).

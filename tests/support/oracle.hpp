@@ -11,6 +11,7 @@
 
 #include "pyrseg/backend.hpp"
 #include "pyrseg/params.hpp"
+#include "pyrseg/result.hpp"
 #include "reference/reference.hpp"
 
 namespace pyrseg::test {
@@ -54,6 +55,38 @@ template <class T>
       << pixel / std::size_t(width) << ") channel " << first % std::size_t(channels) << ": " << +actual[first]
       << " vs reference " << +expected[first];
     return ::testing::AssertionFailure() << s.str();
+}
+
+// The per-segment statistics field by field; on failure, the first differing segment and field.
+inline ::testing::AssertionResult same_segments(const std::vector<SegmentStats>& actual,
+                                                const std::vector<pyrseg_ref::Segment>& expected) {
+    if (actual.size() != expected.size()) {
+        return ::testing::AssertionFailure()
+               << "segment statistics: " << actual.size() << " segments but the reference has " << expected.size();
+    }
+    for (std::size_t k = 0; k < actual.size(); ++k) {
+        const SegmentStats& a = actual[k];
+        const pyrseg_ref::Segment& e = expected[k];
+        const auto differ = [&](const char* field, auto got, auto want) {
+            return ::testing::AssertionFailure() << "segment statistics: segment " << k + 1 << " (label " << e.label
+                                                 << ") " << field << " is " << got << ", reference " << want;
+        };
+        if (a.label != e.label) return differ("label", a.label, e.label);
+        if (a.pixel_count != e.pixel_count) return differ("pixel_count", a.pixel_count, e.pixel_count);
+        if (a.x_min != e.x_min || a.y_min != e.y_min || a.x_max != e.x_max || a.y_max != e.y_max) {
+            std::ostringstream got;
+            std::ostringstream want;
+            got << a.x_min << "," << a.y_min << ".." << a.x_max << "," << a.y_max;
+            want << e.x_min << "," << e.y_min << ".." << e.x_max << "," << e.y_max;
+            return differ("bounding box", got.str(), want.str());
+        }
+        if (a.point_shift != e.point_shift) return differ("point_shift", a.point_shift, e.point_shift);
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (a.point_sum[c] != e.point_sum[c]) return differ("point_sum", a.point_sum[c], e.point_sum[c]);
+            if (a.normal_sum[c] != e.normal_sum[c]) return differ("normal_sum", a.normal_sum[c], e.normal_sum[c]);
+        }
+    }
+    return ::testing::AssertionSuccess();
 }
 
 // Skips the current test, with the backend's own reason, when the backend cannot run here.
