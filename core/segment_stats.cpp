@@ -37,13 +37,13 @@ void decode_segment_stats(const std::uint32_t* words, std::uint32_t count, const
         s.y_max = int(w[PYR_STATS_Y_MAX]);
         s.point_shift = plan.stats_point_shift;
         double length2 = 0;
-        for (int c = 0; c < 3; ++c) {
+        for (std::size_t c = 0; c < 3; ++c) {
             s.point_sum[c] = sum64(w + PYR_STATS_POINT_SUM + 2 * c);
             s.normal_sum[c] = sum64(w + PYR_STATS_NORMAL_SUM + 2 * c);
             length2 += double(s.normal_sum[c]) * double(s.normal_sum[c]);
         }
         const double length = std::sqrt(length2);
-        for (int c = 0; c < 3; ++c) {
+        for (std::size_t c = 0; c < 3; ++c) {
             s.centroid[c] = with_points ? double(s.point_sum[c]) * unit / double(s.pixel_count) : kNaN;
             s.mean_normal[c] = !with_points ? kNaN : length > 0 ? double(s.normal_sum[c]) / length : 0.0;
         }
