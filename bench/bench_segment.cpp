@@ -1,58 +1,87 @@
-// Segmentation speed per backend and pass on synthetic bin-picking scenes, next to a memcpy of the same input
-// bytes measured in the same process (so ratios, not absolute numbers, carry between machines).
-//   pyrseg_bench --benchmark_filter=2064   (full PhoXi frames only)
+// pyrseg per backend: the whole pipeline (points, with estimated or given normals, to compacted labels) and the
+// segmentation stage alone (a fillable mask to compacted labels), at every frame size, next to a memcpy of the
+// same input bytes measured in the same process, so that ratios, not absolute numbers, carry between machines.
+//   pyrseg_bench --benchmark_filter=2064          full PhoXi frames only
+//   pyrseg_bench --benchmark_format=json > b.json && pyrseg_bench_summary b.json   ratio tables and a plot
 #include <benchmark/benchmark.h>
 
 #include <cstring>
 #include <map>
-#include <memory>
 #include <string>
 #include <vector>
 
+#include "bench/bench_scenes.hpp"
 #include "pyrseg/backend.hpp"
-#include "pyrseg/segmenter.hpp"
-#include "pyrseg/synthetic.hpp"
+#include "pyrseg/error.hpp"
 
+namespace pyrseg::bench {
 namespace {
 
-const pyrseg::synthetic::Scene& scene(int width, int height) {
-    static std::map<std::pair<int, int>, std::unique_ptr<pyrseg::synthetic::Scene>> cache;
-    auto& slot = cache[{width, height}];
-    if (!slot) {
-        pyrseg::synthetic::SceneOptions o;
-        o.width = width;
-        o.height = height;
-        slot = std::make_unique<pyrseg::synthetic::Scene>(pyrseg::synthetic::generate(o));
-    }
-    return *slot;
-}
-
-// Total time of a whole frame; counters are milliseconds per frame for each pass, as Segmenter::last_timings()
-// reports them (host times, or the device's timestamps for backends that queue a frame, such as Vulkan).
-void segment(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals) {
-    const pyrseg::synthetic::Scene& s = scene(width, height);
-    pyrseg::Segmenter segmenter(width, height, {}, backend);
-    pyrseg::CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
-    pyrseg::Result result;
-    segmenter.segment(view, result);
-    std::map<std::string, double> pass_ms;
-    for (auto _ : state) {
-        segmenter.segment(view, result);
-        for (const pyrseg::PassTiming& t : segmenter.last_timings()) pass_ms[t.pass] += t.milliseconds;
-        benchmark::DoNotOptimize(result.labels.data());
-    }
+// Per-pass counters (milliseconds per frame, as Segmenter::last_timings() reports them: host times, or the device's
+// timestamps where a backend queues the frame), the segment count and throughput.
+void report(benchmark::State& state, const std::map<std::string, double>& pass_ms, const Result& result,
+            std::size_t input_bytes) {
     for (const auto& [pass, ms] : pass_ms) {
         state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
     }
     state.counters["segments"] = result.segment_count;
     state.counters["Mpix/s"] =
-        benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+        benchmark::Counter(double(result.width) * result.height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(input_bytes));
 }
 
-// The floor: copying the bytes the segmentation reads (points, and normals when given).
-void copy_input(benchmark::State& state, int width, int height, bool given_normals) {
-    const std::size_t bytes = std::size_t(width) * std::size_t(height) * 3 * sizeof(float) * (given_normals ? 2 : 1);
-    std::vector<char> src(bytes, 1), dst(bytes);
+// A backend that cannot take this frame (a device limit) is reported as skipped with its reason.
+template <class Make>
+bool make_segmenter(benchmark::State& state, std::unique_ptr<Segmenter>& out, const Make& make) {
+    try {
+        out = make();
+        return true;
+    } catch (const Error& e) {
+        state.SkipWithError(e.what());
+        return false;
+    }
+}
+
+void pipeline(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals) {
+    const synthetic::Scene& s = scene(width, height);
+    std::unique_ptr<Segmenter> segmenter;
+    if (!make_segmenter(state, segmenter,
+                        [&] { return std::make_unique<Segmenter>(width, height, Params{}, backend); }))
+        return;
+    const CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
+    Result result;
+    segmenter->segment(view, result);
+    std::map<std::string, double> pass_ms;
+    for (auto _ : state) {
+        segmenter->segment(view, result);
+        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
+        benchmark::DoNotOptimize(result.labels.data());
+    }
+    report(state, pass_ms, result, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1));
+}
+
+void stage(benchmark::State& state, const std::string& backend, int width, int height) {
+    const SceneMask& m = scene_mask(width, height);
+    std::unique_ptr<Segmenter> segmenter;
+    if (!make_segmenter(state, segmenter,
+                        [&] { return std::make_unique<Segmenter>(width, height, Params{}, backend); }))
+        return;
+    const MaskView view{m.fillable.data(), m.valid.data(), width, height};
+    Result result;
+    segmenter->segment_mask(view, result);
+    std::map<std::string, double> pass_ms;
+    for (auto _ : state) {
+        segmenter->segment_mask(view, result);
+        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
+        benchmark::DoNotOptimize(result.labels.data());
+    }
+    report(state, pass_ms, result, std::size_t(width) * std::size_t(height));
+}
+
+// The floor: copying the bytes a benchmark reads.
+void copy_bytes(benchmark::State& state, std::size_t bytes) {
+    std::vector<char> src(bytes, 1);
+    std::vector<char> dst(bytes);
     for (auto _ : state) {
         std::memcpy(dst.data(), src.data(), bytes);
         benchmark::DoNotOptimize(dst.data());
@@ -61,33 +90,49 @@ void copy_input(benchmark::State& state, int width, int height, bool given_norma
     state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(bytes));
 }
 
-const int kSizes[][2] = {{640, 480}, {2064, 1544}};
-
 int register_all() {
     for (const auto& size : kSizes) {
         const int w = size[0];
         const int h = size[1];
+        const std::string px = size_name(w, h);
+        const std::size_t pixels = std::size_t(w) * std::size_t(h);
         for (const bool given : {false, true}) {
-            const std::string suffix =
-                std::to_string(w) + "x" + std::to_string(h) + (given ? "/given_normals" : "/estimated_normals");
-            benchmark::RegisterBenchmark(("memcpy_input/" + suffix).c_str(),
-                                         [=](benchmark::State& st) { copy_input(st, w, h, given); })
+            const std::string suffix = px + (given ? "/given_normals" : "/estimated_normals");
+            const std::size_t bytes = pixels * 12 * (given ? 2 : 1);
+            benchmark::RegisterBenchmark(("memcpy/" + suffix).c_str(),
+                                         [=](benchmark::State& st) { copy_bytes(st, bytes); })
                 ->Unit(benchmark::kMillisecond)
                 ->UseRealTime();
-            for (const pyrseg::BackendInfo& b : pyrseg::list_backends()) {
+            for (const BackendInfo& b : list_backends()) {
                 if (!b.available) continue;
-                benchmark::RegisterBenchmark(("segment/" + b.name + "/" + suffix).c_str(),
-                                             [=](benchmark::State& st) { segment(st, b.name, w, h, given); })
+                benchmark::RegisterBenchmark(("pipeline/" + b.name + "/" + suffix).c_str(),
+                                             [=](benchmark::State& st) { pipeline(st, b.name, w, h, given); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
             }
         }
+        benchmark::RegisterBenchmark(("memcpy/" + px + "/mask").c_str(),
+                                     [=](benchmark::State& st) { copy_bytes(st, pixels); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        for (const BackendInfo& b : list_backends()) {
+            if (!b.available) continue;
+            benchmark::RegisterBenchmark(("stage/" + b.name + "/" + px).c_str(),
+                                         [=](benchmark::State& st) { stage(st, b.name, w, h); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+        }
     }
+    for (const BackendInfo& b : list_backends()) {
+        benchmark::AddCustomContext("backend " + b.name, b.available ? "available" : "unavailable: " + b.reason);
+    }
+#ifdef PYRSEG_BENCH_MISSING_PEERS
+    benchmark::AddCustomContext("peers not built", PYRSEG_BENCH_MISSING_PEERS);
+#endif
     return 0;
 }
 
 const int registered = register_all();
 
 }  // namespace
-
-BENCHMARK_MAIN();
+}  // namespace pyrseg::bench

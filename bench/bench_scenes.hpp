@@ -1,0 +1,58 @@
+#pragma once
+// What every benchmark of pyrseg_bench shares: the frame sizes, one synthetic scene per size (generated once), and
+// the fillable mask pyrseg computes for it (the common input of the labelling peers).
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
+
+namespace pyrseg::bench {
+
+// VGA (Kinect, RealSense), SXGA-, a full PhoXi XL frame, and four times that.
+inline constexpr int kSizes[][2] = {{640, 480}, {1280, 960}, {2064, 1544}, {4128, 3088}};
+
+inline std::string size_name(int width, int height) {
+    return std::to_string(width) + "x" + std::to_string(height);
+}
+
+inline const synthetic::Scene& scene(int width, int height) {
+    static std::map<std::pair<int, int>, std::unique_ptr<synthetic::Scene>> cache;
+    auto& slot = cache[{width, height}];
+    if (!slot) {
+        synthetic::SceneOptions o;
+        o.width = width;
+        o.height = height;
+        slot = std::make_unique<synthetic::Scene>(synthetic::generate(o));
+    }
+    return *slot;
+}
+
+// The scene's fillable mask B (0/1 per pixel) and validity, from the CPU backend with the given normals.
+struct SceneMask {
+    std::vector<std::uint8_t> fillable;
+    std::vector<std::uint8_t> valid;
+};
+
+inline const SceneMask& scene_mask(int width, int height) {
+    static std::map<std::pair<int, int>, std::unique_ptr<SceneMask>> cache;
+    auto& slot = cache[{width, height}];
+    if (!slot) {
+        const synthetic::Scene& s = scene(width, height);
+        Outputs o;
+        o.fillable_mask = true;
+        Segmenter segmenter(width, height, {}, "cpu", o);
+        const Result r = segmenter.segment(CloudView{s.points.data(), s.normals.data(), width, height});
+        slot = std::make_unique<SceneMask>();
+        slot->fillable = r.fillable_mask;
+        slot->valid.resize(r.fillable_mask.size());
+        for (std::size_t i = 0; i < slot->valid.size(); ++i) slot->valid[i] = s.object_id[i] != 0 ? 1 : 0;
+    }
+    return *slot;
+}
+
+}  // namespace pyrseg::bench
