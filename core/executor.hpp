@@ -44,6 +44,10 @@ public:
     // A backend whose passes run asynchronously overwrites the host's times in `timings` (same names) with the
     // times its device measured, and returns true. Called after read_back.
     virtual bool device_timings(std::vector<PassTiming>& /*timings*/) { return false; }
+    // Rounds of row and column sweeps the fixed-point fills (steps 2 and 4) of the last frame took, each fill
+    // counted up to and including its first round that changed nothing; 0 for a backend that does not fill by
+    // sweeps (the CPU's union-find). Depends only on the mask, not on the device. Read after read_back.
+    [[nodiscard]] virtual std::uint32_t fill_rounds() const { return 0; }
 };
 
 }  // namespace pyrseg::core

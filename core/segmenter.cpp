@@ -125,5 +125,8 @@ const std::string& Segmenter::backend_name() const noexcept {
 const std::vector<PassTiming>& Segmenter::last_timings() const noexcept {
     return impl_->timings;
 }
+std::uint32_t Segmenter::last_fill_rounds() const {
+    return impl_->executor->fill_rounds();
+}
 
 }  // namespace pyrseg

@@ -50,7 +50,10 @@ public:
           stats_(plan.stats_words()),
           sweeps_(use_sweeps_for_fixed_points()) {}
 
+    [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
+
     void bind_cloud(const CloudView& cloud) override {
+        fill_rounds_ = 0;
         cloud_ = cloud;
         if (cloud_.row_stride == 0) cloud_.row_stride = size_t(cloud_.width);
         normals_estimated_ = false;
@@ -58,6 +61,7 @@ public:
     }
 
     void bind_mask(const MaskView& mask) override {
+        fill_rounds_ = 0;
         from_mask_ = true;
         const size_t w = size_t(plan_.width);
         const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
@@ -151,8 +155,9 @@ public:
             });
         }
         if (sweeps_) {
-            while (sweep(lv, false)) {
-            }
+            do {
+                ++fill_rounds_;
+            } while (sweep(lv, false));
         } else {
             union_find_fill(pool_, lv, mask_.data(), labels_.data(), parent_.data(), best_.data());
         }
@@ -325,6 +330,7 @@ private:
     std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
     bool sweeps_;
     uint32_t segment_count_ = 0;
+    uint32_t fill_rounds_ = 0;
     bool compacted_ = false;
     bool normals_estimated_ = false;
     bool from_mask_ = false;

@@ -133,7 +133,10 @@ public:
     CudaExecutor(const CudaExecutor&) = delete;
     CudaExecutor& operator=(const CudaExecutor&) = delete;
 
+    [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
+
     void bind_cloud(const CloudView& cloud) override {
+        fill_rounds_ = 0;
         select();
         event_count_ = 0;
         record_event("upload");
@@ -149,6 +152,7 @@ public:
     }
 
     void bind_mask(const MaskView& mask) override {
+        fill_rounds_ = 0;
         select();
         event_count_ = 0;
         record_event("upload");
@@ -224,7 +228,12 @@ public:
             check(cudaMemcpyAsync(flags, flags_.as<void>(), 4 * size_t(batch), cudaMemcpyDeviceToHost, stream_),
                   "cudaMemcpyAsync(flags)");
             check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize(fill)");
-            if (std::find(flags, flags + batch, 0u) != flags + batch) break;
+            const uint32_t* unchanged = std::find(flags, flags + batch, 0u);
+            if (unchanged != flags + batch) {
+                fill_rounds_ += uint32_t(unchanged - flags) + 1;
+                break;
+            }
+            fill_rounds_ += batch;
         }
     }
 
@@ -363,6 +372,7 @@ private:
     std::array<const char*, kMaxEvents> event_names_{};
     uint32_t event_count_ = 0;
     bool from_mask_ = false;
+    uint32_t fill_rounds_ = 0;
 };
 
 std::string describe(int index, const cudaDeviceProp& p) {

@@ -118,7 +118,10 @@ public:
         if (queue_ != nullptr) clReleaseCommandQueue(queue_);
     }
 
+    [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
+
     void bind_cloud(const CloudView& cloud) override {
+        fill_rounds_ = 0;
         upload(cloud, cloud.points, points_, host_points_);
         normals_given_ = cloud.normals != nullptr;
         if (normals_given_) upload(cloud, cloud.normals, normals_, host_normals_);
@@ -126,6 +129,7 @@ public:
     }
 
     void bind_mask(const MaskView& mask) override {
+        fill_rounds_ = 0;
         const size_t w = size_t(plan_.width);
         const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
         if (host_mask_.empty()) {
@@ -199,7 +203,12 @@ public:
             check(clEnqueueReadBuffer(queue_, flags_.get(), CL_TRUE, 0, batch * sizeof(cl_int), host_flags_.data(), 0,
                                       nullptr, nullptr),
                   "clEnqueueReadBuffer(flags)");
-            if (std::find(host_flags_.begin(), host_flags_.begin() + batch, 0) != host_flags_.begin() + batch) break;
+            const auto unchanged = std::find(host_flags_.begin(), host_flags_.begin() + batch, 0);
+            if (unchanged != host_flags_.begin() + batch) {
+                fill_rounds_ += uint32_t(unchanged - host_flags_.begin()) + 1;
+                break;
+            }
+            fill_rounds_ += batch;
         }
         finish();
     }
@@ -405,6 +414,7 @@ private:
     std::vector<cl_int> host_flags_;
     std::vector<cl_uint> host_stats_;
     cl_uint segment_count_ = 0;
+    uint32_t fill_rounds_ = 0;
     bool normals_given_ = false;
     bool from_mask_ = false;
 };

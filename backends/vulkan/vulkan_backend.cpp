@@ -367,6 +367,16 @@ private:
         in_flight_ = false;
     }
 
+    [[nodiscard]] uint32_t fill_rounds() const override {
+        const auto* flags = static_cast<const uint32_t*>(readback_.mapped()) + 1;
+        uint32_t rounds = 0;
+        for (uint32_t f = 0; f < fills_in_frame_; ++f) {
+            const uint32_t* begin = flags + size_t(f) * fill_budget_;
+            rounds += uint32_t(std::find(begin, begin + fill_budget_, 0u) - begin) + 1;
+        }
+        return rounds;
+    }
+
     // A fill converged when one of its rounds changed nothing.
     [[nodiscard]] bool fills_converged() const {
         const auto* flags = static_cast<const uint32_t*>(readback_.mapped()) + 1;

@@ -43,6 +43,9 @@ public:
     [[nodiscard]] const std::string& backend_name() const noexcept;
     // Host wall time of each pass of the last frame, in pass order (accumulated per pass name).
     [[nodiscard]] const std::vector<PassTiming>& last_timings() const noexcept;
+    // Rounds of row and column sweeps the fixed-point fills of the last frame took (the worst case of a GPU
+    // backend: a long winding region needs many); 0 where the backend fills another way (the CPU's union-find).
+    [[nodiscard]] std::uint32_t last_fill_rounds() const;
 
     struct Impl;
 

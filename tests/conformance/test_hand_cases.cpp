@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
@@ -76,6 +77,7 @@ protected:
         view.height = m.height;
         Result r;
         segmenter.segment_mask(view, r);
+        fill_rounds_ = segmenter.last_fill_rounds();
         const pyrseg_ref::Output ref =
             pyrseg_ref::segment_mask(m.fillable.data(), m.valid.data(), m.width, m.height, to_reference(params));
         EXPECT_TRUE(ref.ok) << ref.error;
@@ -86,6 +88,8 @@ protected:
         EXPECT_EQ(r.fillable_mask, m.fillable);
         return r;
     }
+
+    std::uint32_t fill_rounds_ = 0;  // of the last run
 };
 
 // Two large regions joined by a 1-pixel and a 2-pixel bridge: plain labelling merges them, the pyramid does not.
@@ -257,6 +261,25 @@ TEST_P(HandCases, AFillNeedingManyRoundsReachesTheFixedPoint) {
     params.bridge_levels = 1;  // new labels on level N - 1, where the corridor is 2 texels wide
     const Result first = run(m, params);
     EXPECT_EQ(first.labels[m.at(0, 0)], first.labels[m.at(500, 500)]) << "the corridor is one segment";
+    // Sweeping backends report the same round count, which depends only on the mask: the CPU's sweep scheme
+    // (PYRSEG_CPU_FILL=sweeps) gives it; its union-find reports 0.
+    const char* cpu_fill = std::getenv("PYRSEG_CPU_FILL");
+    if (GetParam() == "cpu" && (cpu_fill == nullptr || std::string(cpu_fill) != "sweeps")) {
+        EXPECT_EQ(fill_rounds_, 0u);
+        return;
+    }
+    EXPECT_GE(fill_rounds_, 63u) << "a round crosses one step of the staircase";
+    const std::uint32_t rounds = fill_rounds_;
+    ::setenv("PYRSEG_CPU_FILL", "sweeps", 1);
+    Segmenter cpu_sweeps(m.width, m.height, params, "cpu");
+    if (cpu_fill == nullptr) {
+        ::unsetenv("PYRSEG_CPU_FILL");
+    } else {
+        ::setenv("PYRSEG_CPU_FILL", cpu_fill, 1);
+    }
+    Result r;
+    cpu_sweeps.segment_mask(MaskView{m.fillable.data(), m.valid.data(), m.width, m.height}, r);
+    EXPECT_EQ(rounds, cpu_sweeps.last_fill_rounds());
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, HandCases, ::testing::ValuesIn(available_backend_names()),
