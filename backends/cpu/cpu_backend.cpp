@@ -22,7 +22,7 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr size_t kColumnBlock = 64;  // columns swept together, row by row, so column sweeps stay cache-friendly
+constexpr size_t kColumnBlock = 64;  // the narrowest strip of columns swept together, row by row
 
 // The largest level a fixed-point fill runs on: N-1, or N itself for the tiny-image fallback.
 size_t fill_scratch_size(const core::Plan& plan) {
@@ -42,6 +42,7 @@ public:
     explicit CpuExecutor(const core::Plan& plan)
         : plan_(plan),
           quant_(plan.pixel_count()),
+          mask_valid_(plan.pixel_count()),
           mask_(plan.total_texels),
           labels_(plan.total_texels),
           lut_(plan.lut_size()),
@@ -66,11 +67,19 @@ public:
         const size_t w = size_t(plan_.width);
         const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
         std::uint8_t* full = mask_.data() + plan_.full().offset;
+        std::uint8_t* valid = mask_valid_.data();
         rows(size_t(plan_.height), [&](size_t y) {
-            for (size_t x = 0; x < w; ++x) {
-                full[y * w + x] = mask.fillable[y * stride + x] != 0 ? 1 : 0;
-                quant_[y * w + x].valid = (mask.valid == nullptr || mask.valid[y * stride + x] != 0) ? 1 : 0;
+            // Local row pointers: byte stores may alias anything, so members would be reloaded per pixel.
+            const std::uint8_t* in = mask.fillable + y * stride;
+            std::uint8_t* out = full + y * w;
+            for (size_t x = 0; x < w; ++x) out[x] = in[x] != 0 ? 1 : 0;
+            std::uint8_t* out_valid = valid + y * w;
+            if (mask.valid == nullptr) {
+                std::memset(out_valid, 1, w);
+                return;
             }
+            const std::uint8_t* in_valid = mask.valid + y * stride;
+            for (size_t x = 0; x < w; ++x) out_valid[x] = in_valid[x] != 0 ? 1 : 0;
         });
     }
 
@@ -137,14 +146,16 @@ public:
         const PassContext c = context();
         const PyrLevel lv = plan_.level(level);
         const PyrLevel parent = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
-        rows(lv.height, [&](size_t y) {
-            uint32_t* out = labels_.data() + lv.offset + y * lv.width;
-            for (uint32_t x = 0; x < lv.width; ++x)
-                out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, uint32_t(y), mode);
-        });
+        // Step 5 is done row by row inside step 6a's row sweeps (fill_once), while each row is in cache.
+        if (level == plan_.level_count && mode == PYR_INIT_INHERIT) {
+            pending_init_ = level;
+            return;
+        }
+        rows(lv.height, [&](size_t y) { init_row(c, lv, parent, uint32_t(y), mode); });
     }
 
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
+        run_pending_init();
         const PyrLevel lv = plan_.level(level);
         if (anchor_max != 0) {
             rows(lv.height, [&](size_t y) {
@@ -163,11 +174,18 @@ public:
         }
     }
 
-    void fill_once(int level) override { sweep(plan_.level(level), true); }
+    void fill_once(int level) override {
+        const bool fused = pending_init_ == level;
+        run_pending_init(level);
+        sweep(plan_.level(level), true, fused);
+    }
 
+    // Step 6c, and compaction's marking of each row once its labels are final (one pass over the image fewer).
     void label_edges() override {
+        run_pending_init();
         const PassContext c = context();
         const PyrLevel full = plan_.full();
+        std::fill(lut_.begin(), lut_.end(), 0u);
         rows(full.height, [&](size_t y) {
             for (uint32_t x = 0; x < full.width; ++x) {
                 const uint32_t i = full.offset + uint32_t(y) * full.width + x;
@@ -176,19 +194,18 @@ public:
                 const uint32_t l = kernels::pyr_edge_label(c, full, x, uint32_t(y));
                 if (l != labels_[i]) labels_[i] = l;
             }
+            mark_row(y);
         });
+        marked_ = true;
     }
 
     void compact(bool apply) override {
-        std::fill(lut_.begin(), lut_.end(), 0u);
-        const uint32_t* full = labels_.data() + plan_.full().offset;
-        const size_t w = size_t(plan_.width);
-        rows(size_t(plan_.height), [&](size_t y) {
-            for (size_t x = 0; x < w; ++x) {
-                const uint32_t l = full[y * w + x];
-                if (l != 0) std::atomic_ref<uint32_t>(lut_[l]).store(1u, std::memory_order_relaxed);
-            }
-        });
+        run_pending_init();
+        if (!marked_) {
+            std::fill(lut_.begin(), lut_.end(), 0u);
+            rows(size_t(plan_.height), [&](size_t y) { mark_row(y); });
+        }
+        marked_ = false;
         uint32_t count = 0;
         for (uint32_t& entry : lut_) {
             if (entry != 0) entry = ++count;
@@ -219,8 +236,15 @@ public:
         const PassContext c = context();
         rows(size_t(plan_.height), [&](size_t y) {
             const size_t w = size_t(plan_.width);
-            for (size_t i = y * w; i < (y + 1) * w; ++i)
-                out.labels[i] = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
+            uint32_t previous_raw = 0;  // labels come in runs: a run is looked up once
+            uint32_t previous = 0;
+            for (size_t i = y * w; i < (y + 1) * w; ++i) {
+                if (raw[i] != previous_raw) {
+                    previous_raw = raw[i];
+                    previous = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
+                }
+                out.labels[i] = previous;
+            }
         });
         if (outputs.raw_labels) {
             out.raw_labels.assign(raw, raw + pixels);
@@ -255,12 +279,42 @@ private:
         });
     }
 
+    // Marks the labels of row y of the full level in the compaction table (concurrent rows write the same value).
+    void mark_row(size_t y) {
+        const size_t w = size_t(plan_.width);
+        const uint32_t* row = labels_.data() + plan_.full().offset + y * w;
+        uint32_t previous = 0;  // labels come in runs: a run is marked once
+        for (size_t x = 0; x < w; ++x) {
+            const uint32_t l = row[x];
+            if (l != 0 && l != previous) std::atomic_ref<uint32_t>(lut_[l]).store(1u, std::memory_order_relaxed);
+            previous = l;
+        }
+    }
+
+    void init_row(const PassContext& c, const PyrLevel& lv, const PyrLevel& parent, uint32_t y, uint32_t mode) {
+        uint32_t* out = labels_.data() + lv.offset + y * lv.width;
+        for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, y, mode);
+    }
+
+    // A deferred step-5 init that is not fused into the next fill_once runs on its own (`fused_level` is the level
+    // whose fill_once does it instead).
+    void run_pending_init(int fused_level = 0) {
+        const int level = pending_init_;
+        pending_init_ = 0;
+        if (level == 0 || level == fused_level) return;
+        const PassContext c = context();
+        const PyrLevel lv = plan_.level(level);
+        const PyrLevel parent = plan_.level(level - 1);
+        rows(lv.height, [&](size_t y) { init_row(c, lv, parent, uint32_t(y), PYR_INIT_INHERIT); });
+    }
+
     [[nodiscard]] PassContext context() {
         PassContext c;
         c.points = cloud_.points;
         c.row_stride = cloud_.row_stride;
         c.point_stride = size_t(cloud_.point_stride);
         c.quant = quant_.data();
+        c.mask_valid = from_mask_ ? mask_valid_.data() : nullptr;
         c.mask = mask_.data();
         c.labels = labels_.data();
         c.lut = lut_.data();
@@ -278,17 +332,23 @@ private:
 
     // One round of the four directional sweeps (rows left-right then right-left, then columns top-down then
     // bottom-up). Rows are independent, and so are columns: each runs in parallel. Returns whether a label changed.
-    bool sweep(const PyrLevel& lv, bool once) {
+    // init_rows_first: run step 5's label init of each row just before its sweep (the row is then in cache).
+    bool sweep(const PyrLevel& lv, bool once, bool init_rows_first = false) {
         const PassContext c = context();
         const uint32_t onceu = once ? 1u : 0u;
         std::atomic<bool> changed{false};
+        const PyrLevel parent = plan_.level(std::max(1, plan_.level_count - 1));
         rows(lv.height, [&](size_t y) {
+            if (init_rows_first) init_row(c, lv, parent, uint32_t(y), PYR_INIT_INHERIT);
             if (kernels::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u) changed.store(true, std::memory_order_relaxed);
         });
-        const size_t blocks = (size_t(lv.width) + kColumnBlock - 1) / kColumnBlock;
+        // Columns in a few wide strips, one per task: each row of a strip is a long contiguous run.
+        const size_t strips = size_t(pool_.size()) * 2;
+        const size_t strip = std::max(kColumnBlock, (size_t(lv.width) + strips - 1) / strips);
+        const size_t blocks = (size_t(lv.width) + strip - 1) / strip;
         pool_.parallel_for(blocks, 1, [&](size_t b0, size_t b1) {
-            const uint32_t x0 = uint32_t(b0 * kColumnBlock);
-            const uint32_t x1 = uint32_t(std::min(size_t(lv.width), b1 * kColumnBlock));
+            const uint32_t x0 = uint32_t(b0 * strip);
+            const uint32_t x1 = uint32_t(std::min(size_t(lv.width), b1 * strip));
             bool ch = false;
             // Row by row, each column's sequential order is kept: row y reads row y -/+ 1 already updated.
             for (uint32_t y = 1; y < lv.height; ++y) ch |= column_step(c, lv, y, y - 1, x0, x1, once);
@@ -322,15 +382,19 @@ private:
     CloudView cloud_{};
     std::vector<float> normals_;  // estimated, packed
     std::vector<QuantPixel> quant_;
-    std::vector<std::uint8_t> mask_;  // all levels
-    std::vector<uint32_t> labels_;    // all levels
-    std::vector<uint32_t> lut_;       // raw label -> compacted label
-    std::vector<uint32_t> parent_;    // union-find scratch
+    std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
+    std::vector<std::uint8_t> mask_;        // all levels
+    std::vector<uint32_t> labels_;          // all levels
+    std::vector<uint32_t> lut_;             // raw label -> compacted label
+    std::vector<uint32_t> parent_;          // union-find scratch
     std::vector<uint32_t> best_;
     std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
     bool sweeps_;
     uint32_t segment_count_ = 0;
     uint32_t fill_rounds_ = 0;
+    int pending_init_ = 0;
+    bool marked_ = false;  // label_edges marked the compaction table already  // a level whose step-5 init waits for
+                           // its fill_once (0: none)
     bool compacted_ = false;
     bool normals_estimated_ = false;
     bool from_mask_ = false;
@@ -345,7 +409,7 @@ size_t physical_memory_bytes() {
 // Bytes a CpuExecutor allocates (estimated normals counted: they are allocated on the first frame without normals).
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
-    return pixels * (sizeof(QuantPixel) + 3 * sizeof(float)) +  // quantized pixels, estimated normals
+    return pixels * (sizeof(QuantPixel) + 1 + 3 * sizeof(float)) +  // quantized pixels, mask validity, normals
            size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
            (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
            2 * fill_scratch_size(plan) * sizeof(uint32_t) +                         // union-find

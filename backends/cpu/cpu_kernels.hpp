@@ -21,8 +21,9 @@ struct PassContext {
     std::size_t row_stride = 0;     // in points
     std::size_t point_stride = 3;   // in floats
     const QuantPixel* quant = nullptr;
-    std::uint8_t* mask = nullptr;     // all levels
-    std::uint32_t* labels = nullptr;  // all levels
+    const std::uint8_t* mask_valid = nullptr;  // a caller's mask's validity, else null (validity is in quant)
+    std::uint8_t* mask = nullptr;              // all levels
+    std::uint32_t* labels = nullptr;           // all levels
     const std::uint32_t* lut = nullptr;
     std::uint32_t* stats = nullptr;  // the statistics words, PYR_STATS_WORDS per slot
 };
@@ -45,7 +46,7 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
-#define PYR_VALID(p) static_cast<std::uint32_t>(ctx.quant[p].valid)
+#define PYR_VALID(p) static_cast<std::uint32_t>(ctx.mask_valid != nullptr ? ctx.mask_valid[p] : ctx.quant[p].valid)
 #define PYR_LUT(l) (ctx.lut[l])
 #define PYR_STATS_ADD(w, v) std::atomic_ref<std::uint32_t>(ctx.stats[w]).fetch_add((v), std::memory_order_relaxed)
 #define PYR_STATS_MAX(w, v) ::pyrseg::cpu::atomic_max(ctx.stats[w], (v))
