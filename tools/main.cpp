@@ -22,6 +22,8 @@ constexpr const char* kUsage =
     "                      of them, and write labels / pictures\n"
     "  demo                segment a built-in synthetic bin-picking scene (and the shared sample scans when\n"
     "                      present) with every available backend, check they agree, write figures, time them\n"
+    "  eval                measure segmentation quality against ground truth on synthetic scenes: pyramid vs\n"
+    "                      plain connected components, across noise levels and bridge widths\n"
     "  backends            list the backends and devices, and why any is unavailable\n"
     "  --version           print the version\n"
     "\n"
@@ -46,6 +48,7 @@ int main(int argc, char** argv) {
         if (all[0] == "segment") return pyrseg::cli::cmd_segment(rest);
         if (all[0] == "demo") return pyrseg::cli::cmd_demo(rest);
         if (all[0] == "backends") return pyrseg::cli::cmd_backends(rest);
+        if (all[0] == "eval") return pyrseg::cli::cmd_eval(rest);
         std::fprintf(stderr, "pyrseg: unknown command '%s'\n\n%s", all[0].c_str(), kUsage);
         return 2;
     } catch (const pyrseg::cli::UsageError& e) {
