@@ -15,6 +15,7 @@ int cmd_segment(const std::vector<std::string>& args);
 int cmd_backends(const std::vector<std::string>& args);
 int cmd_demo(const std::vector<std::string>& args);
 int cmd_eval(const std::vector<std::string>& args);
+int cmd_bench_report(const std::vector<std::string>& args);
 
 // Parameters shared by the commands that segment: --ct --dt --unit-mm --bridge-levels --unjoinable-gap
 // --normal-radius --no-label-edges --raw.

@@ -24,6 +24,8 @@ constexpr const char* kUsage =
     "                      present) with every available backend, check they agree, write figures, time them\n"
     "  eval                measure segmentation quality against ground truth on synthetic scenes: pyramid vs\n"
     "                      plain connected components, across noise levels and bridge widths\n"
+    "  bench-report JSON   turn pyrseg_bench's JSON into a markdown report of ratios against memcpy and the peers\n"
+    "                      (OpenCV, PCL), with plots (scripts/bench.sh runs both)\n"
     "  backends            list the backends and devices, and why any is unavailable\n"
     "  --version           print the version\n"
     "\n"
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
         if (all[0] == "demo") return pyrseg::cli::cmd_demo(rest);
         if (all[0] == "backends") return pyrseg::cli::cmd_backends(rest);
         if (all[0] == "eval") return pyrseg::cli::cmd_eval(rest);
+        if (all[0] == "bench-report") return pyrseg::cli::cmd_bench_report(rest);
         std::fprintf(stderr, "pyrseg: unknown command '%s'\n\n%s", all[0].c_str(), kUsage);
         return 2;
     } catch (const pyrseg::cli::UsageError& e) {

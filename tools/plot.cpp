@@ -104,26 +104,41 @@ std::string number(double v) {
 RgbImage render_line_chart(const LineChart& chart) {
     const int panels = std::max<int>(1, int(chart.panels.size()));
     const int panel_w = kLeft + kPlotW;
-    const int width = 2 * kMargin + panels * panel_w + (panels - 1) * kPanelGap;
+    const int width =
+        std::max(2 * kMargin + panels * panel_w + (panels - 1) * kPanelGap, 2 * kMargin + text_width(chart.title));
+    // The legend (the series of the first panel) wraps onto as many rows as the width needs.
+    const std::vector<LineSeries> no_series;
+    const std::vector<LineSeries>& legend = chart.panels.empty() ? no_series : chart.panels.front().series;
+    const auto entry_width = [](const LineSeries& s) { return 46 + text_width(s.name) + 30; };
+    int legend_rows = 1;
+    for (int lx = kMargin; const LineSeries& s : legend) {
+        if (lx > kMargin && lx + entry_width(s) > width - kMargin) {
+            ++legend_rows;
+            lx = kMargin;
+        }
+        lx += entry_width(s);
+    }
     const int title_y = kMargin;
     const int legend_y = title_y + kLine + 10;
-    const int panel_title_y = legend_y + kLine + 18;
+    const int panel_title_y = legend_y + legend_rows * (kLine + 8) + 10;
     const int plot_y = panel_title_y + kLine + 10;
     const int height = plot_y + kPlotH + 10 + kLine + 10 + kLine + kMargin;
     Canvas canvas(width, height);
 
     canvas.text(kMargin, title_y, chart.title, kInk);
-    // Legend: the series of the first panel.
     int lx = kMargin;
-    if (!chart.panels.empty()) {
-        for (const LineSeries& s : chart.panels.front().series) {
-            const int my = legend_y + kLine / 2;
-            canvas.line(lx, my, lx + 36, my, 3, s.color);
-            canvas.rect(lx + 14, my - 4, lx + 22, my + 4, s.color);
-            if (s.hollow) canvas.rect(lx + 16, my - 2, lx + 20, my + 2, kWhite);
-            canvas.text(lx + 46, legend_y, s.name, kInk);
-            lx += 46 + text_width(s.name) + 30;
+    int ly = legend_y;
+    for (const LineSeries& s : legend) {
+        if (lx > kMargin && lx + entry_width(s) > width - kMargin) {
+            lx = kMargin;
+            ly += kLine + 8;
         }
+        const int my = ly + kLine / 2;
+        canvas.line(lx, my, lx + 36, my, 3, s.color);
+        canvas.rect(lx + 14, my - 4, lx + 22, my + 4, s.color);
+        if (s.hollow) canvas.rect(lx + 16, my - 2, lx + 20, my + 2, kWhite);
+        canvas.text(lx + 46, ly, s.name, kInk);
+        lx += entry_width(s);
     }
 
     const double y_span = chart.y_max > chart.y_min ? chart.y_max - chart.y_min : 1.0;

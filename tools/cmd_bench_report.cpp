@@ -1,0 +1,404 @@
+// pyrseg bench-report: turns pyrseg_bench's JSON (Google Benchmark) into one markdown report of ratios — pyrseg per
+// backend against a memcpy of the same bytes and against each peer measured in the same run — and PNG plots.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pyrseg/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/plot.hpp"
+
+namespace pyrseg::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kUsage =
+    "Usage: pyrseg bench-report BENCH.json [--out-dir DIR]\n"
+    "\n"
+    "Reads the JSON that `pyrseg_bench --benchmark_format=json --benchmark_out=BENCH.json` writes and writes\n"
+    "DIR/performance.md (default DIR: the JSON's folder) with, per frame size:\n"
+    "  - the whole pipeline (points to labels) per backend, in ms and in multiples of a memcpy of the input bytes,\n"
+    "    and PCL's organized segmentation (its own integral-image normals) divided by pyrseg's time;\n"
+    "  - the segmentation stage (fillable mask to compacted labels) per backend, and OpenCV's connectedComponents\n"
+    "    (SAUF, Spaghetti; 4- and 8-connected) of the same mask: pyrseg's time divided by OpenCV's;\n"
+    "  - the fills' worst cases (spiral, maze) with the sweep rounds each backend needed;\n"
+    "  - the per-pass times of the full-size frame;\n"
+    "and two plots, DIR/bench_vs_pcl.png and DIR/bench_vs_opencv.png. Ratios come from one run on one machine;\n"
+    "the report starts with that machine's description.\n"
+    "The whole run is scripts/bench.sh.\n";
+
+struct Entry {
+    double ms = std::numeric_limits<double>::quiet_NaN();
+    std::string error;  // skipped, with the reason
+    std::map<std::string, double> counters;
+};
+
+using Entries = std::map<std::string, Entry>;
+
+double to_ms(double value, const std::string& unit) {
+    if (unit == "ns") return value * 1e-6;
+    if (unit == "us") return value * 1e-3;
+    if (unit == "s") return value * 1e3;
+    return value;
+}
+
+Entries read_entries(const nlohmann::json& doc) {
+    Entries out;
+    for (const nlohmann::json& b : doc.at("benchmarks")) {
+        std::string name = b.at("name").get<std::string>();
+        if (const auto slash = name.rfind("/real_time"); slash != std::string::npos) name.erase(slash);
+        Entry e;
+        if (b.value("error_occurred", false)) {
+            e.error = b.value("error_message", std::string("skipped"));
+        } else {
+            e.ms = to_ms(b.at("real_time").get<double>(), b.value("time_unit", std::string("ns")));
+        }
+        for (const auto& [key, value] : b.items()) {
+            if (value.is_number() && key != "real_time" && key != "cpu_time" && key != "iterations")
+                e.counters[key] = value.get<double>();
+        }
+        out[name] = e;
+    }
+    return out;
+}
+
+const Entry* find(const Entries& entries, const std::string& name) {
+    const auto it = entries.find(name);
+    return it == entries.end() ? nullptr : &it->second;
+}
+
+std::string fixed(double v, int digits) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", digits, v);
+    return text;
+}
+
+// Three significant digits, the way timings deserve.
+std::string sig3(double v) {
+    if (!std::isfinite(v)) return "—";
+    const double a = std::fabs(v);
+    return fixed(v, a >= 100 ? 0 : a >= 10 ? 1 : a >= 1 ? 2 : 3);
+}
+
+std::string ms_cell(const Entry* e) {
+    if (e == nullptr) return "—";
+    if (!e->error.empty()) return "skipped";
+    return sig3(e->ms) + " ms";
+}
+
+double ratio(const Entry* num, const Entry* den) {
+    if (num == nullptr || den == nullptr || !num->error.empty() || !den->error.empty()) {
+        return std::numeric_limits<double>::quiet_NaN();
+    }
+    return num->ms / den->ms;
+}
+
+std::string ratio_cell(double r) {
+    return std::isfinite(r) ? sig3(r) + "×" : "—";
+}
+
+struct Size {
+    std::string name;  // "2064x1544"
+    double megapixels = 0;
+};
+
+std::vector<Size> frame_sizes(const Entries& entries) {
+    std::vector<Size> sizes;
+    for (const auto& [name, e] : entries) {
+        if (name.rfind("memcpy/", 0) != 0 || name.size() < 12 || name.substr(name.size() - 5) != "/mask") continue;
+        const std::string size = name.substr(7, name.size() - 12);
+        int w = 0;
+        int h = 0;
+        if (std::sscanf(size.c_str(), "%dx%d", &w, &h) == 2) sizes.push_back({size, double(w) * h * 1e-6});
+    }
+    std::sort(sizes.begin(), sizes.end(), [](const Size& a, const Size& b) { return a.megapixels < b.megapixels; });
+    return sizes;
+}
+
+std::vector<std::string> backends_in(const Entries& entries) {
+    std::vector<std::string> out;
+    for (const char* b : {"cpu", "cuda", "opencl", "vulkan"}) {
+        for (const auto& [name, e] : entries) {
+            if (name.rfind(std::string("pipeline/") + b + "/", 0) == 0) {
+                out.emplace_back(b);
+                break;
+            }
+        }
+    }
+    return out;
+}
+
+std::string table_row(const std::vector<std::string>& cells) {
+    std::string row = "|";
+    for (const std::string& c : cells) row += " " + c + " |";
+    return row + "\n";
+}
+
+std::string header(const std::vector<std::string>& cells) {
+    std::string row = table_row(cells) + "|";
+    for (std::size_t i = 0; i < cells.size(); ++i) row += i == 0 ? "---|" : "---:|";
+    return row + "\n";
+}
+
+std::string machine(const nlohmann::json& doc) {
+    const nlohmann::json& c = doc.value("context", nlohmann::json::object());
+    std::ostringstream s;
+    s << "Machine: " << c.value("host_name", std::string("?")) << ", " << c.value("num_cpus", 0) << " CPUs at "
+      << c.value("mhz_per_cpu", 0) << " MHz, run " << c.value("date", std::string("?"))
+      << " (Google Benchmark's own library is a " << c.value("library_build_type", std::string("?"))
+      << " build: Debian's package).\n\n";
+    for (const auto& [key, value] : c.items()) {
+        if (key.rfind("backend ", 0) == 0 || key == "opencv" || key == "pcl" || key == "peers not built")
+            s << "- " << key << ": " << (value.is_string() ? value.get<std::string>() : value.dump()) << "\n";
+    }
+    return s.str() + "\n";
+}
+
+struct Report {
+    std::string markdown;
+    LineChart vs_pcl;
+    LineChart vs_opencv;
+};
+
+LineSeries series(const std::string& name, std::size_t index, bool hollow = false) {
+    static const std::array<std::array<std::uint8_t, 3>, 6> colors = {
+        {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {148, 103, 189}, {255, 127, 14}, {23, 190, 207}}};
+    LineSeries s;
+    s.name = name;
+    s.color = colors[index % colors.size()];
+    s.hollow = hollow;
+    return s;
+}
+
+void fit_y(LineChart& chart) {
+    double top = 0;
+    for (const LinePanel& p : chart.panels) {
+        for (const LineSeries& s : p.series) {
+            for (const double v : s.y) {
+                if (std::isfinite(v)) top = std::max(top, v);
+            }
+        }
+    }
+    const double step = top <= 2 ? 0.5 : top <= 5 ? 1 : top <= 10 ? 2 : top <= 25 ? 5 : top <= 50 ? 10 : 20;
+    chart.y_min = 0;
+    chart.y_max = std::max(step, std::ceil(top / step) * step);
+    chart.y_ticks.clear();
+    for (double t = 0; t <= chart.y_max + 1e-9; t += step) chart.y_ticks.push_back(t);
+}
+
+Report build_report(const nlohmann::json& doc, const std::string& source) {
+    const Entries entries = read_entries(doc);
+    const std::vector<Size> sizes = frame_sizes(entries);
+    const std::vector<std::string> backends = backends_in(entries);
+    if (sizes.empty() || backends.empty()) {
+        throw Error(ErrorCode::format, source + ": no pyrseg_bench results (pipeline/*, memcpy/*/mask) in it");
+    }
+    Report r;
+    std::string& md = r.markdown;
+    md += "# pyrseg benchmark report\n\nFrom `" + source + "`. " + machine(doc);
+
+    // Whole pipeline, per normals source.
+    for (const bool given : {false, true}) {
+        const std::string kind = given ? "given_normals" : "estimated_normals";
+        md += given ? "## Whole pipeline, points and normals to labels\n\n"
+                    : "## Whole pipeline, points to labels (normals estimated)\n\n";
+        md +=
+            "Milliseconds per frame; in brackets, multiples of a memcpy of the same input bytes. PCL: organized "
+            "edge-aware segmentation with its integral-image normals (it has no given-normals variant here).\n\n";
+        std::vector<std::string> head = {"frame", "memcpy"};
+        for (const std::string& b : backends) head.push_back(b);
+        head.emplace_back("PCL");
+        for (const std::string& b : backends) head.push_back("PCL ÷ " + b);
+        md += header(head);
+        for (const Size& s : sizes) {
+            const Entry* copy = find(entries, "memcpy/" + s.name + "/" + kind);
+            const Entry* pcl = find(entries, "pcl/organized_edge_aware/" + s.name + "/estimated_normals");
+            std::vector<std::string> row = {s.name, copy != nullptr ? sig3(copy->ms) + " ms" : "—"};
+            for (const std::string& b : backends) {
+                const Entry* e = find(entries, "pipeline/" + b + "/" + s.name + "/" + kind);
+                std::string cell = ms_cell(e);
+                if (e != nullptr && e->error.empty() && copy != nullptr)
+                    cell += " (" + ratio_cell(ratio(e, copy)) + ")";
+                row.push_back(cell);
+            }
+            row.push_back(ms_cell(pcl));
+            for (const std::string& b : backends)
+                row.push_back(ratio_cell(ratio(pcl, find(entries, "pipeline/" + b + "/" + s.name + "/" + kind))));
+            md += table_row(row);
+        }
+        md += "\n";
+    }
+    // Skips, with their reasons, once.
+    std::set<std::string> reasons;
+    for (const auto& [name, e] : entries) {
+        if (!e.error.empty()) reasons.insert(name + ": " + e.error);
+    }
+    if (!reasons.empty()) {
+        md += "Skipped in this run:\n\n";
+        for (const std::string& why : reasons) md += "- " + why + "\n";
+        md += "\n";
+    }
+
+    // The segmentation stage against OpenCV.
+    const std::vector<std::pair<std::string, std::string>> peers = {{"sauf_4", "SAUF 4-conn"},
+                                                                    {"sauf_8", "SAUF 8-conn"},
+                                                                    {"spaghetti_4", "Spaghetti 4-conn"},
+                                                                    {"spaghetti_8", "Spaghetti 8-conn"}};
+    md +=
+        "## Segmentation stage: fillable mask to compacted labels\n\n"
+        "pyrseg's pyramid passes on the mask its metric produced for the scene, and OpenCV's connectedComponents "
+        "of the same mask (plain labelling, which merges what bridges join). Ratios: pyrseg ÷ OpenCV SAUF "
+        "4-connected (below 1: pyrseg faster).\n\n";
+    std::vector<std::string> head = {"frame", "memcpy"};
+    for (const std::string& b : backends) head.push_back(b);
+    for (const auto& p : peers) head.push_back("OpenCV " + p.second);
+    for (const std::string& b : backends) head.push_back(b + " ÷ SAUF-4");
+    md += header(head);
+    for (const Size& s : sizes) {
+        const Entry* sauf4 = find(entries, "opencv/sauf_4/" + s.name);
+        std::vector<std::string> row = {s.name, ms_cell(find(entries, "memcpy/" + s.name + "/mask"))};
+        for (const std::string& b : backends) row.push_back(ms_cell(find(entries, "stage/" + b + "/" + s.name)));
+        for (const auto& p : peers) row.push_back(ms_cell(find(entries, "opencv/" + p.first + "/" + s.name)));
+        for (const std::string& b : backends)
+            row.push_back(ratio_cell(ratio(find(entries, "stage/" + b + "/" + s.name), sauf4)));
+        md += table_row(row);
+    }
+    md += "\n";
+
+    // The fills' worst cases.
+    md +=
+        "## The fills' worst cases\n\nOne winding region of 8-pixel corridors; sweep rounds are what a sweeping "
+        "backend needed (the CPU fills by union-find: 0).\n\n";
+    md += header({"case", "frame", "backend", "frame time", "fill time", "sweep rounds"});
+    for (const auto& [name, e] : entries) {
+        if (name.rfind("fills/", 0) != 0) continue;
+        std::vector<std::string> parts;
+        std::stringstream in(name);
+        for (std::string part; std::getline(in, part, '/');) parts.push_back(part);
+        if (parts.size() != 4) continue;
+        const auto counter = [&](const char* key) {
+            const auto it = e.counters.find(key);
+            return it == e.counters.end() ? std::string("—") : sig3(it->second);
+        };
+        const auto rounds = e.counters.find("fill_rounds");
+        md += table_row({parts[1], parts[3], parts[2], ms_cell(&e), counter("fill_ms") + " ms",
+                         rounds == e.counters.end() ? "—" : fixed(rounds->second, 0)});
+    }
+    md += "\n";
+
+    // Where a full frame's time goes.
+    const Size& largest_with_all = [&]() -> const Size& {
+        for (const Size& s : sizes) {
+            if (s.name == "2064x1544") return s;
+        }
+        return sizes.back();
+    }();
+    md += "## Per pass, " + largest_with_all.name + ", estimated normals (ms per frame)\n\n";
+    std::set<std::string> passes;
+    for (const std::string& b : backends) {
+        if (const Entry* e = find(entries, "pipeline/" + b + "/" + largest_with_all.name + "/estimated_normals")) {
+            for (const auto& [key, v] : e->counters) {
+                if (key.size() > 3 && key.substr(key.size() - 3) == "_ms") passes.insert(key);
+            }
+        }
+    }
+    head = {"pass"};
+    for (const std::string& b : backends) head.push_back(b);
+    md += header(head);
+    for (const std::string& pass : passes) {
+        std::vector<std::string> row = {pass.substr(0, pass.size() - 3)};
+        for (const std::string& b : backends) {
+            const Entry* e = find(entries, "pipeline/" + b + "/" + largest_with_all.name + "/estimated_normals");
+            const auto it = e != nullptr ? e->counters.find(pass) : std::map<std::string, double>::const_iterator{};
+            row.push_back(e != nullptr && it != e->counters.end() ? sig3(it->second) : "—");
+        }
+        md += table_row(row);
+    }
+    md += "\n";
+
+    // Plots: x = megapixels.
+    r.vs_pcl.title = "PCL time / pyrseg time (higher: pyrseg faster)";
+    r.vs_pcl.x_label = "megapixels";
+    r.vs_opencv.title = "pyrseg / OpenCV SAUF-4 (lower: pyrseg faster)";
+    r.vs_opencv.x_label = "megapixels";
+    LinePanel pcl_panel;
+    pcl_panel.title = "whole pipeline";
+    LinePanel cv_panel;
+    cv_panel.title = "mask to labels";
+    for (const Size& s : sizes) {
+        pcl_panel.x.push_back(s.megapixels);
+        cv_panel.x.push_back(s.megapixels);
+    }
+    for (std::size_t k = 0; k < backends.size(); ++k) {
+        for (const bool given : {false, true}) {
+            LineSeries line = series(backends[k] + (given ? " given n." : " est. n."), k, given);
+            for (const Size& s : sizes) {
+                line.y.push_back(ratio(find(entries, "pcl/organized_edge_aware/" + s.name + "/estimated_normals"),
+                                       find(entries, "pipeline/" + backends[k] + "/" + s.name + "/" +
+                                                         (given ? "given_normals" : "estimated_normals"))));
+            }
+            pcl_panel.series.push_back(line);
+        }
+        LineSeries line = series(backends[k], k);
+        for (const Size& s : sizes)
+            line.y.push_back(
+                ratio(find(entries, "stage/" + backends[k] + "/" + s.name), find(entries, "opencv/sauf_4/" + s.name)));
+        cv_panel.series.push_back(line);
+    }
+    r.vs_pcl.panels.push_back(pcl_panel);
+    r.vs_opencv.panels.push_back(cv_panel);
+    fit_y(r.vs_pcl);
+    fit_y(r.vs_opencv);
+    md += "![PCL / pyrseg](bench_vs_pcl.png)\n\n![pyrseg / OpenCV](bench_vs_opencv.png)\n";
+    return r;
+}
+
+}  // namespace
+
+int cmd_bench_report(const std::vector<std::string>& argv) {
+    const Args args(argv, {"out-dir"}, {"help"});
+    if (args.flag("help")) {
+        std::fputs(kUsage, stdout);
+        return 0;
+    }
+    if (args.positional().size() != 1) throw UsageError{"expects one BENCH.json"};
+    const fs::path input = args.positional()[0];
+    std::ifstream in(input);
+    if (!in) throw Error(ErrorCode::io, input.string() + ": cannot open");
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(ErrorCode::format, input.string() + ": not JSON: " + e.what());
+    }
+    Report report;
+    try {
+        report = build_report(doc, input.filename().string());
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(ErrorCode::format, input.string() + ": not Google Benchmark JSON: " + e.what());
+    }
+    const fs::path out_dir =
+        args.value("out-dir").value_or(input.parent_path().empty() ? fs::path(".") : input.parent_path());
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    const fs::path md = out_dir / "performance.md";
+    std::ofstream out(md);
+    out << report.markdown;
+    if (!out) throw Error(ErrorCode::io, md.string() + ": cannot write");
+    write_png((out_dir / "bench_vs_pcl.png").string(), render_line_chart(report.vs_pcl));
+    write_png((out_dir / "bench_vs_opencv.png").string(), render_line_chart(report.vs_opencv));
+    std::printf("wrote %s, bench_vs_pcl.png, bench_vs_opencv.png\n", md.string().c_str());
+    return 0;
+}
+
+}  // namespace pyrseg::cli
