@@ -27,8 +27,9 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
-    "                      [--backend NAME] [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure] [--progress auto|bar|lines|none]\n"
+    "                      [--ply OUT.ply] [--backend NAME] [input options] [parameters]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply]\n"
+    "                      [--progress auto|bar|lines|none]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments);\n"
@@ -36,17 +37,20 @@ constexpr const char* kSegmentUsage =
     "  --png OUT.png         the segments in colour\n"
     "  --mask-png OUT.png    the fillable mask (white) the pyramid labels\n"
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
+    "  --ply OUT.ply         the cloud coloured by segment (gray: no segment), binary PLY, organized (obj_info\n"
+    "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n"
-    "Batches: several INPUTs, folders (their .pcd/.npy/.png/.tif/.tiff files, by name) or quoted glob patterns,\n"
-    "with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png as --write\n"
-    "asks (default labels,png). A frame that fails is reported and skipped; the exit status is 1 if any failed.\n"
+    "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
+    "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
+    "NAME.ply as --write asks (default labels,png). A frame that fails is reported and skipped; the exit status is\n"
+    "1 if any failed. No output may overwrite its input.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure;
-    [[nodiscard]] bool any() const { return labels || png || mask || figure; }
+    std::optional<fs::path> labels, png, mask, figure, ply;
+    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply; }
 };
 
 struct FrameReport {
@@ -76,6 +80,13 @@ void write_labels(const fs::path& path, const Result& result) {
 // One frame: read, segment (reusing the Segmenter while the size stays the same), write what was asked.
 FrameReport segment_frame(const fs::path& input, const Args& args, const Params& params, const OutputPaths& out,
                           std::unique_ptr<Segmenter>& segmenter) {
+    // NAME.png or NAME.ply in the input's own folder would be the input itself.
+    for (const std::optional<fs::path>* o : {&out.labels, &out.png, &out.mask, &out.figure, &out.ply}) {
+        std::error_code ec;
+        if (o->has_value() && fs::equivalent(**o, input, ec)) {
+            throw Error(ErrorCode::io, (*o)->string() + ": is the input; refusing to overwrite it");
+        }
+    }
     const LoadedInput loaded = load_input(input, args);
     const io::PointCloud& cloud = loaded.cloud;
     const double median_z = median_depth(cloud.points);
@@ -103,6 +114,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.png) write_png(*out.png, colorize(result.labels, result.width, result.height));
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));
+    if (out.ply) io::write_ply(*out.ply, cloud, result.labels.data(), true);
     char line[512];
     std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s", input.string().c_str(),
                   loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
@@ -113,7 +125,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
 bool supported_input(const fs::path& p) {
     std::string ext = p.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".pcd" || ext == ".npy" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+    return ext == ".pcd" || ext == ".ply" || ext == ".npy" || ext == ".png" || ext == ".tif" || ext == ".tiff";
 }
 
 // Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
@@ -128,7 +140,7 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
             }
             std::sort(found.begin(), found.end());
             if (found.empty())
-                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.npy/.png/.tif/.tiff file\n", name.c_str());
+                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.ply/.npy/.png/.tif/.tiff file\n", name.c_str());
             inputs.insert(inputs.end(), found.begin(), found.end());
         } else if (name.find_first_of("*?[") != std::string::npos && !fs::exists(name, ec)) {
             glob_t matches{};
@@ -150,12 +162,12 @@ std::set<std::string> parse_write_list(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        if (item != "labels" && item != "png" && item != "mask" && item != "figure") {
-            throw UsageError{"--write expects a list of labels, png, mask, figure; got '" + item + "'"};
+        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply") {
+            throw UsageError{"--write expects a list of labels, png, mask, figure, ply; got '" + item + "'"};
         }
         kinds.insert(item);
     }
-    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure"};
+    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply"};
     return kinds;
 }
 
@@ -183,6 +195,7 @@ int run_batch(const Args& args, const Params& params) {
         if (kinds.count("png") != 0) out.png = out_dir / (stem + ".png");
         if (kinds.count("mask") != 0) out.mask = out_dir / (stem + ".mask.png");
         if (kinds.count("figure") != 0) out.figure = out_dir / (stem + ".figure.png");
+        if (kinds.count("ply") != 0) out.ply = out_dir / (stem + ".ply");
         try {
             const FrameReport r = segment_frame(input, args, params, out, segmenter);
             total_ms += r.milliseconds;
@@ -211,7 +224,7 @@ int run_batch(const Args& args, const Params& params) {
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
-    values.insert({"labels", "png", "mask-png", "figure", "backend", "out-dir", "write", "progress"});
+    values.insert({"labels", "png", "mask-png", "figure", "ply", "backend", "out-dir", "write", "progress"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -224,6 +237,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (auto v = args.value("png")) out.png = *v;
     if (auto v = args.value("mask-png")) out.mask = *v;
     if (auto v = args.value("figure")) out.figure = *v;
+    if (auto v = args.value("ply")) out.ply = *v;
     const Params params = parse_params(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
@@ -234,7 +248,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
     }
-    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png or --figure"};
+    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure or --ply"};
     std::unique_ptr<Segmenter> segmenter;
     std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter).line.c_str());
     return 0;

@@ -1,4 +1,4 @@
-// What `pyrseg segment` reads: organized PCD clouds, and depth images back-projected with pinhole intrinsics.
+// What `pyrseg segment` reads: organized PCD and PLY clouds, and depth images back-projected with pinhole intrinsics.
 #include <algorithm>
 #include <filesystem>
 #include <string>
@@ -12,6 +12,8 @@ const char* const kInputHelp =
     "Inputs:\n"
     "  .pcd                  organized PCD (ascii, binary or binary_compressed), fields x y z and optionally\n"
     "                        normal_x normal_y normal_z (otherwise normals are estimated)\n"
+    "  .ply                  organized PLY (ascii or binary), vertex x y z and optionally nx ny nz; the grid from\n"
+    "                        obj_info num_cols/num_rows (PCL), the camera viewport (PCL) or Photoneo's Width/Height\n"
     "  .npy                  a NumPy float32/float64 array, H x W x 3 (points) or H x W x 6 (points, normals)\n"
     "  .png, .tif, .tiff     a depth image: 16-bit PNG, or a TIFF of 16-bit or 32-bit float samples; 0 = no data.\n"
     "                        Needs the camera's intrinsics, one of:\n"
@@ -58,7 +60,7 @@ io::Intrinsics intrinsics_from(const Args& args, const std::filesystem::path& in
 
 LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
     const std::string ext = lower_extension(path);
-    if (ext == ".pcd" || ext == ".npy") {
+    if (ext == ".pcd" || ext == ".npy" || ext == ".ply") {
         for (const std::string& option : kInputValueOptions) {
             if (args.value(option)) {
                 std::string message = "--" + option;
@@ -67,6 +69,7 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
             }
         }
         if (ext == ".npy") return {io::read_npy_cloud(path), "NumPy cloud", false};
+        if (ext == ".ply") return {io::read_ply(path), "PLY", false};
         return {io::read_pcd(path), "PCD", false};
     }
     if (ext == ".png" || ext == ".tif" || ext == ".tiff") {
@@ -81,7 +84,7 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
         return {io::depth_to_cloud(depth, k, 1000.0 / per_metre), "depth image", true};
     }
     throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +
-                                       "' (pyrseg reads .pcd and .npy clouds, and .png/.tif/.tiff depth images)");
+                                       "' (pyrseg reads .pcd, .ply and .npy clouds, and .png/.tif/.tiff depth images)");
 }
 
 }  // namespace pyrseg::cli

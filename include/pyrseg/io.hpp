@@ -1,5 +1,5 @@
 #pragma once
-// pyrseg::io: the file formats the CLI and the tests need: PCD in, .npy and PNG out (and back in, for tests).
+// pyrseg::io: the file formats the CLI and the tests need: PCD and PLY in; .npy, PNG and PLY out (and back in).
 // Every failure is a pyrseg::Error whose message names the file: ErrorCode::io when the file cannot be opened,
 // read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::invalid_argument
 // for bad arguments to a writer.
@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include "pyrseg/result.hpp"
 
 namespace pyrseg::io {
 
@@ -28,6 +30,25 @@ PointCloud read_pcd(const std::filesystem::path& path);
 
 // Writes fields x y z (and normal_x normal_y normal_z when cloud.normals is not empty) as F 4, the way PCL does.
 void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding);
+
+// PLY through PCL's PLY reader and writer (pcl_io). Without PCL at build time (PYRSEG_HAVE_PLY=0) both throw
+// ErrorCode::format saying that pyrseg was built without PLY support.
+//
+// Reads ascii, binary_little_endian or binary_big_endian PLY: element vertex with x y z (float or double) and,
+// when present, nx ny nz or normal_x normal_y normal_z (float or double); other properties and elements are
+// skipped. The cloud must be organized, its grid given by one of: obj_info num_cols W / num_rows H (with or without
+// a range_grid element mapping the W x H cells to vertices, as PCL's writer and the Stanford range scans store it;
+// empty cells read as NaN), the camera element's viewportx / viewporty (PCL's writer with use_camera), or a
+// Photoneo PhoXi header line "obj_info Photoneo PLY PointCloud ( Width = W; Height = H)". Points are returned as
+// stored (PhoXi marks missing points as 0 0 0, which pyrseg's z > 0 rule treats as invalid).
+PointCloud read_ply(const std::filesystem::path& path);
+
+// Writes an organized PLY that PCL, CloudCompare and MeshLab read: x y z, nx ny nz when cloud.normals is not empty,
+// and red green blue (uchar) from label_color when labels (W*H, row-major) are given, label 0 as gray 128. Points
+// with a non-finite coordinate are not written as vertices: obj_info num_cols/num_rows and a range_grid element
+// keep the grid (PCL's organized layout), so viewers never see NaN vertices and read_ply returns them as NaN.
+// Binary is exact; ascii has 6 significant digits (PCL's writer ignores its precision setting on this path).
+void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels, bool binary);
 
 // NumPy .npy (format 1.0), C order, little-endian.
 void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int height, int width);  // '<u4' H x W
@@ -87,5 +108,16 @@ PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double m
 // the same label is the same colour in every picture; neighbouring label values clearly different).
 std::array<std::uint8_t, 3> label_color(std::uint32_t label);
 std::vector<std::uint8_t> colorize_labels(const std::uint32_t* labels, int width, int height);  // 3*W*H RGB
+
+// Per-segment statistics (Result::segments) as a table: CSV with a header line when the path ends in .csv, else
+// JSON (nlohmann/json) with the frame's size and units, and one object per segment. Centroids are in the cloud's
+// units (unit_mm millimetres each); NaN (a mask's missing geometry) is an empty CSV field and JSON null.
+struct SegmentTable {
+    int width = 0, height = 0;
+    double unit_mm = 1.0;
+    std::string source;  // the input file, written into the JSON
+};
+void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
+                         const SegmentTable& frame);
 
 }  // namespace pyrseg::io

@@ -99,7 +99,7 @@ TEST(Cli, FileAndParameterErrorsNameTheProblem) {
     r = run("segment " + garbage.string() + " --labels " + (dir / "o.npy").string());
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.output.find("garbage.pcd"), std::string::npos) << r.output;
-    r = run("segment " + (dir / "scan.ply").string() + " --labels o.npy");
+    r = run("segment " + (dir / "scan.xyz").string() + " --labels o.npy");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.output.find("unsupported input format"), std::string::npos) << r.output;
     if (fs::exists(mug_scan())) {
