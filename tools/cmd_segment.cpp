@@ -27,8 +27,8 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
-    "                      [--ply OUT.ply] [--backend NAME] [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply]\n"
+    "                      [--ply OUT.ply] [--stats OUT.json|OUT.csv] [--backend NAME] [input options] [parameters]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,stats]\n"
     "                      [--progress auto|bar|lines|none]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
@@ -39,18 +39,21 @@ constexpr const char* kSegmentUsage =
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
     "  --ply OUT.ply         the cloud coloured by segment (gray: no segment), binary PLY, organized (obj_info\n"
     "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
+    "  --stats OUT.json      per segment: label, pixel count, bounding box, 3D centroid (the cloud's units) and\n"
+    "  --stats OUT.csv       mean normal, computed by the backend; JSON, or CSV when the name ends in .csv\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply as --write asks (default labels,png). A frame that fails is reported and skipped; the exit status is\n"
+    "NAME.ply, NAME.stats.json as --write asks (default labels,png). A frame that fails is reported and skipped; the "
+    "exit status is\n"
     "1 if any failed. No output may overwrite its input.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply;
-    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply; }
+    std::optional<fs::path> labels, png, mask, figure, ply, stats;
+    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || stats; }
 };
 
 struct FrameReport {
@@ -81,7 +84,7 @@ void write_labels(const fs::path& path, const Result& result) {
 FrameReport segment_frame(const fs::path& input, const Args& args, const Params& params, const OutputPaths& out,
                           std::unique_ptr<Segmenter>& segmenter) {
     // NAME.png or NAME.ply in the input's own folder would be the input itself.
-    for (const std::optional<fs::path>* o : {&out.labels, &out.png, &out.mask, &out.figure, &out.ply}) {
+    for (const std::optional<fs::path>* o : {&out.labels, &out.png, &out.mask, &out.figure, &out.ply, &out.stats}) {
         std::error_code ec;
         if (o->has_value() && fs::equivalent(**o, input, ec)) {
             throw Error(ErrorCode::io, (*o)->string() + ": is the input; refusing to overwrite it");
@@ -98,6 +101,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height) {
         Outputs outputs;
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
+        outputs.segment_stats = out.stats.has_value();
         segmenter =
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
@@ -115,6 +119,10 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));
     if (out.ply) io::write_ply(*out.ply, cloud, result.labels.data(), true);
+    if (out.stats) {
+        io::write_segment_stats(*out.stats, result.segments,
+                                io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+    }
     char line[512];
     std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s", input.string().c_str(),
                   loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
@@ -162,12 +170,13 @@ std::set<std::string> parse_write_list(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply") {
-            throw UsageError{"--write expects a list of labels, png, mask, figure, ply; got '" + item + "'"};
+        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" &&
+            item != "stats") {
+            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, stats; got '" + item + "'"};
         }
         kinds.insert(item);
     }
-    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply"};
+    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, stats"};
     return kinds;
 }
 
@@ -196,6 +205,7 @@ int run_batch(const Args& args, const Params& params) {
         if (kinds.count("mask") != 0) out.mask = out_dir / (stem + ".mask.png");
         if (kinds.count("figure") != 0) out.figure = out_dir / (stem + ".figure.png");
         if (kinds.count("ply") != 0) out.ply = out_dir / (stem + ".ply");
+        if (kinds.count("stats") != 0) out.stats = out_dir / (stem + ".stats.json");
         try {
             const FrameReport r = segment_frame(input, args, params, out, segmenter);
             total_ms += r.milliseconds;
@@ -224,7 +234,7 @@ int run_batch(const Args& args, const Params& params) {
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
-    values.insert({"labels", "png", "mask-png", "figure", "ply", "backend", "out-dir", "write", "progress"});
+    values.insert({"labels", "png", "mask-png", "figure", "ply", "stats", "backend", "out-dir", "write", "progress"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -238,6 +248,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (auto v = args.value("mask-png")) out.mask = *v;
     if (auto v = args.value("figure")) out.figure = *v;
     if (auto v = args.value("ply")) out.ply = *v;
+    if (auto v = args.value("stats")) out.stats = *v;
     const Params params = parse_params(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
@@ -248,7 +259,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
     }
-    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure or --ply"};
+    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure, --ply or --stats"};
     std::unique_ptr<Segmenter> segmenter;
     std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter).line.c_str());
     return 0;

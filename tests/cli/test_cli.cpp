@@ -3,11 +3,15 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -50,7 +54,8 @@ fs::path mug_scan() {
 }
 
 TEST(Cli, EveryCommandExplainsItselfWithHelp) {
-    for (const char* command : {"--help", "segment --help", "demo --help", "backends --help"}) {
+    for (const char* command :
+         {"--help", "segment --help", "demo --help", "backends --help", "eval --help", "bench-report --help"}) {
         const CliRun r = run(command);
         EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << command << "\n" << r.output;
@@ -346,3 +351,92 @@ TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
 }
 
 }  // namespace
+
+// --stats writes what the library's statistics pass computed, as JSON or CSV; the pixel counts add up to the
+// labelled pixels of the --labels output of the same run.
+TEST(Cli, StatsAreWrittenAsJsonOrCsv) {
+    pyrseg::synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
+    const fs::path dir = temp_dir();
+    pyrseg::io::PointCloud cloud;
+    cloud.width = o.width;
+    cloud.height = o.height;
+    cloud.points = scene.points;
+    pyrseg::io::write_pcd(dir / "scene.pcd", cloud, pyrseg::io::PcdEncoding::binary);
+    const CliRun r = run("segment " + (dir / "scene.pcd").string() + " --labels " + (dir / "l.npy").string() +
+                         " --stats " + (dir / "s.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::NpyArray labels = pyrseg::io::read_npy(dir / "l.npy");
+    std::size_t labelled = 0;
+    std::uint32_t largest = 0;
+    for (std::size_t i = 0; i < labels.bytes.size() / 4; ++i) {
+        std::uint32_t l = 0;
+        std::memcpy(&l, labels.bytes.data() + 4 * i, 4);
+        labelled += l != 0 ? 1 : 0;
+        largest = std::max(largest, l);
+    }
+    std::ifstream json_file(dir / "s.json");
+    const nlohmann::json doc = nlohmann::json::parse(json_file);
+    EXPECT_EQ(doc["width"], 160);
+    EXPECT_EQ(doc["segment_count"], largest);
+    std::size_t counted = 0;
+    for (const nlohmann::json& s : doc["segments"]) counted += s["pixel_count"].get<std::size_t>();
+    EXPECT_EQ(counted, labelled);
+    EXPECT_GT(doc["segments"][0]["centroid"][2].get<double>(), 500.0) << "millimetres, about 1.2 m away";
+
+    ASSERT_EQ(run("segment " + (dir / "scene.pcd").string() + " --stats " + (dir / "s.csv").string()).status, 0);
+    std::ifstream csv(dir / "s.csv");
+    std::string line;
+    std::size_t lines = 0;
+    while (std::getline(csv, line)) ++lines;
+    EXPECT_EQ(lines, std::size_t(largest) + 1) << "a header and one line per segment";
+    // In a batch: NAME.stats.json.
+    const CliRun batch = run("segment " + (dir / "scene.pcd").string() + " --out-dir " + (dir / "out").string() +
+                             " --write stats --progress none");
+    EXPECT_EQ(batch.status, 0) << batch.output;
+    EXPECT_TRUE(fs::exists(dir / "out" / "scene.stats.json"));
+    fs::remove_all(dir);
+}
+
+// bench-report turns Google Benchmark JSON into ratio tables: a made-up run with known times gives known ratios,
+// and a file that is not such JSON is an error naming it.
+TEST(Cli, BenchReportWritesRatiosAndPlots) {
+    const fs::path dir = temp_dir();
+    const auto entry = [](const std::string& name, double ms) {
+        return nlohmann::json{{"name", name + "/real_time"}, {"real_time", ms}, {"time_unit", "ms"}};
+    };
+    nlohmann::json doc;
+    doc["context"] = {{"host_name", "testhost"}, {"num_cpus", 2}, {"backend cpu", "available"}};
+    doc["benchmarks"] = {entry("memcpy/640x480/estimated_normals", 0.1),
+                         entry("memcpy/640x480/given_normals", 0.2),
+                         entry("memcpy/640x480/mask", 0.01),
+                         entry("pipeline/cpu/640x480/estimated_normals", 10.0),
+                         entry("pipeline/cpu/640x480/given_normals", 5.0),
+                         entry("pcl/organized_edge_aware/640x480/estimated_normals", 150.0),
+                         entry("stage/cpu/640x480", 3.0),
+                         entry("opencv/sauf_4/640x480", 0.5)};
+    doc["benchmarks"].push_back({{"name", "pipeline/vulkan/640x480/estimated_normals/real_time"},
+                                 {"error_occurred", true},
+                                 {"error_message", "too large for this device"}});
+    std::ofstream(dir / "bench.json") << doc.dump();
+    const CliRun r = run("bench-report " + (dir / "bench.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream md_file(dir / "performance.md");
+    const std::string md((std::istreambuf_iterator<char>(md_file)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("testhost"), std::string::npos);
+    EXPECT_NE(md.find("| 640x480 | 0.100 ms | 10.0 ms (100×) |"), std::string::npos) << md;
+    EXPECT_NE(md.find("15.0×"), std::string::npos) << "PCL 150 ms / cpu 10 ms\n" << md;
+    EXPECT_NE(md.find("30.0×"), std::string::npos) << "PCL 150 ms / cpu with given normals 5 ms\n" << md;
+    EXPECT_NE(md.find("6.00×"), std::string::npos) << "stage 3 ms / OpenCV 0.5 ms\n" << md;
+    EXPECT_NE(md.find("too large for this device"), std::string::npos) << "skips keep their reason\n" << md;
+    EXPECT_TRUE(fs::exists(dir / "bench_vs_pcl.png"));
+    EXPECT_TRUE(fs::exists(dir / "bench_vs_opencv.png"));
+
+    std::ofstream(dir / "not.json") << "{ nope";
+    const CliRun bad = run("bench-report " + (dir / "not.json").string());
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_NE(bad.output.find("not.json"), std::string::npos) << bad.output;
+    fs::remove_all(dir);
+}
