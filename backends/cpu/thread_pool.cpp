@@ -1,6 +1,7 @@
 #include "backends/cpu/thread_pool.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <string>
 
@@ -16,6 +17,20 @@ unsigned default_threads() {
         }
     }
     return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// How long a thread spins for the next loop or for the workers to finish before it sleeps.
+constexpr std::chrono::microseconds kSpin{50};
+
+// Spins until done() holds or kSpin has passed; returns done().
+template <class Done>
+bool spin_until(const Done& done) {
+    const auto until = std::chrono::steady_clock::now() + kSpin;
+    for (unsigned n = 0;; ++n) {
+        if (done()) return true;
+        if ((n & 63u) == 63u && std::chrono::steady_clock::now() > until) return done();
+        std::this_thread::yield();
+    }
 }
 
 }  // namespace
@@ -51,30 +66,36 @@ void ThreadPool::run(std::size_t count, std::size_t grain, Invoke invoke, const 
         count_ = count;
         grain_ = std::max<std::size_t>(grain, 1);
         next_.store(0, std::memory_order_relaxed);
-        busy_workers_ = static_cast<unsigned>(workers_.size());
-        ++generation_;
+        busy_workers_.store(static_cast<unsigned>(workers_.size()), std::memory_order_relaxed);
+        generation_.fetch_add(1, std::memory_order_release);
     }
     start_cv_.notify_all();
     work_chunks();
+    const auto all_done = [this] { return busy_workers_.load(std::memory_order_acquire) == 0; };
+    if (spin_until(all_done)) return;
     std::unique_lock lock(mutex_);
-    done_cv_.wait(lock, [this] { return busy_workers_ == 0; });
+    done_cv_.wait(lock, all_done);
 }
 
 void ThreadPool::worker_loop() {
     std::size_t seen = 0;
     for (;;) {
+        // The loop's parameters were written under the mutex before the generation changed: taking the mutex
+        // here (after spinning or sleeping) makes them visible.
+        spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; });
         {
             std::unique_lock lock(mutex_);
-            start_cv_.wait(lock, [&] { return stopping_ || generation_ != seen; });
+            start_cv_.wait(lock, [&] { return stopping_ || generation_.load(std::memory_order_relaxed) != seen; });
             if (stopping_) return;
-            seen = generation_;
+            seen = generation_.load(std::memory_order_relaxed);
         }
         work_chunks();
-        {
+        if (busy_workers_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+            // The caller may be asleep: notify under the mutex, so the wake-up cannot fall between its check and
+            // its wait.
             std::lock_guard lock(mutex_);
-            --busy_workers_;
+            done_cv_.notify_one();
         }
-        done_cv_.notify_one();
     }
 }
 

@@ -45,8 +45,10 @@ private:
     std::mutex mutex_;
     std::condition_variable start_cv_;
     std::condition_variable done_cv_;
-    std::size_t generation_ = 0;
-    unsigned busy_workers_ = 0;
+    // A frame runs dozens of short loops: waking a sleeping thread costs tens of microseconds on a virtual machine,
+    // so workers and the caller first spin briefly on these before they sleep on the condition variables.
+    std::atomic<std::size_t> generation_{0};
+    std::atomic<unsigned> busy_workers_{0};
     bool stopping_ = false;
     // The loop being run.
     Invoke invoke_ = nullptr;
