@@ -340,7 +340,9 @@ private:
         const PyrLevel parent = plan_.level(std::max(1, plan_.level_count - 1));
         rows(lv.height, [&](size_t y) {
             if (init_rows_first) init_row(c, lv, parent, uint32_t(y), PYR_INIT_INHERIT);
-            if (kernels::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u) changed.store(true, std::memory_order_relaxed);
+            const bool row_changed =
+                once ? sweep_row_once(c, lv, uint32_t(y)) : kernels::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u;
+            if (row_changed) changed.store(true, std::memory_order_relaxed);
         });
         // Columns in a few wide strips, one per task: each row of a strip is a long contiguous run.
         const size_t strips = size_t(pool_.size()) * 2;
@@ -358,10 +360,57 @@ private:
         return changed.load();
     }
 
+    // Step 6 changes only fillable pixels without a label (labelled ones never change), so a block of a row that
+    // has none stays as it is whatever its neighbours do: the sweeps skip such blocks after a vectorised check.
+    static constexpr uint32_t kSkipBlock = 64;
+
+    [[nodiscard]] static bool has_unlabelled_fillable(const std::uint8_t* mask, const uint32_t* labels,
+                                                      uint32_t count) {
+        bool any = false;
+        for (uint32_t x = 0; x < count; ++x) any |= ((mask[x] & PYR_MASK_FILLABLE) != 0) & (labels[x] == 0);
+        return any;
+    }
+
+    // Step 6a on row y: the shared sweep, there and back, over the blocks that can change (with the pixel before
+    // each block, which the sweep reads first).
+    bool sweep_row_once(const PassContext& c, const PyrLevel& lv, uint32_t y) {
+        const uint32_t row = lv.offset + y * lv.width;
+        bool changed = false;
+        for (uint32_t b = 0; b < lv.width; b += kSkipBlock) {
+            const uint32_t n = std::min(kSkipBlock, lv.width - b);
+            if (!has_unlabelled_fillable(c.mask + row + b, c.labels + row + b, n)) continue;
+            const uint32_t start = b == 0 ? row : row + b - 1;
+            changed |= kernels::pyr_sweep_line(c, start, 1u, b == 0 ? n : n + 1, 1u) != 0u;
+        }
+        for (uint32_t e = lv.width; e > 0; e -= std::min(kSkipBlock, e)) {
+            const uint32_t n = std::min(kSkipBlock, e);
+            const uint32_t b = e - n;
+            if (!has_unlabelled_fillable(c.mask + row + b, c.labels + row + b, n)) continue;
+            const uint32_t start = e == lv.width ? row + e - 1 : row + e;
+            changed |= kernels::pyr_sweep_line(c, start, 0xffffffffu, e == lv.width ? n : n + 1, 1u) != 0u;
+        }
+        return changed;
+    }
+
     bool column_step(const PassContext& c, const PyrLevel& lv, uint32_t y, uint32_t from_y, uint32_t x0, uint32_t x1,
                      bool once) {
         const uint32_t row = lv.offset + y * lv.width;
         const uint32_t from = lv.offset + from_y * lv.width;
+        const std::uint8_t* m = c.mask;
+        uint32_t* l = c.labels;
+        if (once) {
+            bool ch = false;
+            for (uint32_t b = x0; b < x1; b += kSkipBlock) {
+                const uint32_t e = std::min(x1, b + kSkipBlock);
+                if (has_unlabelled_fillable(m + row + b, l + row + b, e - b))
+                    ch |= column_block(c, row, from, b, e, true);
+            }
+            return ch;
+        }
+        return column_block(c, row, from, x0, x1, false);
+    }
+
+    static bool column_block(const PassContext& c, uint32_t row, uint32_t from, uint32_t x0, uint32_t x1, bool once) {
         const std::uint8_t* m = c.mask;
         uint32_t* l = c.labels;
         bool ch = false;
@@ -392,9 +441,8 @@ private:
     bool sweeps_;
     uint32_t segment_count_ = 0;
     uint32_t fill_rounds_ = 0;
-    int pending_init_ = 0;
-    bool marked_ = false;  // label_edges marked the compaction table already  // a level whose step-5 init waits for
-                           // its fill_once (0: none)
+    int pending_init_ = 0;  // a level whose step-5 init waits for its fill_once (0: none)
+    bool marked_ = false;   // label_edges marked the compaction table already
     bool compacted_ = false;
     bool normals_estimated_ = false;
     bool from_mask_ = false;
