@@ -1,9 +1,8 @@
 // Peer: PCL's organized segmentation as PCL's organized-segmentation demo runs it: integral-image normals, then
 // OrganizedConnectedComponentSegmentation with EdgeAwarePlaneComparator (fed the normal estimation's distance map),
-// on the same clouds as pyrseg's pipeline/*/estimated_normals (converted to metres, PCL's convention). Thresholds
-// follow pyrseg's defaults where they mean the same thing: 0.25 rad between normals, 10 mm along them.
-// Left out: PCL's labelling with the scene's exact normals and no edge map crashes inside
-// OrganizedConnectedComponentSegmentation::segment() (PCL 1.13) on these scenes; not chased further.
+// on the same clouds as pyrseg's pipeline/*/estimated_normals (converted to metres, PCL's convention); and the
+// labelling alone with the scene's exact normals (no edge map), next to pipeline/*/given_normals. Thresholds follow
+// pyrseg's defaults where they mean the same thing: 0.25 rad between normals, 10 mm along them.
 #include <benchmark/benchmark.h>
 
 #include <pcl/features/integral_image_normal.h>
@@ -26,24 +25,22 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using Normals = pcl::PointCloud<pcl::Normal>;
 using Comparator = pcl::EdgeAwarePlaneComparator<pcl::PointXYZ, pcl::Normal>;
 
-bool on_border(const synthetic::Scene& s, std::size_t i) {
-    const std::size_t x = i % std::size_t(s.width);
-    const std::size_t y = i / std::size_t(s.width);
-    return x == 0 || y == 0 || x + 1 == std::size_t(s.width) || y + 1 == std::size_t(s.height);
-}
-
-// The outermost pixels are left out, as PCL's integral-image normals leave them out anyway (a region touching the
-// image border was one suspect for the crash above).
 Cloud::Ptr to_pcl(const synthetic::Scene& s) {
     auto cloud = std::make_shared<Cloud>(std::uint32_t(s.width), std::uint32_t(s.height));
     cloud->is_dense = false;
-    const float nan = std::numeric_limits<float>::quiet_NaN();
     for (std::size_t i = 0; i < cloud->size(); ++i) {
-        (*cloud)[i] = on_border(s, i) ? pcl::PointXYZ(nan, nan, nan)
-                                      : pcl::PointXYZ(s.points[3 * i] * 1e-3f, s.points[3 * i + 1] * 1e-3f,
-                                                      s.points[3 * i + 2] * 1e-3f);
+        (*cloud)[i] = pcl::PointXYZ(s.points[3 * i] * 1e-3f, s.points[3 * i + 1] * 1e-3f, s.points[3 * i + 2] * 1e-3f);
     }
     return cloud;
+}
+
+Normals::Ptr scene_normals(const synthetic::Scene& s) {
+    auto normals = std::make_shared<Normals>(std::uint32_t(s.width), std::uint32_t(s.height));
+    for (std::size_t i = 0; i < normals->size(); ++i) {
+        (*normals)[i] = pcl::Normal(s.normals[3 * i], s.normals[3 * i + 1], s.normals[3 * i + 2]);
+        (*normals)[i].curvature = 0.0f;
+    }
+    return normals;
 }
 
 // What one PCL frame computes: plane offsets d = -n.p, the comparator, the labelling.
@@ -63,16 +60,22 @@ std::size_t segment_with_pcl(const Cloud::ConstPtr& cloud, const Normals::ConstP
     comparator->setEuclideanDistanceThreshold(0.010f);
     pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> segmentation(comparator);
     segmentation.setInputCloud(cloud);
+    // segment() only resizes the labels it is given, and reads the stale labels of a reused cloud as its own
+    // (it crashes on them): every frame starts from empty outputs, as a fresh PCL pipeline would.
+    labels.clear();
+    indices.clear();
     segmentation.segment(labels, indices);
     std::size_t segments = 0;  // regions of at least 100 points (PCL's organized plane segmentation's default)
     for (const pcl::PointIndices& region : indices) segments += region.indices.size() >= 100 ? 1 : 0;
     return segments;
 }
 
-void pcl_segmentation(benchmark::State& state, int width, int height) {
+void pcl_segmentation(benchmark::State& state, int width, int height, bool given_normals) {
     const synthetic::Scene& s = scene(width, height);
     const Cloud::ConstPtr cloud = to_pcl(s);
-    auto normals = std::make_shared<Normals>();
+    const Normals::Ptr normals = given_normals ? scene_normals(s) : std::make_shared<Normals>();
+    // Without an edge map every point is far from an edge.
+    const std::vector<float> no_edges(cloud->size(), std::numeric_limits<float>::max());
     pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> estimation;
     estimation.setNormalEstimationMethod(estimation.COVARIANCE_MATRIX);
     estimation.setMaxDepthChangeFactor(0.02f);
@@ -82,25 +85,33 @@ void pcl_segmentation(benchmark::State& state, int width, int height) {
     std::vector<pcl::PointIndices> indices;
     std::size_t segments = 0;
     for (auto _ : state) {
-        estimation.setInputCloud(cloud);
-        estimation.compute(*normals);
-        segments = segment_with_pcl(cloud, normals, estimation.getDistanceMap(), plane_d, labels, indices);
+        const float* distance_map = no_edges.data();
+        if (!given_normals) {
+            estimation.setInputCloud(cloud);
+            estimation.compute(*normals);
+            distance_map = estimation.getDistanceMap();
+        }
+        segments = segment_with_pcl(cloud, normals, distance_map, plane_d, labels, indices);
         benchmark::DoNotOptimize(labels.data());
     }
     state.counters["segments"] = double(segments);
     state.counters["Mpix/s"] =
         benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(width) * height * 12);
+    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(width) * height * 12 *
+                            (given_normals ? 2 : 1));
 }
 
 int register_all() {
     for (const auto& size : kSizes) {
         const int w = size[0];
         const int h = size[1];
-        const std::string name = "pcl/organized_edge_aware/" + size_name(w, h) + "/estimated_normals";
-        benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) { pcl_segmentation(st, w, h); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        for (const bool given : {false, true}) {
+            const std::string name =
+                "pcl/organized_edge_aware/" + size_name(w, h) + (given ? "/given_normals" : "/estimated_normals");
+            benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) { pcl_segmentation(st, w, h, given); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+        }
     }
     benchmark::AddCustomContext("pcl", PCL_VERSION_PRETTY);
     return 0;
