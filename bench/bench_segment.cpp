@@ -20,7 +20,8 @@ namespace {
 // Per-pass counters (milliseconds per frame, as Segmenter::last_timings() reports them: host times, or the device's
 // timestamps where a backend queues the frame), the segment count and throughput.
 void report(benchmark::State& state, const std::map<std::string, double>& pass_ms, const Result& result,
-            std::size_t input_bytes) {
+            std::uint32_t fill_rounds, std::size_t input_bytes) {
+    state.counters["fill_rounds"] = fill_rounds;
     for (const auto& [pass, ms] : pass_ms) {
         state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
     }
@@ -57,7 +58,8 @@ void pipeline(benchmark::State& state, const std::string& backend, int width, in
         for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
         benchmark::DoNotOptimize(result.labels.data());
     }
-    report(state, pass_ms, result, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1));
+    report(state, pass_ms, result, segmenter->last_fill_rounds(),
+           std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1));
 }
 
 void stage(benchmark::State& state, const std::string& backend, int width, int height) {
@@ -75,7 +77,7 @@ void stage(benchmark::State& state, const std::string& backend, int width, int h
         for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
         benchmark::DoNotOptimize(result.labels.data());
     }
-    report(state, pass_ms, result, std::size_t(width) * std::size_t(height));
+    report(state, pass_ms, result, segmenter->last_fill_rounds(), std::size_t(width) * std::size_t(height));
 }
 
 // The floor: copying the bytes a benchmark reads.

@@ -207,33 +207,55 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     std::string& md = r.markdown;
     md += "# pyrseg benchmark report\n\nFrom `" + source + "`. " + machine(doc);
 
-    // Whole pipeline, per normals source.
+    // Whole pipeline, per normals source. PCL's pipeline estimates its own normals (integral images); with the
+    // scene's normals it runs only its labelling, which compares with pyrseg given the same normals.
     for (const bool given : {false, true}) {
         const std::string kind = given ? "given_normals" : "estimated_normals";
         md += given ? "## Whole pipeline, points and normals to labels\n\n"
                     : "## Whole pipeline, points to labels (normals estimated)\n\n";
         md +=
-            "Milliseconds per frame; in brackets, multiples of a memcpy of the same input bytes. PCL: organized "
-            "edge-aware segmentation with its integral-image normals (it has no given-normals variant here).\n\n";
+            "Milliseconds per frame; in brackets, multiples of a memcpy of the same input bytes; fill rounds: the "
+            "sweep rounds a sweeping backend needed. PCL: OrganizedConnectedComponentSegmentation with "
+            "EdgeAwarePlaneComparator, ";
+        md += given ? "once with its integral-image normals (its whole pipeline) and once with the scene's normals "
+                      "(its labelling alone).\n\n"
+                    : "with its integral-image normals.\n\n";
+        std::vector<std::pair<std::string, std::string>> peers = {{"PCL", "estimated_normals"}};
+        if (given) peers = {{"PCL, its normals", "estimated_normals"}, {"PCL, these normals", "given_normals"}};
+        const auto peer_entry = [&](const std::string& peer_kind, const Size& s) {
+            return find(entries, "pcl/organized_edge_aware/" + s.name + "/" + peer_kind);
+        };
         std::vector<std::string> head = {"frame", "memcpy"};
         for (const std::string& b : backends) head.push_back(b);
-        head.emplace_back("PCL");
-        for (const std::string& b : backends) head.push_back("PCL ÷ " + b);
+        head.emplace_back("fill rounds");
+        for (const auto& p : peers) head.push_back(p.first);
+        for (const auto& p : peers) {
+            for (const std::string& b : backends) head.push_back(p.first + " ÷ " + b);
+        }
         md += header(head);
         for (const Size& s : sizes) {
             const Entry* copy = find(entries, "memcpy/" + s.name + "/" + kind);
-            const Entry* pcl = find(entries, "pcl/organized_edge_aware/" + s.name + "/estimated_normals");
             std::vector<std::string> row = {s.name, copy != nullptr ? sig3(copy->ms) + " ms" : "—"};
+            std::string rounds = "—";
             for (const std::string& b : backends) {
                 const Entry* e = find(entries, "pipeline/" + b + "/" + s.name + "/" + kind);
                 std::string cell = ms_cell(e);
                 if (e != nullptr && e->error.empty() && copy != nullptr)
                     cell += " (" + ratio_cell(ratio(e, copy)) + ")";
                 row.push_back(cell);
+                const auto rounds_it =
+                    e != nullptr ? e->counters.find("fill_rounds") : std::map<std::string, double>::const_iterator{};
+                if (e != nullptr && rounds_it != e->counters.end() && rounds_it->second > 0)
+                    rounds = fixed(rounds_it->second, 0);
             }
-            row.push_back(ms_cell(pcl));
-            for (const std::string& b : backends)
-                row.push_back(ratio_cell(ratio(pcl, find(entries, "pipeline/" + b + "/" + s.name + "/" + kind))));
+            row.push_back(rounds);
+            for (const auto& p : peers) row.push_back(ms_cell(peer_entry(p.second, s)));
+            for (const auto& p : peers) {
+                for (const std::string& b : backends) {
+                    row.push_back(ratio_cell(
+                        ratio(peer_entry(p.second, s), find(entries, "pipeline/" + b + "/" + s.name + "/" + kind))));
+                }
+            }
             md += table_row(row);
         }
         md += "\n";
@@ -327,7 +349,7 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     md += "\n";
 
     // Plots: x = megapixels.
-    r.vs_pcl.title = "PCL time / pyrseg time (higher: pyrseg faster)";
+    r.vs_pcl.title = "PCL time / pyrseg time, same normals (higher: pyrseg faster)";
     r.vs_pcl.x_label = "megapixels";
     r.vs_opencv.title = "pyrseg / OpenCV SAUF-4 (lower: pyrseg faster)";
     r.vs_opencv.x_label = "megapixels";
@@ -343,9 +365,10 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
         for (const bool given : {false, true}) {
             LineSeries line = series(backends[k] + (given ? " given n." : " est. n."), k, given);
             for (const Size& s : sizes) {
-                line.y.push_back(ratio(find(entries, "pcl/organized_edge_aware/" + s.name + "/estimated_normals"),
-                                       find(entries, "pipeline/" + backends[k] + "/" + s.name + "/" +
-                                                         (given ? "given_normals" : "estimated_normals"))));
+                // Like for like: both sides estimate their normals, or both are given the scene's.
+                const std::string kind = given ? "given_normals" : "estimated_normals";
+                line.y.push_back(ratio(find(entries, "pcl/organized_edge_aware/" + s.name + "/" + kind),
+                                       find(entries, "pipeline/" + backends[k] + "/" + s.name + "/" + kind)));
             }
             pcl_panel.series.push_back(line);
         }

@@ -415,6 +415,7 @@ TEST(Cli, BenchReportWritesRatiosAndPlots) {
                          entry("pipeline/cpu/640x480/estimated_normals", 10.0),
                          entry("pipeline/cpu/640x480/given_normals", 5.0),
                          entry("pcl/organized_edge_aware/640x480/estimated_normals", 150.0),
+                         entry("pcl/organized_edge_aware/640x480/given_normals", 8.0),
                          entry("stage/cpu/640x480", 3.0),
                          entry("opencv/sauf_4/640x480", 0.5)};
     doc["benchmarks"].push_back({{"name", "pipeline/vulkan/640x480/estimated_normals/real_time"},
@@ -429,6 +430,7 @@ TEST(Cli, BenchReportWritesRatiosAndPlots) {
     EXPECT_NE(md.find("| 640x480 | 0.100 ms | 10.0 ms (100×) |"), std::string::npos) << md;
     EXPECT_NE(md.find("15.0×"), std::string::npos) << "PCL 150 ms / cpu 10 ms\n" << md;
     EXPECT_NE(md.find("30.0×"), std::string::npos) << "PCL 150 ms / cpu with given normals 5 ms\n" << md;
+    EXPECT_NE(md.find("1.60×"), std::string::npos) << "PCL's labelling 8 ms / cpu with given normals 5 ms\n" << md;
     EXPECT_NE(md.find("6.00×"), std::string::npos) << "stage 3 ms / OpenCV 0.5 ms\n" << md;
     EXPECT_NE(md.find("too large for this device"), std::string::npos) << "skips keep their reason\n" << md;
     EXPECT_TRUE(fs::exists(dir / "bench_vs_pcl.png"));
