@@ -350,16 +350,19 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
 
     // Plots: x = megapixels.
     r.vs_pcl.title = "PCL time / pyrseg time, same normals (higher: pyrseg faster)";
-    r.vs_pcl.x_label = "megapixels";
+    r.vs_pcl.x_label = "frame, megapixels";
     r.vs_opencv.title = "pyrseg / OpenCV SAUF-4 (lower: pyrseg faster)";
-    r.vs_opencv.x_label = "megapixels";
+    r.vs_opencv.x_label = "frame, megapixels";
     LinePanel pcl_panel;
     pcl_panel.title = "whole pipeline";
     LinePanel cv_panel;
     cv_panel.title = "mask to labels";
+    // Frame sizes evenly spaced (they grow by factors of about 4), labelled with their megapixels.
     for (const Size& s : sizes) {
-        pcl_panel.x.push_back(s.megapixels);
-        cv_panel.x.push_back(s.megapixels);
+        for (LinePanel* panel : {&pcl_panel, &cv_panel}) {
+            panel->x.push_back(double(panel->x.size()));
+            panel->x_labels.push_back(sig3(s.megapixels));
+        }
     }
     for (std::size_t k = 0; k < backends.size(); ++k) {
         for (const bool given : {false, true}) {

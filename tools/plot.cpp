@@ -169,10 +169,10 @@ RgbImage render_line_chart(const LineChart& chart) {
             canvas.text(x0 - 10 - text_width(label), y - kLine / 2, label, kInk);
         }
         // x ticks.
-        for (const double v : panel.x) {
-            const int x = px(v);
+        for (std::size_t t = 0; t < panel.x.size(); ++t) {
+            const int x = px(panel.x[t]);
             canvas.line(x, y1, x, y1 + 6, 1, kInk);
-            const std::string label = number(v);
+            const std::string label = t < panel.x_labels.size() ? panel.x_labels[t] : number(panel.x[t]);
             canvas.text(x - text_width(label) / 2, y1 + 10, label, kInk);
         }
         canvas.text(x0 + (kPlotW - text_width(chart.x_label)) / 2, y1 + 10 + kLine + 10, chart.x_label, kInk);

@@ -19,7 +19,8 @@ struct LineSeries {
 
 struct LinePanel {
     std::string title;
-    std::vector<double> x;  // ascending; every x gets a tick
+    std::vector<double> x;              // ascending; every x gets a tick
+    std::vector<std::string> x_labels;  // the ticks' labels, one per x; empty: the x values themselves
     std::vector<LineSeries> series;
 };
 
