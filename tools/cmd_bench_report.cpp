@@ -138,6 +138,16 @@ std::vector<std::string> backends_in(const Entries& entries) {
     return out;
 }
 
+std::string pipeline_name(const std::string& backend, const std::string& size, const std::string& kind) {
+    std::string name = "pipeline/";
+    name += backend;
+    name += '/';
+    name += size;
+    name += '/';
+    name += kind;
+    return name;
+}
+
 std::string table_row(const std::vector<std::string>& cells) {
     std::string row = "|";
     for (const std::string& c : cells) row += " " + c + " |";
@@ -238,7 +248,7 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
             std::vector<std::string> row = {s.name, copy != nullptr ? sig3(copy->ms) + " ms" : "—"};
             std::string rounds = "—";
             for (const std::string& b : backends) {
-                const Entry* e = find(entries, "pipeline/" + b + "/" + s.name + "/" + kind);
+                const Entry* e = find(entries, pipeline_name(b, s.name, kind));
                 std::string cell = ms_cell(e);
                 if (e != nullptr && e->error.empty() && copy != nullptr)
                     cell += " (" + ratio_cell(ratio(e, copy)) + ")";
@@ -252,8 +262,8 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
             for (const auto& p : peers) row.push_back(ms_cell(peer_entry(p.second, s)));
             for (const auto& p : peers) {
                 for (const std::string& b : backends) {
-                    row.push_back(ratio_cell(
-                        ratio(peer_entry(p.second, s), find(entries, "pipeline/" + b + "/" + s.name + "/" + kind))));
+                    row.push_back(
+                        ratio_cell(ratio(peer_entry(p.second, s), find(entries, pipeline_name(b, s.name, kind)))));
                 }
             }
             md += table_row(row);
@@ -302,7 +312,10 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
         "## The fills' worst cases\n\nOne winding region of 8-pixel corridors; sweep rounds are what a sweeping "
         "backend needed (the CPU fills by union-find: 0).\n\n";
     md += header({"case", "frame", "backend", "frame time", "fill time", "sweep rounds"});
-    for (const auto& [name, e] : entries) {
+    for (const auto& named : entries) {
+        const std::string& name = named.first;
+        const Entry& e =
+            named.second;  // a plain reference: lambdas below capture it (clang 14 cannot capture bindings)
         if (name.rfind("fills/", 0) != 0) continue;
         std::vector<std::string> parts;
         std::stringstream in(name);

@@ -292,7 +292,7 @@ private:
     }
 
     void init_row(const PassContext& c, const PyrLevel& lv, const PyrLevel& parent, uint32_t y, uint32_t mode) {
-        uint32_t* out = labels_.data() + lv.offset + y * lv.width;
+        uint32_t* out = labels_.data() + lv.offset + size_t(y) * lv.width;
         for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, y, mode);
     }
 
