@@ -1,9 +1,11 @@
 #include "file_util.hpp"
 
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <system_error>
 
 namespace pyrseg::io::detail {
@@ -61,6 +63,25 @@ void write_file(const std::filesystem::path& path, const void* data, std::size_t
     }
     // Buffered data only reaches the disk at fclose, so a full disk shows up here.
     if (std::fclose(file.release()) != 0) fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+}
+
+void check_cloud_to_write(const std::filesystem::path& path, const PointCloud& cloud) {
+    if (cloud.width <= 0 || cloud.height <= 0 ||
+        static_cast<long long>(cloud.width) * cloud.height > static_cast<long long>(INT_MAX)) {
+        fail(ErrorCode::invalid_argument, path,
+             "cannot write a " + std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " cloud");
+    }
+    const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
+    if (cloud.points.size() != 3 * n) {
+        fail(ErrorCode::invalid_argument, path,
+             "cloud has " + std::to_string(cloud.points.size()) + " point values, expected 3 x " +
+                 std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " = " + std::to_string(3 * n));
+    }
+    if (!cloud.normals.empty() && cloud.normals.size() != 3 * n) {
+        fail(ErrorCode::invalid_argument, path,
+             "cloud has " + std::to_string(cloud.normals.size()) + " normal values, expected 0 or " +
+                 std::to_string(3 * n));
+    }
 }
 
 }  // namespace pyrseg::io::detail

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pyrseg/error.hpp"
+#include "pyrseg/io.hpp"
 
 namespace pyrseg::io::detail {
 
@@ -17,5 +18,9 @@ namespace pyrseg::io::detail {
 std::vector<unsigned char> read_file(const std::filesystem::path& path);
 
 void write_file(const std::filesystem::path& path, const void* data, std::size_t size);
+
+// What a cloud writer needs of its cloud: a positive size that fits int, 3 point values per pixel, and 0 or 3
+// normal values per pixel. ErrorCode::invalid_argument naming the file otherwise.
+void check_cloud_to_write(const std::filesystem::path& path, const PointCloud& cloud);
 
 }  // namespace pyrseg::io::detail

@@ -1,7 +1,6 @@
 // Writing PCD files the way PCL does: fields x y z [normal_x normal_y normal_z], all F 4, VERSION 0.7.
 #include <bit>
 #include <charconv>
-#include <climits>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -99,23 +98,9 @@ std::string compressed_body(const std::filesystem::path& path, const PointCloud&
 }  // namespace
 
 void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding) {
-    if (cloud.width <= 0 || cloud.height <= 0 ||
-        static_cast<long long>(cloud.width) * cloud.height > static_cast<long long>(INT_MAX)) {
-        fail(ErrorCode::invalid_argument, path,
-             "cannot write a " + std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " cloud");
-    }
+    detail::check_cloud_to_write(path, cloud);
     const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
-    if (cloud.points.size() != 3 * n) {
-        fail(ErrorCode::invalid_argument, path,
-             "cloud has " + std::to_string(cloud.points.size()) + " point values, expected 3 x " +
-                 std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " = " + std::to_string(3 * n));
-    }
     const bool normals = !cloud.normals.empty();
-    if (normals && cloud.normals.size() != 3 * n) {
-        fail(ErrorCode::invalid_argument, path,
-             "cloud has " + std::to_string(cloud.normals.size()) + " normal values, expected 0 or " +
-                 std::to_string(3 * n));
-    }
     std::string out;
     switch (encoding) {
         case PcdEncoding::ascii:

@@ -534,25 +534,6 @@ PointCloud to_cloud(const pcl::PCLPointCloud2& blob, const PlyHeader& h, const f
     return cloud;
 }
 
-void check_cloud(const fs::path& path, const PointCloud& cloud) {
-    if (cloud.width <= 0 || cloud.height <= 0 ||
-        static_cast<long long>(cloud.width) * cloud.height > static_cast<long long>(INT_MAX)) {
-        fail(ErrorCode::invalid_argument, path,
-             "cannot write a " + std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " cloud");
-    }
-    const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
-    if (cloud.points.size() != 3 * n) {
-        fail(ErrorCode::invalid_argument, path,
-             "cloud has " + std::to_string(cloud.points.size()) + " point values, expected 3 x " +
-                 std::to_string(cloud.width) + " x " + std::to_string(cloud.height) + " = " + std::to_string(3 * n));
-    }
-    if (!cloud.normals.empty() && cloud.normals.size() != 3 * n) {
-        fail(ErrorCode::invalid_argument, path,
-             "cloud has " + std::to_string(cloud.normals.size()) + " normal values, expected 0 or " +
-                 std::to_string(3 * n));
-    }
-}
-
 void add_field(pcl::PCLPointCloud2& blob, const char* name) {
     pcl::PCLPointField f;
     f.name = name;
@@ -597,7 +578,7 @@ PointCloud read_ply(const std::filesystem::path& path) {
 }
 
 void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels, bool binary) {
-    check_cloud(path, cloud);
+    detail::check_cloud_to_write(path, cloud);
     const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
     const bool normals = !cloud.normals.empty();
     pcl::PCLPointCloud2 blob;
