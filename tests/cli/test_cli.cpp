@@ -1,10 +1,8 @@
 // The pyrseg command-line tool, run as a user runs it: exit codes, messages, files written.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -15,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/cli_runner.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/synthetic.hpp"
@@ -23,25 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int status;
-    std::string output;  // stdout and stderr together
-};
-
-CliRun run_with_env(const std::string& env, const std::string& args) {
-    const std::string command = env + std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return {-1, "popen failed"};
-    std::string out;
-    std::array<char, 4096> buffer{};
-    while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-CliRun run(const std::string& args) {
-    return run_with_env("", args);
-}
+using pyrseg::cli_test::CliRun;
+using pyrseg::cli_test::run;
+using pyrseg::cli_test::run_with_env;
 
 fs::path temp_dir() {
     const fs::path dir = fs::temp_directory_path() / ("pyrseg_cli_test_" + std::to_string(::getpid()));

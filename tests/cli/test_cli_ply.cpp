@@ -2,15 +2,14 @@
 // --write ...,ply), run as a user runs it.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "cli/cli_runner.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -18,21 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct PlyCliRun {
-    int status;
-    std::string output;  // stdout and stderr together
-};
-
-PlyCliRun run_cli(const std::string& args) {
-    const std::string command = std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return {-1, "popen failed"};
-    std::string out;
-    std::array<char, 4096> buffer{};
-    while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using pyrseg::cli_test::CliRun;
+using pyrseg::cli_test::run;
 
 class CliPly : public ::testing::Test {
 protected:
@@ -72,11 +58,11 @@ TEST_F(CliPly, PlyInputGivesTheLabelsOfTheSameCloudAsPcdAndPlyOutReadsBack) {
     const pyrseg::io::PointCloud cloud = scene_cloud(3);
     pyrseg::io::write_pcd(dir_ / "frame.pcd", cloud, pyrseg::io::PcdEncoding::binary);
     pyrseg::io::write_ply(dir_ / "frame.ply", cloud, nullptr, true);
-    PlyCliRun r =
-        run_cli("segment " + (dir_ / "frame.pcd").string() + " --backend cpu --labels " + (dir_ / "pcd.npy").string());
+    CliRun r =
+        run("segment " + (dir_ / "frame.pcd").string() + " --backend cpu --labels " + (dir_ / "pcd.npy").string());
     ASSERT_EQ(r.status, 0) << r.output;
-    r = run_cli("segment " + (dir_ / "frame.ply").string() + " --backend cpu --labels " + (dir_ / "ply.npy").string() +
-                " --ply " + (dir_ / "segments.ply").string());
+    r = run("segment " + (dir_ / "frame.ply").string() + " --backend cpu --labels " + (dir_ / "ply.npy").string() +
+            " --ply " + (dir_ / "segments.ply").string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("PLY, 96 x 72, normals estimated"), std::string::npos) << r.output;
     const std::vector<unsigned char> from_pcd = labels_of(dir_ / "pcd.npy");
@@ -97,8 +83,7 @@ TEST_F(CliPly, PlyInputGivesTheLabelsOfTheSameCloudAsPcdAndPlyOutReadsBack) {
         }
     }
     // The PLY written is itself an input that gives the same labels.
-    r = run_cli("segment " + (dir_ / "segments.ply").string() + " --backend cpu --labels " +
-                (dir_ / "again.npy").string());
+    r = run("segment " + (dir_ / "segments.ply").string() + " --backend cpu --labels " + (dir_ / "again.npy").string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(labels_of(dir_ / "again.npy"), from_pcd);
 }
@@ -107,8 +92,8 @@ TEST_F(CliPly, BatchWritesPlyAndNeverOverwritesItsInput) {
     fs::create_directories(dir_ / "in");
     pyrseg::io::write_ply(dir_ / "in" / "a.ply", scene_cloud(5), nullptr, true);
     pyrseg::io::write_pcd(dir_ / "in" / "b.pcd", scene_cloud(6), pyrseg::io::PcdEncoding::binary);
-    PlyCliRun r = run_cli("segment " + (dir_ / "in").string() + " --out-dir " + (dir_ / "out").string() +
-                          " --write labels,ply --progress lines --backend cpu");
+    CliRun r = run("segment " + (dir_ / "in").string() + " --out-dir " + (dir_ / "out").string() +
+                   " --write labels,ply --progress lines --backend cpu");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("batch: 2 frames, 2 segmented, 0 failed"), std::string::npos) << r.output;
     for (const char* name : {"a", "b"}) {
@@ -119,11 +104,11 @@ TEST_F(CliPly, BatchWritesPlyAndNeverOverwritesItsInput) {
     }
     // Into the input's own folder, NAME.ply would replace the input: refused, the input untouched.
     const auto before = fs::file_size(dir_ / "in" / "a.ply");
-    r = run_cli("segment " + (dir_ / "in" / "a.ply").string() + " --out-dir " + (dir_ / "in").string() +
-                " --write ply --progress lines --backend cpu");
+    r = run("segment " + (dir_ / "in" / "a.ply").string() + " --out-dir " + (dir_ / "in").string() +
+            " --write ply --progress lines --backend cpu");
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("refusing to overwrite"), std::string::npos) << r.output;
-    r = run_cli("segment " + (dir_ / "in" / "a.ply").string() + " --ply " + (dir_ / "in" / "a.ply").string());
+    r = run("segment " + (dir_ / "in" / "a.ply").string() + " --ply " + (dir_ / "in" / "a.ply").string());
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_EQ(fs::file_size(dir_ / "in" / "a.ply"), before);
     EXPECT_NO_THROW(pyrseg::io::read_ply(dir_ / "in" / "a.ply"));
@@ -131,11 +116,11 @@ TEST_F(CliPly, BatchWritesPlyAndNeverOverwritesItsInput) {
 
 TEST_F(CliPly, DepthImageOptionsAndUnorganizedPlyAreRefused) {
     pyrseg::io::write_ply(dir_ / "a.ply", scene_cloud(7), nullptr, true);
-    PlyCliRun r = run_cli("segment " + (dir_ / "a.ply").string() + " --intrinsics 500,500,48,36 --labels " +
-                          (dir_ / "o.npy").string());
+    CliRun r = run("segment " + (dir_ / "a.ply").string() + " --intrinsics 500,500,48,36 --labels " +
+                   (dir_ / "o.npy").string());
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("--intrinsics applies to depth images, not to .ply"), std::string::npos) << r.output;
-    r = run_cli("segment " + (dir_ / "a.ply").string() + " --out-dir " + (dir_ / "o").string() + " --write ply,bogus");
+    r = run("segment " + (dir_ / "a.ply").string() + " --out-dir " + (dir_ / "o").string() + " --write ply,bogus");
     EXPECT_EQ(r.status, 2) << r.output;
     FILE* f = std::fopen((dir_ / "flat.ply").c_str(), "w");
     ASSERT_NE(f, nullptr);
@@ -144,7 +129,7 @@ TEST_F(CliPly, DepthImageOptionsAndUnorganizedPlyAreRefused) {
         "end_header\n1 2 3\n4 5 6\n",
         f);
     std::fclose(f);
-    r = run_cli("segment " + (dir_ / "flat.ply").string() + " --labels " + (dir_ / "o.npy").string());
+    r = run("segment " + (dir_ / "flat.ply").string() + " --labels " + (dir_ / "o.npy").string());
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("flat.ply: PLY cloud is not organized"), std::string::npos) << r.output;
 }
@@ -152,7 +137,7 @@ TEST_F(CliPly, DepthImageOptionsAndUnorganizedPlyAreRefused) {
 #else
 
 TEST_F(CliPly, WithoutPclPlyIsAClearError) {
-    const PlyCliRun r = run_cli("segment " + (dir_ / "a.ply").string() + " --labels " + (dir_ / "o.npy").string());
+    const CliRun r = run("segment " + (dir_ / "a.ply").string() + " --labels " + (dir_ / "o.npy").string());
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("without PLY support"), std::string::npos) << r.output;
 }

@@ -2,9 +2,7 @@
 // no more ground-truth objects than plain connected components once bridges are added (the paper's claim).
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,27 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "cli/cli_runner.hpp"
 #include "pyrseg/io.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int status;
-    std::string output;
-};
-
-CliRun run(const std::string& args) {
-    const std::string command = std::string(PYRSEG_CLI_PATH) + " " + args + " 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return {-1, "popen failed"};
-    std::string out;
-    std::array<char, 4096> buffer{};
-    while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using pyrseg::cli_test::CliRun;
+using pyrseg::cli_test::run;
 
 std::vector<std::string> cells_of(const std::string& row) {
     std::vector<std::string> cells;

@@ -245,6 +245,26 @@ inline std::string outcome(const std::function<void()>& f, std::string* message 
     }
 }
 
+// Runs `load` on the file; expects a pyrseg::Error of the given code naming the file, and returns its message.
+inline std::string expect_load_error(const fs::path& path, const std::function<void()>& load,
+                                     ErrorCode expected_code = ErrorCode::format) {
+    std::string message;
+    ErrorCode code{};
+    const std::string result = outcome(load, &message, &code);
+    EXPECT_EQ(result, "error") << "loaded without error: " << read_bytes(path).substr(0, 300);
+    if (result == "error") {
+        EXPECT_EQ(code, expected_code) << message;
+        EXPECT_NE(message.find(path.filename().string()), std::string::npos) << "message names no file: " << message;
+    }
+    return message;
+}
+
+inline void expect_load_error_containing(const fs::path& path, const std::function<void()>& load,
+                                         const std::string& text) {
+    const std::string message = expect_load_error(path, load);
+    EXPECT_NE(message.find(text), std::string::npos) << "'" << text << "' not in: " << message;
+}
+
 inline const std::vector<std::string>& encodings() {
     static const std::vector<std::string> names = {"ascii", "binary", "binary_compressed"};
     return names;

@@ -35,22 +35,14 @@ std::string join_lines(const std::vector<std::string>& lines) {
     return s;
 }
 
-// Loads the file; expects a pyrseg::Error of the given code naming the file, and returns its message.
 std::string expect_error(const fs::path& path, ErrorCode expected_code = ErrorCode::format) {
-    std::string message;
-    ErrorCode code{};
-    const std::string result = outcome([&] { read_pcd(path); }, &message, &code);
-    EXPECT_EQ(result, "error") << "loaded without error: " << read_bytes(path).substr(0, 300);
-    if (result == "error") {
-        EXPECT_EQ(code, expected_code) << message;
-        EXPECT_NE(message.find(path.filename().string()), std::string::npos) << "message names no file: " << message;
-    }
-    return message;
+    return expect_load_error(
+        path, [&] { read_pcd(path); }, expected_code);
 }
 
 void expect_error_containing(const fs::path& path, const std::string& text) {
-    const std::string message = expect_error(path);
-    EXPECT_NE(message.find(text), std::string::npos) << "'" << text << "' not in: " << message;
+    expect_load_error_containing(
+        path, [&] { read_pcd(path); }, text);
 }
 
 class PcdMalformed : public ::testing::TestWithParam<std::string> {
