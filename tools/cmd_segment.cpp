@@ -130,12 +130,6 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     return {line, result.segment_count, elapsed.count()};
 }
 
-bool supported_input(const fs::path& p) {
-    std::string ext = p.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".pcd" || ext == ".ply" || ext == ".npy" || ext == ".png" || ext == ".tif" || ext == ".tiff";
-}
-
 // Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
 std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
     std::vector<fs::path> inputs;
@@ -144,7 +138,7 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
         if (fs::is_directory(name, ec)) {
             std::vector<fs::path> found;
             for (const fs::directory_entry& e : fs::directory_iterator(name, ec)) {
-                if (e.is_regular_file(ec) && supported_input(e.path())) found.push_back(e.path());
+                if (e.is_regular_file(ec) && is_supported_input(e.path())) found.push_back(e.path());
             }
             std::sort(found.begin(), found.end());
             if (found.empty())

@@ -34,5 +34,7 @@ struct LoadedInput {
     bool millimetres;  // the cloud is in millimetres whatever --unit-mm says
 };
 [[nodiscard]] LoadedInput load_input(const std::filesystem::path& path, const Args& args);
+// Whether load_input reads files with this path's extension (batches pick such files out of folders).
+[[nodiscard]] bool is_supported_input(const std::filesystem::path& path);
 
 }  // namespace pyrseg::cli

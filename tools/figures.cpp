@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
-#include <queue>
 
 #include "pyrseg/io.hpp"
+#include "tools/eval/bridges.hpp"
 #include "tools/font5x7.hpp"
 
 namespace pyrseg::cli {
@@ -56,38 +56,6 @@ RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int 
     return img;
 }
 
-std::vector<std::uint32_t> connected_components(const std::vector<std::uint8_t>& fillable, int width, int height,
-                                                std::uint32_t* count) {
-    const std::size_t w = std::size_t(width);
-    const std::size_t h = std::size_t(height);
-    std::vector<std::uint32_t> labels(w * h, 0);
-    std::uint32_t next = 0;
-    std::queue<std::size_t> queue;
-    for (std::size_t start = 0; start < w * h; ++start) {
-        if (!fillable[start] || labels[start] != 0) continue;
-        labels[start] = ++next;
-        queue.push(start);
-        while (!queue.empty()) {
-            const std::size_t i = queue.front();
-            queue.pop();
-            const std::size_t x = i % w;
-            const std::size_t y = i / w;
-            const auto visit = [&](std::size_t j) {
-                if (fillable[j] && labels[j] == 0) {
-                    labels[j] = next;
-                    queue.push(j);
-                }
-            };
-            if (x > 0) visit(i - 1);
-            if (x + 1 < w) visit(i + 1);
-            if (y > 0) visit(i - w);
-            if (y + 1 < h) visit(i + w);
-        }
-    }
-    if (count != nullptr) *count = next;
-    return labels;
-}
-
 RgbImage side_by_side(const std::vector<Panel>& panels) {
     if (panels.empty()) return {};
     const int pw = panels.front().image.width;
@@ -113,7 +81,7 @@ RgbImage side_by_side(const std::vector<Panel>& panels) {
 
 RgbImage comparison_figure(const Result& r) {
     std::uint32_t ccl_count = 0;
-    const auto ccl = connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
+    const auto ccl = eval::connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
     return side_by_side({{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
                          {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
                          {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}});

@@ -18,11 +18,6 @@ struct RgbImage {
 [[nodiscard]] RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int height);
 [[nodiscard]] RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height);
 
-// Plain 4-connected components of the fillable mask (no pyramid): what bridges do to ordinary labelling.
-// Labels are 1..count in row-major order of first appearance.
-[[nodiscard]] std::vector<std::uint32_t> connected_components(const std::vector<std::uint8_t>& fillable, int width,
-                                                              int height, std::uint32_t* count);
-
 struct Panel {
     std::string caption;
     RgbImage image;

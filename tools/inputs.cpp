@@ -34,6 +34,14 @@ std::string lower_extension(const std::filesystem::path& path) {
     return ext;
 }
 
+bool is_cloud_extension(const std::string& ext) {
+    return ext == ".pcd" || ext == ".npy" || ext == ".ply";
+}
+
+bool is_depth_image_extension(const std::string& ext) {
+    return ext == ".png" || ext == ".tif" || ext == ".tiff";
+}
+
 io::Intrinsics intrinsics_from(const Args& args, const std::filesystem::path& input) {
     const auto text = args.value("intrinsics");
     const auto calib = args.value("calib");
@@ -58,9 +66,14 @@ io::Intrinsics intrinsics_from(const Args& args, const std::filesystem::path& in
 
 }  // namespace
 
+bool is_supported_input(const std::filesystem::path& path) {
+    const std::string ext = lower_extension(path);
+    return is_cloud_extension(ext) || is_depth_image_extension(ext);
+}
+
 LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
     const std::string ext = lower_extension(path);
-    if (ext == ".pcd" || ext == ".npy" || ext == ".ply") {
+    if (is_cloud_extension(ext)) {
         for (const std::string& option : kInputValueOptions) {
             if (args.value(option)) {
                 std::string message = "--" + option;
@@ -72,7 +85,7 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
         if (ext == ".ply") return {io::read_ply(path), "PLY", false};
         return {io::read_pcd(path), "PCD", false};
     }
-    if (ext == ".png" || ext == ".tif" || ext == ".tiff") {
+    if (is_depth_image_extension(ext)) {
         if (args.value("unit-mm")) {
             throw UsageError{"--unit-mm applies to point clouds; a depth image's units are set by --depth-scale"};
         }
