@@ -19,6 +19,9 @@
 #include "tools/eval/metrics.hpp"
 #include "tools/figures.hpp"
 #include "tools/plot.hpp"
+#ifdef PYRSEG_HAVE_PCL_PEER
+#include "peers/pcl_segmentation.hpp"
+#endif
 
 namespace pyrseg::cli {
 namespace {
@@ -33,6 +36,9 @@ constexpr const char* kEvalUsage =
     "and spheres touching each other in a bin; seeds 1..N), comparing two labellings of the SAME fillable mask:\n"
     "  pyramid   pyrseg's pyramid (CPU backend, default parameters) through Segmenter::segment_mask\n"
     "  CC        plain 4-connected components of the mask, with the same edge labelling (contract step 6c)\n"
+    "  PCL       at bridge width 0 only (it makes its own edges from the cloud, so bridges cannot be added to its\n"
+    "            input): PCL's organized segmentation of the same cloud, OrganizedConnectedComponentSegmentation\n"
+    "            with EdgeAwarePlaneComparator on integral-image normals (when pyrseg is built with PCL)\n"
     "The mask is the one pyrseg computes from the scene's points (normals estimated). Bridge width 0 evaluates it\n"
     "as it is (the pyramid's labels are then exactly `pyrseg segment`'s); a width W >= 1 first adds one bridge per\n"
     "pair of neighbouring ground-truth objects: a W-pixel-wide strip of fillable pixels across the edge band\n"
@@ -124,8 +130,9 @@ struct Cell {
     int bridge = 0;
     int frames = 0;
     std::uint64_t objects = 0;
-    std::uint64_t sites = 0;  // bridges drawn (0 for width 0)
-    MethodTotals pyramid, cc;
+    std::uint64_t sites = 0;        // bridges drawn (0 for width 0)
+    MethodTotals pyramid, cc, pcl;  // pcl: bridge width 0 only
+    int pcl_frames = 0;
 };
 
 double rate(std::uint64_t n, std::uint64_t of) {
@@ -163,8 +170,27 @@ std::vector<std::uint8_t> valid_pixels(const synthetic::Scene& scene, const std:
 }
 
 // One scene at one noise level, evaluated at every bridge width; cells[b] is the cell of bridges[b].
+// PCL's organized segmentation of the scene's cloud, when pyrseg is built with it; null otherwise.
+struct PclPeer {
+#ifdef PYRSEG_HAVE_PCL_PEER
+    peers::PclOrganizedSegmentation segmentation;
+    std::vector<std::uint32_t> labels;
+    const std::vector<std::uint32_t>* run(const synthetic::Scene& scene) {
+        segmentation.set_cloud(scene.points.data(), nullptr, scene.width, scene.height);
+        // Regions of at least 100 points, as PCL's organized plane segmentation keeps them: the rest of its
+        // output is single points and slivers its comparator did not join.
+        segmentation.run(&labels, 100);
+        return &labels;
+    }
+#else
+    const std::vector<std::uint32_t>* run(const synthetic::Scene& /*scene*/) {
+        return nullptr;
+    }
+#endif
+};
+
 void evaluate_scene(const Size& size, std::uint64_t seed, double noise, const std::vector<double>& bridges,
-                    Segmenter& segmenter, std::vector<Cell>& cells) {
+                    Segmenter& segmenter, PclPeer& pcl, std::vector<Cell>& cells) {
     synthetic::SceneOptions options;
     options.width = size.width;
     options.height = size.height;
@@ -208,6 +234,11 @@ void evaluate_scene(const Size& size, std::uint64_t seed, double noise, const st
         if (width > 0) cell.sites += sites.size();
         cell.pyramid.add(ps);
         cell.cc.add(cs);
+        if (width != 0) continue;
+        if (const std::vector<std::uint32_t>* labels = pcl.run(scene)) {
+            cell.pcl.add(eval::score(scene.object_id, *labels));
+            ++cell.pcl_frames;
+        }
     }
 }
 
@@ -215,8 +246,8 @@ std::string table(const std::vector<Cell>& cells) {
     std::ostringstream out;
     out << "| noise (mm) | bridge (px) | bridges | objects | merged: pyramid | merged: CC | split: pyramid | "
            "split: CC | ARI: pyramid | ARI: CC | labelled: pyramid | labelled: CC | segments: pyramid | "
-           "segments: CC |\n";
-    out << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "segments: CC | merged: PCL | split: PCL | ARI: PCL | segments: PCL |\n";
+    out << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Cell& c : cells) {
         const double frames = std::max(1, c.frames);
         out << "| " << format("%g", c.noise) << " | " << c.bridge << " | " << c.sites << " | " << c.objects << " | "
@@ -226,7 +257,14 @@ std::string table(const std::vector<Cell>& cells) {
             << format("%.1f%%", 100.0 * rate(c.pyramid.labelled, c.pyramid.pixels)) << " | "
             << format("%.1f%%", 100.0 * rate(c.cc.labelled, c.cc.pixels)) << " | "
             << format("%.1f", double(c.pyramid.segments) / frames) << " | "
-            << format("%.1f", double(c.cc.segments) / frames) << " |\n";
+            << format("%.1f", double(c.cc.segments) / frames) << " | ";
+        if (c.pcl_frames == 0) {
+            out << "— | — | — | — |\n";
+            continue;
+        }
+        out << count_and_rate(c.pcl.merged, c.objects) << " | " << count_and_rate(c.pcl.split, c.objects) << " | "
+            << format("%.3f", c.pcl.ari_sum / c.pcl_frames) << " | "
+            << format("%.1f", double(c.pcl.segments) / c.pcl_frames) << " |\n";
     }
     return out.str();
 }
@@ -248,25 +286,33 @@ LineChart chart_of(const std::vector<Cell>& cells, const std::vector<double>& no
         panel.x = bridges;
         LineSeries pyr{"pyramid", {230, 97, 1}, false, {}};
         LineSeries cc{"connected components", {33, 102, 172}, true, {}};
+        LineSeries pcl{"PCL (no bridges added)", {40, 160, 60}, false, {}};
         for (std::size_t b = 0; b < bridges.size(); ++b) {
             const Cell& c = cells[n * bridges.size() + b];
             const double frames = std::max(1, c.frames);
+            const double pcl_frames = c.pcl_frames;
+            const double none = std::nan("");
             switch (what) {
                 case Plotted::merged:
                     pyr.y.push_back(rate(c.pyramid.merged, c.objects));
                     cc.y.push_back(rate(c.cc.merged, c.objects));
+                    pcl.y.push_back(c.pcl_frames > 0 ? rate(c.pcl.merged, c.objects) : none);
                     break;
                 case Plotted::split:
                     pyr.y.push_back(rate(c.pyramid.split, c.objects));
                     cc.y.push_back(rate(c.cc.split, c.objects));
+                    pcl.y.push_back(c.pcl_frames > 0 ? rate(c.pcl.split, c.objects) : none);
                     break;
                 case Plotted::ari:
                     pyr.y.push_back(c.pyramid.ari_sum / frames);
                     cc.y.push_back(c.cc.ari_sum / frames);
+                    pcl.y.push_back(c.pcl_frames > 0 ? c.pcl.ari_sum / pcl_frames : none);
                     break;
             }
         }
         panel.series = {pyr, cc};
+        if (std::any_of(pcl.y.begin(), pcl.y.end(), [](double v) { return !std::isnan(v); }))
+            panel.series.push_back(pcl);
         chart.panels.push_back(panel);
     }
     return chart;
@@ -319,6 +365,7 @@ int cmd_eval(const std::vector<std::string>& argv) {
         outputs.fillable_mask = true;
         outputs.normals = true;
         Segmenter segmenter(size.width, size.height, Params{}, "cpu", outputs);
+        PclPeer pcl;
         std::vector<Cell> cells;
         for (const double noise : noises) {
             std::vector<Cell> row(bridges.size());
@@ -328,7 +375,7 @@ int cmd_eval(const std::vector<std::string>& argv) {
             }
             const auto cell_start = std::chrono::steady_clock::now();
             for (int seed = 1; seed <= seeds; ++seed) {
-                evaluate_scene(size, std::uint64_t(seed), noise, bridges, segmenter, row);
+                evaluate_scene(size, std::uint64_t(seed), noise, bridges, segmenter, pcl, row);
             }
             std::printf("%s, noise %g mm: %d scenes in %.1f s\n", size_name(size).c_str(), noise, seeds,
                         seconds_since(cell_start));
