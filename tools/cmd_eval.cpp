@@ -243,11 +243,14 @@ void evaluate_scene(const Size& size, std::uint64_t seed, double noise, const st
 }
 
 std::string table(const std::vector<Cell>& cells) {
+    // PCL's columns only when it was scored (pyrseg built with it).
+    const bool with_pcl = std::any_of(cells.begin(), cells.end(), [](const Cell& c) { return c.pcl_frames > 0; });
     std::ostringstream out;
     out << "| noise (mm) | bridge (px) | bridges | objects | merged: pyramid | merged: CC | split: pyramid | "
            "split: CC | ARI: pyramid | ARI: CC | labelled: pyramid | labelled: CC | segments: pyramid | "
-           "segments: CC | merged: PCL | split: PCL | ARI: PCL | segments: PCL |\n";
-    out << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "segments: CC |";
+    out << (with_pcl ? " merged: PCL | split: PCL | ARI: PCL | segments: PCL |\n" : "\n");
+    out << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" << (with_pcl ? "---|---|---|---|\n" : "\n");
     for (const Cell& c : cells) {
         const double frames = std::max(1, c.frames);
         out << "| " << format("%g", c.noise) << " | " << c.bridge << " | " << c.sites << " | " << c.objects << " | "
@@ -257,14 +260,16 @@ std::string table(const std::vector<Cell>& cells) {
             << format("%.1f%%", 100.0 * rate(c.pyramid.labelled, c.pyramid.pixels)) << " | "
             << format("%.1f%%", 100.0 * rate(c.cc.labelled, c.cc.pixels)) << " | "
             << format("%.1f", double(c.pyramid.segments) / frames) << " | "
-            << format("%.1f", double(c.cc.segments) / frames) << " | ";
-        if (c.pcl_frames == 0) {
-            out << "— | — | — | — |\n";
-            continue;
+            << format("%.1f", double(c.cc.segments) / frames) << " |";
+        if (!with_pcl) {
+            out << "\n";
+        } else if (c.pcl_frames == 0) {
+            out << " — | — | — | — |\n";
+        } else {
+            out << " " << count_and_rate(c.pcl.merged, c.objects) << " | " << count_and_rate(c.pcl.split, c.objects)
+                << " | " << format("%.3f", c.pcl.ari_sum / c.pcl_frames) << " | "
+                << format("%.1f", double(c.pcl.segments) / c.pcl_frames) << " |\n";
         }
-        out << count_and_rate(c.pcl.merged, c.objects) << " | " << count_and_rate(c.pcl.split, c.objects) << " | "
-            << format("%.3f", c.pcl.ari_sum / c.pcl_frames) << " | "
-            << format("%.1f", double(c.pcl.segments) / c.pcl_frames) << " |\n";
     }
     return out.str();
 }
