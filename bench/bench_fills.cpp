@@ -15,7 +15,6 @@
 
 #include "bench/bench_scenes.hpp"
 #include "pyrseg/backend.hpp"
-#include "pyrseg/error.hpp"
 
 namespace pyrseg::bench {
 namespace {
@@ -95,28 +94,9 @@ const Mask& worst_case(const std::string& kind, int width, int height) {
 void fill_worst_case(benchmark::State& state, const std::string& backend, const std::string& kind, int width,
                      int height) {
     const Mask& m = worst_case(kind, width, height);
-    std::unique_ptr<Segmenter> segmenter;
-    try {
-        segmenter = std::make_unique<Segmenter>(width, height, Params{}, backend);
-    } catch (const Error& e) {
-        state.SkipWithError(e.what());
-        return;
-    }
     const MaskView view{m.fillable.data(), nullptr, width, height};
-    Result result;
-    segmenter->segment_mask(view, result);
-    double fill_ms = 0;
-    for (auto _ : state) {
-        segmenter->segment_mask(view, result);
-        for (const PassTiming& t : segmenter->last_timings())
-            fill_ms += std::string(t.pass) == "fill" ? t.milliseconds : 0;
-        benchmark::DoNotOptimize(result.labels.data());
-    }
-    state.counters["fill_ms"] = benchmark::Counter(fill_ms / double(state.iterations()));
-    state.counters["fill_rounds"] = segmenter->last_fill_rounds();
-    state.counters["segments"] = result.segment_count;
-    state.counters["Mpix/s"] =
-        benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+    time_frames(state, backend, width, height, std::size_t(width) * std::size_t(height),
+                [&](Segmenter& segmenter, Result& result) { segmenter.segment_mask(view, result); });
 }
 
 int register_all() {

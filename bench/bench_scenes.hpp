@@ -1,6 +1,8 @@
 #pragma once
 // What every benchmark of pyrseg_bench shares: the frame sizes, one synthetic scene per size (generated once), and
 // the fillable mask pyrseg computes for it (the common input of the labelling peers).
+#include <benchmark/benchmark.h>
+
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -8,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -53,6 +56,39 @@ inline const SceneMask& scene_mask(int width, int height) {
         for (std::size_t i = 0; i < slot->valid.size(); ++i) slot->valid[i] = s.object_id[i] != 0 ? 1 : 0;
     }
     return *slot;
+}
+
+// Times `frame(segmenter, result)` (one frame into result) on a Segmenter of `backend`: once to size everything,
+// then once per iteration. Reports per-pass counters (`<pass>_ms`, milliseconds per frame as
+// Segmenter::last_timings() gives them: host times, or the device's timestamps where a backend queues the frame),
+// the fills' sweep rounds, the segment count, Mpix/s and input bytes/s. A backend that cannot take the frame (a device
+// limit) is reported as skipped with its reason.
+template <class Frame>
+void time_frames(benchmark::State& state, const std::string& backend, int width, int height, std::size_t input_bytes,
+                 const Frame& frame) {
+    std::unique_ptr<Segmenter> segmenter;
+    try {
+        segmenter = std::make_unique<Segmenter>(width, height, Params{}, backend);
+    } catch (const Error& e) {
+        state.SkipWithError(e.what());
+        return;
+    }
+    Result result;
+    frame(*segmenter, result);
+    std::map<std::string, double> pass_ms;
+    for (auto _ : state) {
+        frame(*segmenter, result);
+        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
+        benchmark::DoNotOptimize(result.labels.data());
+    }
+    for (const auto& [pass, ms] : pass_ms) {
+        state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
+    }
+    state.counters["fill_rounds"] = segmenter->last_fill_rounds();
+    state.counters["segments"] = result.segment_count;
+    state.counters["Mpix/s"] =
+        benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(input_bytes));
 }
 
 }  // namespace pyrseg::bench

@@ -6,78 +6,27 @@
 #include <benchmark/benchmark.h>
 
 #include <cstring>
-#include <map>
 #include <string>
 #include <vector>
 
 #include "bench/bench_scenes.hpp"
 #include "pyrseg/backend.hpp"
-#include "pyrseg/error.hpp"
 
 namespace pyrseg::bench {
 namespace {
 
-// Per-pass counters (milliseconds per frame, as Segmenter::last_timings() reports them: host times, or the device's
-// timestamps where a backend queues the frame), the segment count and throughput.
-void report(benchmark::State& state, const std::map<std::string, double>& pass_ms, const Result& result,
-            std::uint32_t fill_rounds, std::size_t input_bytes) {
-    state.counters["fill_rounds"] = fill_rounds;
-    for (const auto& [pass, ms] : pass_ms) {
-        state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
-    }
-    state.counters["segments"] = result.segment_count;
-    state.counters["Mpix/s"] =
-        benchmark::Counter(double(result.width) * result.height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(input_bytes));
-}
-
-// A backend that cannot take this frame (a device limit) is reported as skipped with its reason.
-template <class Make>
-bool make_segmenter(benchmark::State& state, std::unique_ptr<Segmenter>& out, const Make& make) {
-    try {
-        out = make();
-        return true;
-    } catch (const Error& e) {
-        state.SkipWithError(e.what());
-        return false;
-    }
-}
-
 void pipeline(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals) {
     const synthetic::Scene& s = scene(width, height);
-    std::unique_ptr<Segmenter> segmenter;
-    if (!make_segmenter(state, segmenter,
-                        [&] { return std::make_unique<Segmenter>(width, height, Params{}, backend); }))
-        return;
     const CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
-    Result result;
-    segmenter->segment(view, result);
-    std::map<std::string, double> pass_ms;
-    for (auto _ : state) {
-        segmenter->segment(view, result);
-        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
-        benchmark::DoNotOptimize(result.labels.data());
-    }
-    report(state, pass_ms, result, segmenter->last_fill_rounds(),
-           std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1));
+    time_frames(state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
+                [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); });
 }
 
 void stage(benchmark::State& state, const std::string& backend, int width, int height) {
     const SceneMask& m = scene_mask(width, height);
-    std::unique_ptr<Segmenter> segmenter;
-    if (!make_segmenter(state, segmenter,
-                        [&] { return std::make_unique<Segmenter>(width, height, Params{}, backend); }))
-        return;
     const MaskView view{m.fillable.data(), m.valid.data(), width, height};
-    Result result;
-    segmenter->segment_mask(view, result);
-    std::map<std::string, double> pass_ms;
-    for (auto _ : state) {
-        segmenter->segment_mask(view, result);
-        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
-        benchmark::DoNotOptimize(result.labels.data());
-    }
-    report(state, pass_ms, result, segmenter->last_fill_rounds(), std::size_t(width) * std::size_t(height));
+    time_frames(state, backend, width, height, std::size_t(width) * std::size_t(height),
+                [&](Segmenter& segmenter, Result& result) { segmenter.segment_mask(view, result); });
 }
 
 // The floor: copying the bytes a benchmark reads.
