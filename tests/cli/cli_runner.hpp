@@ -1,10 +1,14 @@
 #pragma once
-// Runs the pyrseg command-line tool as a user runs it (PYRSEG_CLI_PATH), for the CLI tests.
+// Runs the pyrseg command-line tool as a user runs it (PYRSEG_CLI_PATH), and makes the clouds the CLI tests feed it.
 #include <sys/wait.h>
 
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+
+#include "pyrseg/io.hpp"
+#include "pyrseg/synthetic.hpp"
 
 namespace pyrseg::cli_test {
 
@@ -27,6 +31,20 @@ inline CliRun run_with_env(const std::string& env, const std::string& args) {
 
 inline CliRun run(const std::string& args) {
     return run_with_env("", args);
+}
+
+// A synthetic bin-picking frame as a cloud file holds it: points in millimetres, no normals (the CLI estimates them).
+inline io::PointCloud scene_cloud(int width, int height, std::uint64_t seed, int object_count = 12) {
+    synthetic::SceneOptions o;
+    o.width = width;
+    o.height = height;
+    o.seed = seed;
+    o.object_count = object_count;
+    io::PointCloud cloud;
+    cloud.width = width;
+    cloud.height = height;
+    cloud.points = synthetic::generate(o).points;
+    return cloud;
 }
 
 }  // namespace pyrseg::cli_test

@@ -232,16 +232,7 @@ TEST(Cli, BatchOfFiftyFramesReportsProgressFailuresAndASummary) {
     const fs::path in = dir / "frames";
     fs::create_directories(in);
     for (int i = 0; i < 50; ++i) {
-        pyrseg::synthetic::SceneOptions o;
-        o.width = 96;
-        o.height = 72;
-        o.seed = std::uint64_t(i + 1);
-        o.object_count = 4;
-        const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
-        pyrseg::io::PointCloud cloud;
-        cloud.width = o.width;
-        cloud.height = o.height;
-        cloud.points = scene.points;
+        const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(96, 72, std::uint64_t(i + 1), 4);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%02d.pcd", i);
         pyrseg::io::write_pcd(in / name, cloud, pyrseg::io::PcdEncoding::binary);
@@ -338,15 +329,8 @@ TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
 // --stats writes what the library's statistics pass computed, as JSON or CSV; the pixel counts add up to the
 // labelled pixels of the --labels output of the same run.
 TEST(Cli, StatsAreWrittenAsJsonOrCsv) {
-    pyrseg::synthetic::SceneOptions o;
-    o.width = 160;
-    o.height = 120;
-    const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
     const fs::path dir = temp_dir();
-    pyrseg::io::PointCloud cloud;
-    cloud.width = o.width;
-    cloud.height = o.height;
-    cloud.points = scene.points;
+    const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(160, 120, 1);
     pyrseg::io::write_pcd(dir / "scene.pcd", cloud, pyrseg::io::PcdEncoding::binary);
     const CliRun r = run("segment " + (dir / "scene.pcd").string() + " --labels " + (dir / "l.npy").string() +
                          " --stats " + (dir / "s.json").string());

@@ -32,19 +32,9 @@ protected:
         fs::remove_all(dir_, ec);
     }
 
-    // A synthetic bin-picking frame (mm), without normals so that both runs estimate them the same way.
+    // A small synthetic bin-picking frame (mm), without normals so that both runs estimate them the same way.
     static pyrseg::io::PointCloud scene_cloud(std::uint64_t seed) {
-        pyrseg::synthetic::SceneOptions o;
-        o.width = 96;
-        o.height = 72;
-        o.seed = seed;
-        o.object_count = 4;
-        const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
-        pyrseg::io::PointCloud cloud;
-        cloud.width = o.width;
-        cloud.height = o.height;
-        cloud.points = scene.points;
-        return cloud;
+        return pyrseg::cli_test::scene_cloud(96, 72, seed, 4);
     }
 
     static std::vector<unsigned char> labels_of(const fs::path& npy) { return pyrseg::io::read_npy(npy).bytes; }
