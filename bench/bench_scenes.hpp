@@ -4,6 +4,8 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "pyrseg/error.hpp"
+#include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -35,7 +38,9 @@ inline const synthetic::Scene& scene(int width, int height) {
     return *slot;
 }
 
-// The scene's fillable mask B (0/1 per pixel) and validity, from the CPU backend with the given normals.
+// The scene's fillable mask B (0/1 per pixel) and validity, from the CPU backend with the given normals. With
+// PYRSEG_BENCH_MASKS=DIR each mask is also written as DIR/fillable_WxH.npy (uint8, H x W), so that a peer outside
+// this process (scripts/gpu_check/cupy_label.py: CuPy's label on the GPU) times the very same input.
 struct SceneMask {
     std::vector<std::uint8_t> fillable;
     std::vector<std::uint8_t> valid;
@@ -54,6 +59,11 @@ inline const SceneMask& scene_mask(int width, int height) {
         slot->fillable = r.fillable_mask;
         slot->valid.resize(r.fillable_mask.size());
         for (std::size_t i = 0; i < slot->valid.size(); ++i) slot->valid[i] = s.object_id[i] != 0 ? 1 : 0;
+        if (const char* dir = std::getenv("PYRSEG_BENCH_MASKS"); dir != nullptr && *dir != '\0') {
+            std::filesystem::create_directories(dir);
+            io::write_npy(std::filesystem::path(dir) / ("fillable_" + size_name(width, height) + ".npy"),
+                          slot->fillable.data(), height, width);
+        }
     }
     return *slot;
 }

@@ -176,6 +176,12 @@ void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int
                 n * sizeof(std::uint32_t));
 }
 
+void write_npy(const std::filesystem::path& path, const std::uint8_t* data, int height, int width) {
+    check_dims(path, data, height, width, 1);
+    const std::size_t n = static_cast<std::size_t>(height) * static_cast<std::size_t>(width);
+    write_array(path, "|u1", {static_cast<std::size_t>(height), static_cast<std::size_t>(width)}, data, n);
+}
+
 void write_npy(const std::filesystem::path& path, const float* data, int height, int width, int channels) {
     check_dims(path, data, height, width, channels);
     std::vector<std::size_t> shape = {static_cast<std::size_t>(height), static_cast<std::size_t>(width)};

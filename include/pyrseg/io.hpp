@@ -52,6 +52,7 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const
 
 // NumPy .npy (format 1.0), C order, little-endian.
 void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int height, int width);  // '<u4' H x W
+void write_npy(const std::filesystem::path& path, const std::uint8_t* data, int height, int width);   // '|u1' H x W
 void write_npy(const std::filesystem::path& path, const float* data, int height, int width,
                int channels);  // '<f4' H x W x C (C=1: H x W)
 

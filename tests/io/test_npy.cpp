@@ -58,6 +58,22 @@ TEST(Npy, Uint32LabelsRoundTrip) {
     EXPECT_EQ(std::memcmp(a.bytes.data(), labels.data(), a.bytes.size()), 0);
 }
 
+TEST(Npy, Uint8MasksRoundTrip) {
+    ScratchDir dir;
+    const int h = 4, w = 3;
+    const std::vector<std::uint8_t> mask = {0, 1, 1, 0, 255, 0, 1, 1, 1, 0, 0, 7};
+    write_npy(dir / "mask.npy", mask.data(), h, w);
+    const std::string bytes = read_bytes(dir / "mask.npy");
+    expect_numpy_header(bytes, "{'descr': '|u1', 'fortran_order': False, 'shape': (4, 3), }");
+    const RawNpy raw = split_npy(bytes);
+    ASSERT_EQ(raw.data.size(), mask.size());
+    EXPECT_EQ(std::memcmp(raw.data.data(), mask.data(), mask.size()), 0);
+    const NpyArray a = read_npy(dir / "mask.npy");
+    EXPECT_EQ(a.dtype, "|u1");
+    EXPECT_EQ(a.shape, (std::vector<std::size_t>{4, 3}));
+    EXPECT_EQ(a.bytes, std::vector<unsigned char>(mask.begin(), mask.end()));
+}
+
 TEST(Npy, FloatImagesRoundTrip) {
     ScratchDir dir;
     for (const int channels : {1, 3, 4}) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -122,8 +123,11 @@ inline std::vector<std::string> available_backend_names() {
     return names;
 }
 
+// The shared sample scans: $PYRSEG_DATA_DIR when set (a GPU machine has them in the prepared bundle, not beside
+// the checkout: scripts/gpu-check.sh), else the folder the build was configured with.
 inline std::string shared_data_dir() {
-    return PYRSEG_SHARED_DATA_DIR;
+    const char* dir = std::getenv("PYRSEG_DATA_DIR");
+    return dir != nullptr && *dir != '\0' ? std::string(dir) : std::string(PYRSEG_SHARED_DATA_DIR);
 }
 
 }  // namespace pyrseg::test

@@ -1,0 +1,382 @@
+#!/usr/bin/env bash
+# One command verifies every GPU backend on a GPU machine. GPU time is rare and short, so everything is built
+# beforehand, on a machine without a GPU, into a self-contained folder that travels with the checkout:
+#
+#   scripts/gpu-check.sh prepare            here: builds build/gpu/ (binaries, the .so files they need, test data)
+#   scripts/gpu-check.sh run [REPORT_DIR]   there: versions, conformance, compute-sanitizer, bench, CuPy's label,
+#                                           Vulkan and OpenCL on the NVIDIA driver; summary.md and logs in
+#                                           REPORT_DIR ($PYRSEG_GPU_REPORT, default build/gpu-report/)
+#   scripts/gpu-check.sh run --rehearse [REPORT_DIR]
+#                                           the same steps with the cpu backend standing in for the GPU ones, to
+#                                           test this script where there is no GPU; it checks nothing about GPUs
+#
+# backends/cuda/README.md gives the whole procedure and how long each step takes.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+bundle="${PYRSEG_GPU_BUNDLE:-$root/build/gpu}"
+bundle_limit_mib=48
+# The sample scans the tests read (tests/conformance): copied into the bundle, since a GPU machine has no ../shared.
+data_files=(table_scene_mug_stereo_textured.pcd milk_cartoon_all_small_clorox.pcd cape_depth_0.png
+            cape_calib_params.xml README.md LICENSE-PCL.txt LICENSE-CAPE.txt)
+binaries=(tests/pyrseg_test_conformance tests/pyrseg_test_unit bench/pyrseg_bench tools/pyrseg)
+fallback_libs=(libstdc++.so.6 libgcc_s.so.1 libGLX.so.0 libGLdispatch.so.0 libX11.so.6 libxcb.so.1 libXau.so.6
+               libXdmcp.so.6 libbsd.so.0 libmd.so.0)
+
+say() { printf 'gpu-check: %s\n' "$*"; }
+die() { printf 'gpu-check: %s\n' "$1" >&2; exit "${2:-1}"; }
+
+usage() {
+  sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'
+}
+
+# The newest glibc symbol version any of the given ELF files asks for (e.g. 2.34).
+glibc_needed() {
+  objdump -T "$@" 2>/dev/null | grep -o 'GLIBC_[0-9][0-9.]*' | sed 's/GLIBC_//' | sort -V | tail -n 1
+}
+
+prepare() {
+  local build="$root/build/gpu-build"
+  "$root/scripts/deps.sh"
+  command -v nvcc >/dev/null || die "prepare needs the CUDA compiler (nvcc) on the PATH"
+  local log
+  if ! log=$(cd "$root" && cmake --preset gpu-check 2>&1); then
+    echo "$log"
+    die "configuring the gpu-check preset failed"
+  fi
+  grep -E "^-- pyrseg" <<<"$log" || true
+  (cd "$root" && cmake --build --preset gpu-check)
+
+  rm -rf "$bundle"
+  mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/data"
+  for b in "${binaries[@]}"; do
+    cp "$build/$b" "$bundle/bin/"
+  done
+  strip --strip-unneeded "$bundle"/bin/*
+  # Every shared library the binaries load, except glibc's own (any Linux has them): the GPU machine has none of
+  # Debian's libraries (libpng, libtiff, OpenCV core, liblzf, Google Benchmark, the Vulkan and OpenCL loaders).
+  # libstdc++ travels too, so an older one there cannot stop the binaries. The binaries' RPATH is $ORIGIN/../lib
+  # (the preset), as DT_RPATH so that it also serves the libraries' own dependencies.
+  local lib name
+  while read -r lib; do
+    name="$(basename "$lib")"
+    case "$name" in
+      libc.so.* | libm.so.* | libdl.so.* | libpthread.so.* | librt.so.* | libresolv.so.* | ld-linux*) continue ;;
+    esac
+    cp -L "$lib" "$bundle/lib/$name"
+  done < <(ldd "$bundle"/bin/* | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u)
+  chmod u+w "$bundle"/lib/*
+  strip --strip-unneeded "$bundle"/lib/*
+  # Libraries a GPU machine most likely has already, and whose own copy should win there: the C++ runtime (Debian's
+  # needs glibc 2.36) and glvnd's GLX with X11 (OpenCV core links them; NVIDIA's Vulkan driver uses glvnd too).
+  # `run` uses these copies only for those its machine lacks.
+  mkdir -p "$bundle/lib/fallback"
+  for name in "${fallback_libs[@]}"; do
+    if [ -f "$bundle/lib/$name" ]; then mv "$bundle/lib/$name" "$bundle/lib/fallback/"; fi
+  done
+  if ldd "$bundle"/bin/* | grep -q "not found"; then
+    ldd "$bundle"/bin/* | grep "not found" >&2
+    die "a library the binaries need was not found"
+  fi
+
+  local data="${PYRSEG_SHARED_DATA_DIR:-$root/../shared/data}" missing=()
+  for f in "${data_files[@]}"; do
+    if [ -f "$data/$f" ]; then cp "$data/$f" "$bundle/data/"; else missing+=("$f"); fi
+  done
+  if ((${#missing[@]})); then
+    say "warning: not in $data: ${missing[*]} (the real-scan tests will be skipped on the GPU machine)"
+  fi
+
+  local glibc glibcxx
+  glibc="$(glibc_needed "$bundle"/bin/* "$bundle"/lib/*.so*)"
+  glibcxx="$(objdump -T "$bundle"/bin/* "$bundle"/lib/*.so* | grep -o 'GLIBCXX_[0-9][0-9.]*' | sort -V | tail -n 1)"
+  {
+    echo "commit: $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)$(
+      git -C "$root" diff --quiet HEAD 2>/dev/null || echo ' (with uncommitted changes)')"
+    echo "prepared: $(date -u '+%Y-%m-%d %H:%M UTC') on $(uname -n)"
+    echo "nvcc: $(nvcc --version | sed -n 's/.*release \([0-9.]*\).*/\1/p')"
+    echo "cuda architectures: $(sed -n 's/^CMAKE_CUDA_ARCHITECTURES:[A-Z]*=//p' "$build/CMakeCache.txt")"
+    echo "glibc needed: $glibc"
+    echo "libstdc++ needed: $glibcxx"
+    echo "glibc needed by lib/fallback: $(glibc_needed "$bundle"/lib/fallback/*)"
+    echo "backends built: $(grep -E '^-- pyrseg backend' <<<"$log" | grep -o 'backend [a-z]*: built' |
+      awk '{printf "%s%s", sep, substr($2, 1, length($2) - 1); sep=" "}')"
+  } >"$bundle/MANIFEST.txt"
+
+  local bytes mib
+  bytes=$(du -sb "$bundle" | cut -f1)
+  mib=$(awk -v b="$bytes" 'BEGIN {printf "%.1f", b / 1048576}')
+  say "bundle $bundle: $mib MiB (limit $bundle_limit_mib MiB); glibc >= $glibc needed"
+  du -sh "$bundle"/bin "$bundle"/lib "$bundle"/data | sed 's/^/  /'
+  if ((bytes >= bundle_limit_mib * 1048576)); then
+    die "the bundle is over $bundle_limit_mib MiB: it would slow every copy to the GPU machine"
+  fi
+  # The binaries must start on their own: what they say here (no GPU) is what a GPU machine shows otherwise.
+  say "the prepared binaries, started here:"
+  env -u LD_LIBRARY_PATH "$bundle/bin/pyrseg" backends | sed 's/^/  /'
+  say "next: copy the checkout with build/gpu to the GPU machine and run 'scripts/gpu-check.sh run' there"
+}
+
+# --- run -------------------------------------------------------------------------------------------------------
+
+backend_available() {  # backend_available NAME: from `pyrseg backends`, under the current environment
+  "$bundle/bin/pyrseg" backends | awk -v b="$1" '$1 == b && $2 == "available" {found = 1} END {exit !found}'
+}
+
+# The copies in lib/fallback that this machine needs: each one whose soname the machine lacks, and the C++ runtime
+# when the machine's is older than the one the binaries were built with. Linked into $work/fallback-lib.
+use_fallback_libs() {
+  local so name system need_cxx
+  need_cxx="$(sed -n 's/^libstdc++ needed: //p' "$bundle/MANIFEST.txt" 2>/dev/null || true)"
+  mkdir -p "$work/fallback-lib"
+  for so in "$bundle"/lib/fallback/*; do
+    [ -f "$so" ] || continue
+    name="$(basename "$so")"
+    system="$(ldconfig -p 2>/dev/null | awk -v n="$name" '$1 == n && !found {print $NF; found = 1}')"
+    if [ -z "$system" ] ||
+       { [ "$name" = libstdc++.so.6 ] && [ -n "$need_cxx" ] && ! grep -qa "$need_cxx" "$system"; }; then
+      ln -s "$so" "$work/fallback-lib/$name"
+    fi
+  done
+  if [ -n "$(find "$work/fallback-lib" -mindepth 1)" ]; then
+    say "using the bundle's own $(find "$work/fallback-lib" -mindepth 1 -printf '%f ') (not found on this machine)"
+    export LD_LIBRARY_PATH="$work/fallback-lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+  fi
+}
+
+# Points the carried Vulkan and OpenCL loaders at the NVIDIA driver when it is installed where they do not look
+# (a container with the driver mounted under /usr/local/nvidia, say).
+find_nvidia_drivers() {
+  local dir
+  for dir in /usr/local/nvidia/lib64 /usr/local/nvidia/lib /usr/lib/x86_64-linux-gnu/nvidia; do
+    [ -d "$dir" ] && export LD_LIBRARY_PATH="${LD_LIBRARY_PATH:+$LD_LIBRARY_PATH:}$dir"
+  done
+  if [ -z "${VK_DRIVER_FILES:-}${VK_ICD_FILENAMES:-}" ]; then
+    local json
+    for json in /usr/share/vulkan/icd.d/nvidia_icd.json /etc/vulkan/icd.d/nvidia_icd.json \
+                /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json /usr/local/nvidia/icd.d/nvidia_icd.json; do
+      if [ -f "$json" ]; then
+        export VK_DRIVER_FILES="$json" VK_ICD_FILENAMES="$json"
+        break
+      fi
+    done
+  fi
+  if [ -z "${OCL_ICD_VENDORS:-}" ] && [ ! -f /etc/OpenCL/vendors/nvidia.icd ]; then
+    local so
+    so="$(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ && !found {print $NF; found = 1}')"
+    for dir in /usr/local/nvidia/lib64 /usr/local/nvidia/lib; do
+      [ -z "$so" ] && [ -f "$dir/libnvidia-opencl.so.1" ] && so="$dir/libnvidia-opencl.so.1"
+    done
+    if [ -n "$so" ]; then
+      mkdir -p "$work/opencl-vendors"
+      echo "$so" >"$work/opencl-vendors/nvidia.icd"
+      export OCL_ICD_VENDORS="$work/opencl-vendors"
+    fi
+  fi
+}
+
+# run_sharded NAME BACKEND: the conformance suite for BACKEND, split over the machine's cores; XML per shard in $work.
+run_sharded() {
+  local name="$1" backend="$2" shards i status=0
+  shards=$(nproc)
+  ((shards > 16)) && shards=16
+  local filter="*/${backend}_*:*/${backend}"
+  local start=$SECONDS
+  for ((i = 0; i < shards; ++i)); do
+    GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i timeout "$test_timeout" \
+      "$bundle/bin/pyrseg_test_conformance" --gtest_filter="$filter" --gtest_brief=1 \
+      --gtest_output="xml:$work/xml/${name}_$i.xml" >"$work/logs/${name}_$i.log" 2>&1 &
+  done
+  for ((i = 0; i < shards; ++i)); do
+    wait -n || status=1
+  done
+  echo "$((SECONDS - start))" >"$work/time_$name"
+  {
+    echo "=== conformance, backend $backend ($shards shards, $((SECONDS - start)) s, exit ${status}) ==="
+    for ((i = 0; i < shards; ++i)); do
+      grep -v -e '^Running main()' -e '^Note: This is test shard' "$work/logs/${name}_$i.log" || true
+    done
+  } >>"$report/conformance.log"
+  say "conformance on $backend: $((SECONDS - start)) s, $( ((status)) && echo 'FAILURES' || echo 'all shards exited 0')"
+}
+
+# The small subset compute-sanitizer runs (each tool slows kernels 10-100x): tiny and odd sizes, a 160x120 frame,
+# saturating statistics, subnormal depths, strided clouds, the hand cases.
+sanitizer_subset() {
+  local b="$1"
+  echo "*/${b}_case3_*:*/${b}_case4_*:*/${b}_case5_*:*/${b}_case10_*:*/${b}_case13_*:*/${b}_case15_*:*FarPoints*/${b}:*TinyDepths*/${b}:*StridedClouds*/${b}:*HandCases*/${b}"
+}
+
+run_sanitizers() {
+  local tool pids=()
+  if ! command -v compute-sanitizer >/dev/null; then
+    for tool in memcheck racecheck synccheck initcheck; do echo "not run: compute-sanitizer is not on the PATH" \
+      >"$work/sanitizer_$tool.status"; done
+    return
+  fi
+  for tool in memcheck racecheck synccheck initcheck; do
+    (
+      set +e
+      timeout "$sanitizer_timeout" compute-sanitizer --tool "$tool" --error-exitcode 99 --print-limit 20 \
+        "$bundle/bin/pyrseg_test_conformance" --gtest_filter="$(sanitizer_subset cuda)" --gtest_brief=1 \
+        >"$work/logs/sanitizer_$tool.log" 2>&1
+      rc=$?
+      if grep -qiE "device not supported|not supported on this|unsupported device" "$work/logs/sanitizer_$tool.log"; then
+        echo "not supported on this machine" >"$work/sanitizer_$tool.status"
+      elif ((rc == 0)); then
+        echo "clean" >"$work/sanitizer_$tool.status"
+      elif ((rc == 99)); then
+        echo "errors" >"$work/sanitizer_$tool.status"
+      elif ((rc == 124)); then
+        echo "timed out after $sanitizer_timeout s" >"$work/sanitizer_$tool.status"
+      else
+        echo "failed (exit $rc)" >"$work/sanitizer_$tool.status"
+      fi
+    ) &
+    pids+=($!)
+  done
+  wait "${pids[@]}"
+  for tool in memcheck racecheck synccheck initcheck; do
+    echo "=== compute-sanitizer --tool $tool: $(cat "$work/sanitizer_$tool.status") ==="
+    cat "$work/logs/sanitizer_$tool.log"
+  done >"$report/sanitizers.log"
+  say "compute-sanitizer: $(for t in memcheck racecheck synccheck initcheck; do
+    printf '%s %s; ' "$t" "$(cat "$work/sanitizer_$t.status")"; done)"
+}
+
+run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME
+  local name="$1" start=$SECONDS rc=0
+  PYRSEG_BENCH_MASKS="$work/masks" timeout "$bench_timeout" "$bundle/bin/pyrseg_bench" \
+    --benchmark_filter="^(pipeline|stage)/($2)/($3)" --benchmark_min_time="$4" \
+    --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
+  say "bench $name: $((SECONDS - start)) s, exit $rc"
+}
+
+run() {
+  local rehearse=0
+  if [ "${1:-}" = "--rehearse" ]; then
+    rehearse=1
+    shift
+  fi
+  report="${1:-${PYRSEG_GPU_REPORT:-$root/build/gpu-report}}"
+  test_timeout=${PYRSEG_GPU_TEST_TIMEOUT:-300}
+  sanitizer_timeout=${PYRSEG_GPU_SANITIZER_TIMEOUT:-240}
+  bench_timeout=${PYRSEG_GPU_BENCH_TIMEOUT:-240}
+  [ -x "$bundle/bin/pyrseg" ] ||
+    die "no prepared bundle in $bundle: run 'scripts/gpu-check.sh prepare' on a build machine and bring build/gpu"
+  mkdir -p "$report"
+  rm -f "$report"/{summary.md,run.log,environment.txt,conformance.log,sanitizers.log,bench_cuda.json}
+  rm -f "$report"/{bench_other_gpus.json,bench_rehearsal.json,cupy_label.json}
+  work="$(mktemp -d)"
+  trap 'rm -rf "$work"' EXIT
+  mkdir -p "$work/xml" "$work/logs" "$work/masks"
+  exec > >(tee "$report/run.log") 2>&1
+  say "bundle $bundle; report $report"
+
+  local host_glibc need_glibc
+  host_glibc="$(getconf GNU_LIBC_VERSION 2>/dev/null | awk '{print $2}')"
+  need_glibc="$(sed -n 's/^glibc needed: //p' "$bundle/MANIFEST.txt" 2>/dev/null || true)"
+  if [ -n "$host_glibc" ] && [ -n "$need_glibc" ] &&
+     [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | head -n 1)" != "$need_glibc" ]; then
+    die "this machine's glibc is $host_glibc; the bundle needs $need_glibc (prepare it on an older distribution)" 3
+  fi
+  export PYRSEG_DATA_DIR="$bundle/data"
+  use_fallback_libs
+  if [ -e "$work/fallback-lib/libstdc++.so.6" ]; then
+    need_glibc="$(sed -n 's/^glibc needed by lib\/fallback: //p' "$bundle/MANIFEST.txt")"
+    if [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | head -n 1)" != "$need_glibc" ]; then
+      die "this machine's C++ runtime is older than the bundle's, and its glibc ($host_glibc) too old for the bundle's own (glibc $need_glibc)" 3
+    fi
+  fi
+  [ "$rehearse" = 1 ] || find_nvidia_drivers
+
+  {
+    echo "date: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
+    echo "host: $(uname -n), $(uname -srm), $(nproc) cores, glibc ${host_glibc:-unknown}"
+    echo "--- bundle"
+    cat "$bundle/MANIFEST.txt" 2>/dev/null || echo "(no MANIFEST.txt)"
+    echo "--- nvidia-smi"
+    if command -v nvidia-smi >/dev/null; then
+      nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm,clocks.max.mem,pcie.link.gen.max,pcie.link.width.max,compute_cap \
+        --format=csv 2>&1 || true
+      nvidia-smi 2>&1 || true
+    else
+      echo "nvidia-smi: not found"
+    fi
+    echo "--- nvcc"
+    command -v nvcc >/dev/null && nvcc --version | tail -n 2 || echo "nvcc: not found"
+    echo "--- loaders"
+    echo "VK_DRIVER_FILES=${VK_DRIVER_FILES:-} OCL_ICD_VENDORS=${OCL_ICD_VENDORS:-}"
+    echo "--- pyrseg backends"
+    "$bundle/bin/pyrseg" backends 2>&1 || echo "pyrseg backends failed (exit $?)"
+  } >"$report/environment.txt" 2>&1
+  sed -n '/^--- pyrseg backends/,$p' "$report/environment.txt"
+
+  local gpu_backends=()
+  if [ "$rehearse" = 1 ]; then
+    say "REHEARSAL: the cpu backend stands in for the GPU backends; nothing about a GPU is checked"
+    gpu_backends=(cpu)
+  else
+    local why=""
+    if ! command -v nvidia-smi >/dev/null; then
+      why="nvidia-smi is not installed"
+    elif ! nvidia-smi -L 2>/dev/null | grep -q "^GPU "; then
+      why="nvidia-smi lists no GPU"
+    fi
+    if backend_available cuda; then
+      gpu_backends+=(cuda)
+    else
+      why="${why:+$why; }pyrseg: $("$bundle/bin/pyrseg" backends | awk '$1 == "cuda" {getline; sub(/^ +/, ""); print}')"
+    fi
+    if [ "${#gpu_backends[@]}" = 0 ]; then
+      printf '# pyrseg GPU check: no GPU\n\nNo NVIDIA GPU is present here (%s). Nothing was checked.\n' "$why" \
+        >"$report/summary.md"
+      die "no NVIDIA GPU is present ($why): nothing was checked" 2
+    fi
+    for b in vulkan opencl; do
+      if backend_available "$b"; then gpu_backends+=("$b"); fi
+    done
+  fi
+  say "backends to check: ${gpu_backends[*]}"
+  echo "${gpu_backends[*]}" >"$work/backends"
+
+  for b in "${gpu_backends[@]}"; do
+    run_sharded "conformance_$b" "$b"
+  done
+  local start=$SECONDS
+  timeout "$test_timeout" "$bundle/bin/pyrseg_test_unit" --gtest_brief=1 --gtest_output="xml:$work/xml/unit_all.xml" \
+    >"$work/logs/unit.log" 2>&1 || true
+  { echo "=== unit tests, every available backend ($((SECONDS - start)) s) ==="; cat "$work/logs/unit.log"; } \
+    >>"$report/conformance.log"
+
+  if [ "$rehearse" = 1 ]; then
+    run_bench bench_rehearsal cpu 640x480 0.01
+  else
+    run_sanitizers
+    run_bench bench_cuda cuda "640x480|2064x1544|4128x3088" 0.5
+    local others
+    others="$(printf '%s\n' "${gpu_backends[@]}" | grep -v '^cuda$' | paste -sd '|' || true)"
+    if [ -n "$others" ]; then
+      run_bench bench_other_gpus "$others" "640x480|2064x1544|4128x3088" 0.2
+    fi
+  fi
+
+  if command -v python3 >/dev/null; then
+    local start=$SECONDS
+    python3 "$root/scripts/gpu_check/cupy_label.py" "$work/masks" "$report/cupy_label.json" || true
+    say "cupy label: $((SECONDS - start)) s"
+    local summarize_args=(--work "$work" --report "$report")
+    [ "$rehearse" = 1 ] && summarize_args+=(--rehearsal)
+    python3 "$root/scripts/gpu_check/summarize.py" "${summarize_args[@]}"
+  else
+    echo "# pyrseg GPU check" >"$report/summary.md"
+    echo "python3 is missing here: no summary; read the logs." >>"$report/summary.md"
+    die "python3 is missing: the logs are in $report, without a summary"
+  fi
+}
+
+case "${1:-}" in
+  prepare) prepare ;;
+  run) shift; run "$@" ;;
+  -h | --help | help) usage ;;
+  *) usage >&2; exit 2 ;;
+esac
