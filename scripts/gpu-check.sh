@@ -118,6 +118,14 @@ prepare() {
 
 # --- run -------------------------------------------------------------------------------------------------------
 
+# Seconds a step may take: its own limit, cut so that the whole run ends within $PYRSEG_GPU_CHECK_BUDGET (default
+# 480 s: a GPU lease's command limit is 600 s, and the summary must be written before anything is killed).
+step_limit() {
+  local left=$((deadline - SECONDS - 30))
+  ((left < 1)) && left=1
+  ((left < $1)) && echo "$left" || echo "$1"
+}
+
 backend_available() {  # backend_available NAME: from `pyrseg backends`, under the current environment
   "$bundle/bin/pyrseg" backends | awk -v b="$1" '$1 == b && $2 == "available" {found = 1} END {exit !found}'
 }
@@ -132,6 +140,10 @@ use_fallback_libs() {
     [ -f "$so" ] || continue
     name="$(basename "$so")"
     system="$(ldconfig -p 2>/dev/null | awk -v n="$name" '$1 == n && !found {print $NF; found = 1}')"
+    local dir
+    for dir in ${LD_LIBRARY_PATH:+${LD_LIBRARY_PATH//:/ }}; do  # the driver's folders that find_nvidia_drivers added
+      [ -z "$system" ] && [ -f "$dir/$name" ] && system="$dir/$name"
+    done
     if [ -z "$system" ] ||
        { [ "$name" = libstdc++.so.6 ] && [ -n "$need_cxx" ] && ! grep -qa "$need_cxx" "$system"; }; then
       ln -s "$so" "$work/fallback-lib/$name"
@@ -180,9 +192,15 @@ run_sharded() {
   shards=$(nproc)
   ((shards > 16)) && shards=16
   local filter="*/${backend}_*:*/${backend}"
-  local start=$SECONDS
+  local start=$SECONDS limit
+  limit=$(step_limit 180)
+  if ((limit < 20)); then
+    say "conformance on $backend: not run, out of time"
+    echo "not run: out of time" >"$work/time_$name"
+    return
+  fi
   for ((i = 0; i < shards; ++i)); do
-    GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i timeout "$test_timeout" \
+    GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i timeout "$limit" \
       "$bundle/bin/pyrseg_test_conformance" --gtest_filter="$filter" --gtest_brief=1 \
       --gtest_output="xml:$work/xml/${name}_$i.xml" >"$work/logs/${name}_$i.log" 2>&1 &
   done
@@ -211,6 +229,12 @@ run_sanitizers() {
   if ! command -v compute-sanitizer >/dev/null; then
     for tool in memcheck racecheck synccheck initcheck; do echo "not run: compute-sanitizer is not on the PATH" \
       >"$work/sanitizer_$tool.status"; done
+    return
+  fi
+  local sanitizer_timeout
+  sanitizer_timeout=$(step_limit 180)
+  if ((sanitizer_timeout < 20)); then
+    for tool in memcheck racecheck synccheck initcheck; do echo "not run: out of time" >"$work/sanitizer_$tool.status"; done
     return
   fi
   for tool in memcheck racecheck synccheck initcheck; do
@@ -243,12 +267,23 @@ run_sanitizers() {
     printf '%s %s; ' "$t" "$(cat "$work/sanitizer_$t.status")"; done)"
 }
 
-run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME
-  local name="$1" start=$SECONDS rc=0
-  PYRSEG_BENCH_MASKS="$work/masks" timeout "$bench_timeout" "$bundle/bin/pyrseg_bench" \
+run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S
+  local name="$1" start=$SECONDS rc=0 limit
+  limit=$(step_limit "$5")
+  if ((limit < 20)); then
+    say "bench $name: not run, out of time"
+    return
+  fi
+  PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
     --benchmark_filter="^(pipeline|stage)/($2)/($3)" --benchmark_min_time="$4" \
     --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
   say "bench $name: $((SECONDS - start)) s, exit $rc"
+}
+
+finish_run() {  # run.log complete before the script returns (whoever collects the report may not wait for tee)
+  exec 1>&- 2>&-
+  wait "$tee_pid" 2>/dev/null || true
+  rm -rf "$work"
 }
 
 run() {
@@ -258,18 +293,17 @@ run() {
     shift
   fi
   report="${1:-${PYRSEG_GPU_REPORT:-$root/build/gpu-report}}"
-  test_timeout=${PYRSEG_GPU_TEST_TIMEOUT:-300}
-  sanitizer_timeout=${PYRSEG_GPU_SANITIZER_TIMEOUT:-240}
-  bench_timeout=${PYRSEG_GPU_BENCH_TIMEOUT:-240}
+  deadline=$((SECONDS + ${PYRSEG_GPU_CHECK_BUDGET:-480}))
   [ -x "$bundle/bin/pyrseg" ] ||
     die "no prepared bundle in $bundle: run 'scripts/gpu-check.sh prepare' on a build machine and bring build/gpu"
   mkdir -p "$report"
   rm -f "$report"/{summary.md,run.log,environment.txt,conformance.log,sanitizers.log,bench_cuda.json}
   rm -f "$report"/{bench_other_gpus.json,bench_rehearsal.json,cupy_label.json}
   work="$(mktemp -d)"
-  trap 'rm -rf "$work"' EXIT
   mkdir -p "$work/xml" "$work/logs" "$work/masks"
   exec > >(tee "$report/run.log") 2>&1
+  tee_pid=$!
+  trap finish_run EXIT
   say "bundle $bundle; report $report"
 
   local host_glibc need_glibc
@@ -280,6 +314,7 @@ run() {
     die "this machine's glibc is $host_glibc; the bundle needs $need_glibc (prepare it on an older distribution)" 3
   fi
   export PYRSEG_DATA_DIR="$bundle/data"
+  [ "$rehearse" = 1 ] || find_nvidia_drivers
   use_fallback_libs
   if [ -e "$work/fallback-lib/libstdc++.so.6" ]; then
     need_glibc="$(sed -n 's/^glibc needed by lib\/fallback: //p' "$bundle/MANIFEST.txt")"
@@ -287,7 +322,6 @@ run() {
       die "this machine's C++ runtime is older than the bundle's, and its glibc ($host_glibc) too old for the bundle's own (glibc $need_glibc)" 3
     fi
   fi
-  [ "$rehearse" = 1 ] || find_nvidia_drivers
 
   {
     echo "date: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
@@ -328,9 +362,17 @@ run() {
       why="${why:+$why; }pyrseg: $("$bundle/bin/pyrseg" backends | awk '$1 == "cuda" {getline; sub(/^ +/, ""); print}')"
     fi
     if [ "${#gpu_backends[@]}" = 0 ]; then
-      printf '# pyrseg GPU check: no GPU\n\nNo NVIDIA GPU is present here (%s). Nothing was checked.\n' "$why" \
+      printf '# pyrseg GPU check: no GPU\n\nNo usable NVIDIA GPU here (%s). Nothing was checked.\n' "$why" \
         >"$report/summary.md"
-      die "no NVIDIA GPU is present ($why): nothing was checked" 2
+      die "no usable NVIDIA GPU here ($why): nothing was checked" 2
+    fi
+    local cap archs
+    cap="$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader 2>/dev/null | head -n 1 | tr -d '. ')"
+    archs="$(sed -n 's/^cuda architectures: //p' "$bundle/MANIFEST.txt" 2>/dev/null || true)"
+    if [ -n "$cap" ] && [ -n "$archs" ] && ! grep -qE "(^|[ ;])$cap(-real)?([ ;]|$)" <<<"$archs" &&
+       ! grep -q "virtual" <<<"$archs"; then
+      say "WARNING: this GPU is sm_$cap but the bundle has machine code for $archs only: expect 'no kernel image'"
+      say "         failures; prepare again with CMAKE_CUDA_ARCHITECTURES=$cap-real in the gpu-check preset"
     fi
     for b in vulkan opencl; do
       if backend_available "$b"; then gpu_backends+=("$b"); fi
@@ -339,39 +381,39 @@ run() {
   say "backends to check: ${gpu_backends[*]}"
   echo "${gpu_backends[*]}" >"$work/backends"
 
-  for b in "${gpu_backends[@]}"; do
-    run_sharded "conformance_$b" "$b"
-  done
+  # CUDA first, then what needs its results (CuPy times the bench's masks), then the slower and the secondary
+  # checks: if the time runs out, what is cut is the least important.
+  run_sharded "conformance_${gpu_backends[0]}" "${gpu_backends[0]}"
   local start=$SECONDS
-  timeout "$test_timeout" "$bundle/bin/pyrseg_test_unit" --gtest_brief=1 --gtest_output="xml:$work/xml/unit_all.xml" \
+  timeout "$(step_limit 120)" "$bundle/bin/pyrseg_test_unit" --gtest_brief=1 --gtest_output="xml:$work/xml/unit_all.xml" \
     >"$work/logs/unit.log" 2>&1 || true
   { echo "=== unit tests, every available backend ($((SECONDS - start)) s) ==="; cat "$work/logs/unit.log"; } \
     >>"$report/conformance.log"
-
   if [ "$rehearse" = 1 ]; then
-    run_bench bench_rehearsal cpu 640x480 0.01
+    run_bench bench_rehearsal cpu 640x480 0.01 60
   else
+    run_bench bench_cuda cuda "640x480|2064x1544|4128x3088" 0.5 150
+  fi
+  command -v python3 >/dev/null || die "python3 is missing: no CuPy peer and no summary; the logs are in $report"
+  start=$SECONDS
+  timeout "$(step_limit 90)" python3 "$root/scripts/gpu_check/cupy_label.py" "$work/masks" "$report/cupy_label.json" ||
+    true
+  say "cupy label: $((SECONDS - start)) s"
+  if [ "$rehearse" = 0 ]; then
     run_sanitizers
-    run_bench bench_cuda cuda "640x480|2064x1544|4128x3088" 0.5
-    local others
-    others="$(printf '%s\n' "${gpu_backends[@]}" | grep -v '^cuda$' | paste -sd '|' || true)"
-    if [ -n "$others" ]; then
-      run_bench bench_other_gpus "$others" "640x480|2064x1544|4128x3088" 0.2
+    local b others=()
+    for b in "${gpu_backends[@]:1}"; do
+      run_sharded "conformance_$b" "$b"
+      others+=("$b")
+    done
+    if ((${#others[@]})); then
+      run_bench bench_other_gpus "$(IFS='|'; echo "${others[*]}")" "640x480|2064x1544|4128x3088" 0.2 120
     fi
   fi
 
-  if command -v python3 >/dev/null; then
-    local start=$SECONDS
-    python3 "$root/scripts/gpu_check/cupy_label.py" "$work/masks" "$report/cupy_label.json" || true
-    say "cupy label: $((SECONDS - start)) s"
-    local summarize_args=(--work "$work" --report "$report")
-    [ "$rehearse" = 1 ] && summarize_args+=(--rehearsal)
-    python3 "$root/scripts/gpu_check/summarize.py" "${summarize_args[@]}"
-  else
-    echo "# pyrseg GPU check" >"$report/summary.md"
-    echo "python3 is missing here: no summary; read the logs." >>"$report/summary.md"
-    die "python3 is missing: the logs are in $report, without a summary"
-  fi
+  local summarize_args=(--work "$work" --report "$report")
+  [ "$rehearse" = 1 ] && summarize_args+=(--rehearsal)
+  python3 "$root/scripts/gpu_check/summarize.py" "${summarize_args[@]}"
 }
 
 case "${1:-}" in

@@ -91,6 +91,7 @@ def main():
     backends = read(os.path.join(work, "backends")).split()
     env = read(os.path.join(report, "environment.txt"))
     problems = []
+    not_run = []
     out = []
 
     gpu = "no GPU (rehearsal)" if args.rehearsal else "unknown GPU"
@@ -134,7 +135,9 @@ def main():
         all_failures += fails
         if f:
             problems.append(f"{f} conformance failures on {b}")
-        if p == 0:
+        if seconds.startswith("not run"):
+            not_run.append(f"conformance on {b} ({seconds[len('not run: '):]})")
+        elif p == 0:
             problems.append(f"no conformance test passed on {b}")
     p, f, s, fails = gtest_results(glob.glob(os.path.join(work, "xml", "unit_*.xml")))
     out.append(f"| unit tests, all backends | {p} | {f} | {s} | |")
@@ -161,6 +164,8 @@ def main():
             out.append(f"| {tool} | {status} | {summary[-1] if summary else ''} |")
             if status in ("errors",) or status.startswith("failed") or status.startswith("timed out"):
                 problems.append(f"compute-sanitizer {tool}: {status}")
+            elif status != "clean":
+                not_run.append(f"compute-sanitizer {tool} ({status})")
         out.append("")
 
     out.append("## Speed")
@@ -209,6 +214,7 @@ def main():
     out.append("")
     if not cupy.get("available"):
         out.append(f"Not measured: {cupy.get('reason', 'cupy_label.json is missing')}")
+        not_run.append("CuPy's label")
     else:
         out.append(f"CuPy {cupy.get('cupy', '')}; its mask is already on the GPU, CUDA events, median of "
                    f"{cupy['masks'][0]['runs'] if cupy.get('masks') else 0} runs.")
@@ -227,6 +233,8 @@ def main():
     out.append("")
 
     verdict = "FAIL: " + "; ".join(problems) if problems else "PASS: every check that ran passed"
+    if not_run:
+        verdict += "; not run: " + ", ".join(not_run)
     if args.rehearsal:
         verdict = "REHEARSAL " + verdict + " (cpu backend only)"
     out.insert(2, f"**{verdict}**")
