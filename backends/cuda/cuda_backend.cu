@@ -405,9 +405,14 @@ std::vector<std::string> describe_devices(std::string* why_none) {
         cudaGetLastError();  // clear the sticky-free error state for later calls
         return out;
     }
+    // The driver's CUDA version beside the runtime's: a report from a GPU machine then says what ran on what.
+    int driver = 0;
+    cudaDriverGetVersion(&driver);
+    const auto version = [](int v) { return std::to_string(v / 1000) + "." + std::to_string(v % 1000 / 10); };
+    const std::string versions = "driver CUDA " + version(driver) + ", runtime " + version(CUDART_VERSION);
     for (int d = 0; d < count; ++d) {
         cudaDeviceProp p{};
-        if (cudaGetDeviceProperties(&p, d) == cudaSuccess) out.push_back(describe(d, p));
+        if (cudaGetDeviceProperties(&p, d) == cudaSuccess) out.push_back(describe(d, p) + ", " + versions);
     }
     return out;
 }
