@@ -1,20 +1,21 @@
+// The Vulkan backend: gpu::Device over one command buffer per Segmenter, recorded as the passes are queued and
+// submitted at finish() (once per frame, plus once per batch of fill rounds until the fills are GPU-shaped). The
+// passes are core/gpu/gpu_executor.cpp; the kernels are shaders/pyr_vulkan.comp, one pipeline per kernel of the
+// table (vulkan_runtime.cpp). Transfers go through two host-visible staging buffers.
 #include "backends/vulkan/vulkan_backend.hpp"
 
 #include <algorithm>
 #include <array>
-#include <bit>
-#include <chrono>
 #include <cstring>
-#include <initializer_list>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "backends/vulkan/vulkan_buffer.hpp"
 #include "backends/vulkan/vulkan_runtime.hpp"
-#include "core/segment_stats.hpp"
-#include "core/staging.hpp"
+#include "core/gpu/device.hpp"
+#include "core/gpu/gpu_executor.hpp"
 #include "pyrseg/error.hpp"
-#include "shaders/pyr_types.h"
 
 namespace pyrseg::vulkan {
 namespace {
@@ -22,70 +23,16 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr uint32_t kGroup1D = 64;        // PYR_GROUP_1D in shaders/pyr_vulkan.comp
-constexpr uint32_t kGroup2D = 8;         // PYR_GROUP_2D
-constexpr uint32_t kFillsPerFrame = 2;   // steps 2 and 4 (or the small-image fallback's one)
-constexpr uint32_t kFirstBudget = 8;     // fill rounds recorded per fill until a frame needs more
-constexpr size_t kMaxOps = 128;          // commands of one frame, kept to record it again
 constexpr uint32_t kMaxTimestamps = 64;  // pass boundaries per frame
 
-enum Binding : uint32_t { kPoints, kNormalsBuf, kQuant, kMask, kLabels, kLut, kSums, kFlags, kOut };
-
-double ms_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-// One command of a frame, as the pipeline asked for it. A frame whose fills did not converge within the recorded
-// rounds is recorded again from these with more rounds.
-struct Op {
-    enum Kind {
-        upload_cloud,
-        upload_mask,
-        pass_start,
-        normals,
-        quantize,
-        metric,
-        mip,
-        init_labels,
-        fill,
-        fill_once,
-        edges,
-        compact,
-        stats
-    } kind = upload_cloud;
-    uint32_t a = 0;
-    uint32_t b = 0;
-    const char* name = nullptr;
-};
-
-class VulkanExecutor final : public core::PassExecutor {
+class VulkanDevice final : public gpu::Device {
 public:
-    VulkanExecutor(const core::Plan& plan, std::shared_ptr<Runtime> runtime) : plan_(plan), rt_(std::move(runtime)) {
-        check_limits();
-        const VkDeviceSize pixels = plan.pixel_count();
-        const VkDeviceSize texels = plan.total_texels;
-        using M = VulkanBuffer::Memory;
-        buffers_[kPoints] = VulkanBuffer(*rt_, 12 * pixels, M::device, "the points buffer");
-        buffers_[kNormalsBuf] = VulkanBuffer(*rt_, 12 * pixels, M::device, "the normals buffer");
-        buffers_[kQuant] = VulkanBuffer(*rt_, 16 * pixels, M::device, "the quantized-normals buffer");
-        buffers_[kMask] = VulkanBuffer(*rt_, 4 * texels, M::device, "the mask pyramid");
-        buffers_[kLabels] = VulkanBuffer(*rt_, 4 * texels, M::device, "the label pyramid");
-        buffers_[kLut] = VulkanBuffer(*rt_, 4 * lut_words(), M::device, "the compaction table and statistics");
-        buffers_[kSums] = VulkanBuffer(*rt_, 4 * (VkDeviceSize(plan_.scan_chunks()) + 1), M::device, "the scan sums");
-        buffers_[kOut] = VulkanBuffer(*rt_, 4 * pixels, M::device, "the labels output");
-        upload_ = VulkanBuffer(*rt_, 24 * pixels, M::host, "the upload staging buffer");
-        download_ =
-            VulkanBuffer(*rt_, core::StagedResults::kBytesPerPixel * pixels, M::host, "the download staging buffer");
-        if (plan_.stats_slots != 0) {
-            stats_download_ =
-                VulkanBuffer(*rt_, 4 * VkDeviceSize(plan_.stats_words()), M::host, "the statistics staging buffer");
-        }
+    explicit VulkanDevice(std::shared_ptr<Runtime> runtime) : rt_(std::move(runtime)) {
         create_command_objects();
-        size_flags(kFirstBudget);
-        throw_on_validation_messages("the creation of a Vulkan Segmenter");
+        downloads_.reserve(16);
     }
 
-    ~VulkanExecutor() override {
+    ~VulkanDevice() override {
         const VkDevice d = rt_->device;
         if (in_flight_) vkWaitForFences(d, 1, &fence_, VK_TRUE, UINT64_MAX);
         if (fence_ != VK_NULL_HANDLE) vkDestroyFence(d, fence_, nullptr);
@@ -93,267 +40,107 @@ public:
         if (command_pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(d, command_pool_, nullptr);
         if (descriptor_pool_ != VK_NULL_HANDLE) vkDestroyDescriptorPool(d, descriptor_pool_, nullptr);
     }
+    VulkanDevice(const VulkanDevice&) = delete;
+    VulkanDevice& operator=(const VulkanDevice&) = delete;
 
-    VulkanExecutor(const VulkanExecutor&) = delete;
-    VulkanExecutor& operator=(const VulkanExecutor&) = delete;
+    [[nodiscard]] std::string description() const override { return rt_->description; }
 
-    void bind_cloud(const CloudView& cloud) override {
-        start_frame();
-        const auto start = std::chrono::steady_clock::now();
-        auto* staging = static_cast<float*>(upload_.mapped());
-        core::pack_xyz(cloud, cloud.points, staging);
-        normals_given_ = cloud.normals != nullptr;
-        if (normals_given_) core::pack_xyz(cloud, cloud.normals, staging + 3 * plan_.pixel_count());
-        from_mask_ = false;
-        host_upload_ms_ = ms_since(start);
-        push({Op::upload_cloud, normals_given_ ? 1u : 0u});
+    // A storage buffer binds at most maxStorageBufferRange bytes, and is one allocation (maxMemoryAllocationSize).
+    [[nodiscard]] gpu::DeviceLimits limits() const override {
+        const VkDeviceSize range = rt_->properties.limits.maxStorageBufferRange;
+        gpu::DeviceLimits l;
+        l.max_buffer_bytes = size_t(std::min(range, rt_->max_allocation));
+        l.max_buffer_what = range <= rt_->max_allocation ? "maxStorageBufferRange" : "maxMemoryAllocationSize";
+        VkDeviceSize heap = 0;
+        for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
+            heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
+        l.memory_bytes = size_t(heap);
+        l.memory_what = "its largest memory heap";
+        l.mask_texel_bytes = 4;  // GLSL has no byte access without extensions
+        return l;
     }
 
-    void bind_mask(const MaskView& mask) override {
-        start_frame();
-        const auto start = std::chrono::steady_clock::now();
-        const size_t w = size_t(plan_.width);
-        const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
-        auto* staging = static_cast<uint32_t*>(upload_.mapped());
-        for (size_t y = 0; y < size_t(plan_.height); ++y) {
-            for (size_t x = 0; x < w; ++x) {
-                const bool fillable = mask.fillable[y * stride + x] != 0;
-                const bool valid = mask.valid == nullptr || mask.valid[y * stride + x] != 0;
-                staging[y * w + x] = (fillable ? 1u : 0u) | (valid ? 2u : 0u);
-            }
+    void allocate(const gpu::BufferSizes& sizes, uint32_t image_width) override {
+        width_ = image_width;
+        const size_t pixels = sizes[size_t(gpu::Buffer::out)] / 4;
+        check_workgroups(pixels, std::max(pixels, sizes[size_t(gpu::Buffer::lut)] / 4));
+        for (size_t b = 0; b < kBindingCount; ++b) {
+            const std::string what = std::string("the ") + gpu::buffer_name(gpu::Buffer(b)) + " buffer";
+            buffers_[b] = VulkanBuffer(*rt_, sizes[b], VulkanBuffer::Memory::device, what.c_str());
         }
-        from_mask_ = true;
-        host_upload_ms_ = ms_since(start);
-        push({Op::upload_mask});
+        // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count, fill
+        // flags, statistics), each packed from offset 0 between two finish() calls.
+        const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)];
+        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] +
+                                  sizes[size_t(gpu::Buffer::flags)] + sizes[size_t(gpu::Buffer::sums)];
+        upload_ = VulkanBuffer(*rt_, up, VulkanBuffer::Memory::host, "the upload staging buffer");
+        download_ = VulkanBuffer(*rt_, down, VulkanBuffer::Memory::host, "the download staging buffer");
+        write_descriptors();
+        throw_on_validation_messages("the creation of a Vulkan Segmenter");
     }
 
-    void begin_pass(const char* pass) override { push({Op::pass_start, 0, 0, pass}); }
-    void estimate_normals() override { push({Op::normals}); }
-    void quantize() override { push({Op::quantize}); }
-    void metric() override { push({Op::metric}); }
-    void mip(int parent_level) override { push({Op::mip, uint32_t(parent_level)}); }
-    void init_labels(int level, uint32_t mode) override { push({Op::init_labels, uint32_t(level), mode}); }
-    void fill_to_fixed_point(int level, uint32_t anchor_max) override { push({Op::fill, uint32_t(level), anchor_max}); }
-    void fill_once(int level) override { push({Op::fill_once, uint32_t(level)}); }
-    void label_edges() override { push({Op::edges}); }
-    void compact(bool apply) override { push({Op::compact, apply ? 1u : 0u}); }
-    void segment_stats() override { push({Op::stats}); }
-
-    // Runs the frame: one submission, unless a fill needed more rounds than were recorded; then the frame is
-    // recorded again with twice the rounds (kept for the frames after) and run again.
-    void read_back(Result& out, const Outputs& outputs) override {
-        for (;;) {
-            record_download(outputs);
-            submit_and_wait();
-            throw_on_validation_messages("a frame");
-            if (fills_converged()) break;
-            size_flags(fill_budget_ * 2);
-            start_commands();
-            for (size_t k = 0; k < op_count_; ++k) record(ops_[k]);
-        }
-        const auto start = std::chrono::steady_clock::now();
-        const size_t pixels = plan_.pixel_count();
-        const auto* staged = static_cast<const unsigned char*>(download_.mapped());
-        const auto* readback = static_cast<const uint32_t*>(readback_.mapped());
-        out.width = plan_.width;
-        out.height = plan_.height;
-        out.segment_count = readback[0];
-        core::unstage_results(staged, pixels, true, outputs, !from_mask_, out);
-        out.segments.clear();
-        if (plan_.stats_slots != 0) {
-            download_statistics(out.segment_count);
-            core::decode_segment_stats(static_cast<const uint32_t*>(stats_download_.mapped()), out.segment_count, plan_,
-                                       !from_mask_, out.segments);
-        }
-        host_download_ms_ = ms_since(start);
-    }
-
-    // The device's timestamps per pass; upload and download add the host's copies to and from staging memory.
-    bool device_timings(std::vector<PassTiming>& timings) override {
-        if (!rt_->timestamps || timestamp_count_ < 2) return false;
-        std::array<std::uint64_t, kMaxTimestamps> ticks{};
-        check(vkGetQueryPoolResults(rt_->device, query_pool_, 0, timestamp_count_, sizeof(ticks), ticks.data(),
-                                    sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-              "vkGetQueryPoolResults");
-        for (PassTiming& t : timings) {
-            t.milliseconds = std::strcmp(t.pass, "upload") == 0     ? host_upload_ms_
-                             : std::strcmp(t.pass, "download") == 0 ? host_download_ms_
-                                                                    : 0.0;
-        }
-        const double ms_per_tick = double(rt_->properties.limits.timestampPeriod) * 1e-6;
-        for (uint32_t k = 0; k + 1 < timestamp_count_; ++k) {
-            for (PassTiming& t : timings) {
-                if (std::strcmp(t.pass, timestamp_names_[k]) == 0) {
-                    t.milliseconds += double(ticks[k + 1] - ticks[k]) * ms_per_tick;
-                }
-            }
-        }
-        return true;
-    }
-
-private:
-    // --- frames and commands ---
-
-    void start_frame() {
-        op_count_ = 0;
-        start_commands();
-    }
-
-    void start_commands() {
-        check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
-        auto begin = make_info<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
-        if (rt_->timestamps) vkCmdResetQueryPool(commands_, query_pool_, 0, kMaxTimestamps);
-        vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipeline_layout, 0, 1, &descriptor_set_,
-                                0, nullptr);
-        fills_in_frame_ = 0;
-        timestamp_count_ = 0;
-        timestamp("upload");
-    }
-
-    void push(const Op& op) {
-        if (op_count_ == kMaxOps) throw Error(ErrorCode::internal, "Vulkan: more commands in one frame than expected");
-        ops_[op_count_++] = op;
-        record(op);
-    }
-
-    void record(const Op& op) {
-        switch (op.kind) {
-            case Op::upload_cloud: {
-                const VkDeviceSize bytes = 12 * VkDeviceSize(plan_.pixel_count());
-                copy(upload_.get(), 0, buffers_[kPoints].get(), 0, bytes);
-                if (op.a != 0) copy(upload_.get(), bytes, buffers_[kNormalsBuf].get(), 0, bytes);
-                barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-                break;
-            }
-            case Op::upload_mask:
-                copy(upload_.get(), 0, buffers_[kPoints].get(), 0, 4 * VkDeviceSize(plan_.pixel_count()));
-                barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-                dispatch_1d(kBindMask, pixels(), {pixels(), plan_.full().offset});
-                break;
-            case Op::pass_start:
-                timestamp(op.name);
-                break;
-            case Op::normals:
-                dispatch_2d(kNormals, width(), height(), {height(), uint32_t(plan_.params.normal_radius)});
-                break;
-            case Op::quantize:
-                dispatch_1d(kQuantize, pixels(), {pixels()});
-                break;
-            case Op::metric:
-                dispatch_2d(kMetric, width(), height(),
-                            {height(), plan_.full().offset, std::bit_cast<uint32_t>(plan_.thresholds.curvature),
-                             std::bit_cast<uint32_t>(plan_.thresholds.depth)});
-                break;
-            case Op::mip: {
-                const PyrLevel p = plan_.level(int(op.a));
-                const PyrLevel c = plan_.level(int(op.a) + 1);
-                dispatch_2d(kMip, p.width, p.height, {p.width, p.height, p.offset, c.width, c.height, c.offset});
-                break;
-            }
-            case Op::init_labels: {
-                const PyrLevel l = plan_.level(int(op.a));
-                const PyrLevel p = op.a > 1 ? plan_.level(int(op.a) - 1) : PyrLevel{0, 0, 0};
-                dispatch_2d(kInitLabels, l.width, l.height,
-                            {l.width, l.height, l.offset, p.width, p.height, p.offset, op.b});
-                break;
-            }
-            case Op::fill:
-                record_fill(plan_.level(int(op.a)), op.b);
-                break;
-            case Op::fill_once: {
-                const PyrLevel l = plan_.level(int(op.a));
-                const uint32_t scratch = kFillsPerFrame * fill_budget_;  // a slot nobody reads
-                sweep_round(l, 1, scratch, scratch);
-                break;
-            }
-            case Op::edges:
-                dispatch_2d(kEdges, width(), height(), {height(), plan_.full().offset});
-                break;
-            case Op::compact:
-                record_compact(op.a);
-                break;
-            case Op::stats:
-                vkCmdFillBuffer(commands_, buffers_[kLut].get(), 4 * VkDeviceSize(plan_.lut_size()),
-                                4 * VkDeviceSize(plan_.stats_words()), 0);
-                barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-                dispatch_1d(kStats, stats_runs(),
-                            {height(), plan_.full().offset, stats_runs(), from_mask_ ? 0u : 1u,
-                             std::bit_cast<uint32_t>(plan_.stats_point_scale()), plan_.lut_size(), plan_.stats_slots});
-                break;
-        }
-    }
-
-    // Steps 2 and 4: fill_budget_ rounds of row and column sweeps. Round r sets flags[first + r] when it changed a
-    // label and is skipped on the device when round r - 1 changed nothing; the host reads the flags after the frame.
-    void record_fill(const PyrLevel& l, uint32_t anchor_max) {
-        if (fills_in_frame_ == kFillsPerFrame) throw Error(ErrorCode::internal, "Vulkan: more fills than expected");
-        if (anchor_max != 0) {
-            const uint32_t count = l.width * l.height;
-            dispatch_1d(kAnchor, count, {l.offset, count, anchor_max});
-        }
-        const uint32_t first = fills_in_frame_++ * fill_budget_;
-        vkCmdFillBuffer(commands_, buffers_[kFlags].get(), 4 * VkDeviceSize(first), 4 * VkDeviceSize(fill_budget_), 0);
+    void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
+        recording();
+        const VkDeviceSize at = take(upload_used_, upload_.size(), bytes, "upload");
+        std::memcpy(static_cast<unsigned char*>(upload_.mapped()) + at, src, bytes);
+        copy(upload_.get(), at, buffer(b), offset, bytes);
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-        for (uint32_t r = 0; r < fill_budget_; ++r) sweep_round(l, 0, first + r, first);
     }
 
-    void sweep_round(const PyrLevel& l, uint32_t once, uint32_t slot, uint32_t first) {
-        dispatch_1d(kSweepRows, l.height, {l.width, l.height, l.offset, once, slot, first});
-        dispatch_1d(kSweepColumns, l.width, {l.width, l.height, l.offset, once, slot, first});
+    void download(gpu::Buffer b, size_t offset, void* dst, size_t bytes) override {
+        recording();
+        const VkDeviceSize at = take(download_used_, download_.size(), bytes, "download");
+        copy(buffer(b), offset, download_.get(), at, bytes);
+        downloads_.push_back({dst, at, bytes});
     }
 
-    // Step 7: mark the labels present, number the marks by a chunked scan (K lands after the chunk sums), map.
-    void record_compact(uint32_t apply) {
-        const uint32_t count = plan_.lut_size();
-        const uint32_t chunks = plan_.scan_chunks();
-        vkCmdFillBuffer(commands_, buffers_[kLut].get(), 0, 4 * VkDeviceSize(count), 0);
+    void zero(gpu::Buffer b, size_t offset, size_t bytes) override {
+        recording();
+        vkCmdFillBuffer(commands_, buffer(b), offset, bytes, 0);
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-        dispatch_1d(kLutMark, pixels(), {pixels(), plan_.full().offset});
-        dispatch_1d(kScanCount, chunks, {count, PYR_SCAN_CHUNK, chunks});
-        dispatch_1d(kScanSums, 1, {chunks});
-        dispatch_1d(kScanNumber, chunks, {count, PYR_SCAN_CHUNK, chunks});
-        dispatch_1d(kCompact, pixels(), {pixels(), plan_.full().offset, apply});
     }
 
-    // The results into staging memory: labels, then (as asked) raw labels, mask and normals at fixed offsets; K
-    // and the fill flags into the small readback buffer.
-    void record_download(const Outputs& outputs) {
-        timestamp("download");
-        using S = core::StagedResults;
-        const VkDeviceSize px = pixels();
-        const VkDeviceSize full = plan_.full().offset;
-        const VkBuffer staged = download_.get();
-        copy(buffers_[kOut].get(), 0, staged, S::kLabels * px, 4 * px);
-        if (outputs.raw_labels) copy(buffers_[kLabels].get(), 4 * full, staged, S::kRawLabels * px, 4 * px);
-        if (outputs.fillable_mask) copy(buffers_[kMask].get(), 4 * full, staged, S::kMask * px, 4 * px);
-        if (outputs.normals && !from_mask_) copy(buffers_[kNormalsBuf].get(), 0, staged, S::kNormals * px, 12 * px);
-        copy(buffers_[kSums].get(), 4 * VkDeviceSize(plan_.scan_chunks()), readback_.get(), 0, 4);
-        copy(buffers_[kFlags].get(), 0, readback_.get(), 4, 4 * VkDeviceSize(kFillsPerFrame) * fill_budget_);
-        to_host_barrier();
-        timestamp(nullptr);  // the end of the last interval
+    // 1D: `nx` invocations in groups of PYR_GROUP_1D over a 2D grid of workgroups (PYR_I); 2D: 8 x 8 groups.
+    void dispatch(gpu::Kernel k, uint32_t nx, uint32_t ny, const gpu::Args& args) override {
+        if (nx == 0 || ny == 0) return;
+        recording();
+        uint32_t gx = 0;
+        uint32_t gy = 0;
+        if (gpu::kernel_dims(k) == 1) {
+            const uint32_t groups = (nx + PYR_GROUP_1D - 1) / PYR_GROUP_1D;
+            gx = std::min(groups, max_groups_x_);
+            gy = (groups + gx - 1) / gx;
+        } else {
+            gx = (nx + PYR_GROUP_2D - 1) / PYR_GROUP_2D;
+            gy = (ny + PYR_GROUP_2D - 1) / PYR_GROUP_2D;
+        }
+        std::array<uint32_t, kPushConstantBytes / 4> constants{};
+        constants[0] = width_;
+        std::copy(args.words.begin(), args.words.end(), constants.begin() + 1);
+        vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipelines[size_t(k)]);
+        vkCmdPushConstants(commands_, rt_->pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushConstantBytes,
+                           constants.data());
+        vkCmdDispatch(commands_, gx, gy, 1);
+        barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+    }
+
+    // Closes the interval named before and opens one named `pass` (nullptr: the frame's end).
+    void mark(const char* pass) override {
+        if (!rt_->timestamps || timestamp_count_ == kMaxTimestamps) return;
+        recording();
+        vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, timestamp_count_);
+        timestamp_names_[timestamp_count_++] = pass;
+    }
+
+    void finish() override {
+        if (!recording_) return;
+        auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                             nullptr, 0, nullptr);
         check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
-    }
-
-    // The K slots the frame used, in a second small submission once K is known (the whole table of slots can be
-    // far larger than what a frame fills).
-    void download_statistics(uint32_t segments) {
-        const VkDeviceSize bytes =
-            4 * VkDeviceSize(std::min<size_t>(plan_.stats_words(), size_t(segments) * PYR_STATS_WORDS));
-        if (bytes == 0) return;
-        check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
-        auto begin = make_info<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
-        copy(buffers_[kLut].get(), 4 * VkDeviceSize(plan_.lut_size()), stats_download_.get(), 0, bytes);
-        to_host_barrier();
-        check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
-        submit_and_wait();
-        throw_on_validation_messages("reading the segment statistics");
-    }
-
-    void submit_and_wait() {
+        recording_ = false;
         check(vkResetFences(rt_->device, 1, &fence_), "vkResetFences");
         auto submit = make_info<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
         submit.commandBufferCount = 1;
@@ -365,70 +152,66 @@ private:
         in_flight_ = true;
         check(vkWaitForFences(rt_->device, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
         in_flight_ = false;
+        throw_on_validation_messages("a frame");
+        const auto* staged = static_cast<const unsigned char*>(download_.mapped());
+        for (const Download& d : downloads_) std::memcpy(d.dst, staged + d.at, d.bytes);
+        downloads_.clear();
+        upload_used_ = 0;
+        download_used_ = 0;
     }
 
-    [[nodiscard]] uint32_t fill_rounds() const override {
-        const auto* flags = static_cast<const uint32_t*>(readback_.mapped()) + 1;
-        uint32_t rounds = 0;
-        for (uint32_t f = 0; f < fills_in_frame_; ++f) {
-            const uint32_t* begin = flags + size_t(f) * fill_budget_;
-            rounds += uint32_t(std::find(begin, begin + fill_budget_, 0u) - begin) + 1;
-        }
-        return rounds;
-    }
-
-    // A fill converged when one of its rounds changed nothing.
-    [[nodiscard]] bool fills_converged() const {
-        const auto* flags = static_cast<const uint32_t*>(readback_.mapped()) + 1;
-        for (uint32_t f = 0; f < fills_in_frame_; ++f) {
-            const uint32_t* begin = flags + size_t(f) * fill_budget_;
-            if (std::find(begin, begin + fill_budget_, 0u) == begin + fill_budget_) return false;
+    bool pass_times(std::vector<PassTiming>& timings) override {
+        if (!rt_->timestamps || timestamp_count_ < 2) return false;
+        std::array<std::uint64_t, kMaxTimestamps> ticks{};
+        check(vkGetQueryPoolResults(rt_->device, query_pool_, 0, timestamp_count_, sizeof(ticks), ticks.data(),
+                                    sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+              "vkGetQueryPoolResults");
+        for (PassTiming& t : timings) t.milliseconds = 0.0;
+        const double ms_per_tick = double(rt_->properties.limits.timestampPeriod) * 1e-6;
+        for (uint32_t k = 0; k + 1 < timestamp_count_; ++k) {
+            for (PassTiming& t : timings) {
+                if (timestamp_names_[k] != nullptr && std::strcmp(t.pass, timestamp_names_[k]) == 0)
+                    t.milliseconds += double(ticks[k + 1] - ticks[k]) * ms_per_tick;
+            }
         }
         return true;
     }
 
-    // The flags buffer (kFillsPerFrame rounds of budget, plus the step-6 scratch slot) and its readback copy.
-    void size_flags(uint32_t budget) {
-        fill_budget_ = budget;
-        const VkDeviceSize slots = VkDeviceSize(kFillsPerFrame) * budget + 1;
-        buffers_[kFlags] = VulkanBuffer(*rt_, 4 * slots, VulkanBuffer::Memory::device, "the fill flags");
-        readback_ = VulkanBuffer(*rt_, 4 * (slots + 1), VulkanBuffer::Memory::host, "the readback buffer");
-        write_descriptors();
+    void begin_frame() override {
+        timestamp_count_ = 0;
+        reset_queries_ = true;
     }
 
-    // --- recording helpers ---
+private:
+    struct Download {
+        void* dst;
+        VkDeviceSize at;
+        size_t bytes;
+    };
 
-    void dispatch(Entry e, uint32_t groups_x, uint32_t groups_y, std::initializer_list<uint32_t> args) {
-        std::array<uint32_t, kPushConstantBytes / 4> constants{};
-        constants[0] = width();
-        std::copy(args.begin(), args.end(), constants.begin() + 1);
-        vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipelines[e]);
-        vkCmdPushConstants(commands_, rt_->pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushConstantBytes,
-                           constants.data());
-        vkCmdDispatch(commands_, groups_x, groups_y, 1);
-        barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+    [[nodiscard]] VkBuffer buffer(gpu::Buffer b) const { return buffers_[size_t(b)].get(); }
+
+    // Begins the command buffer when nothing is being recorded; the frame's first one resets the timestamps.
+    void recording() {
+        if (recording_) return;
+        check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
+        auto begin = make_info<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
+        recording_ = true;
+        if (rt_->timestamps && reset_queries_) vkCmdResetQueryPool(commands_, query_pool_, 0, kMaxTimestamps);
+        reset_queries_ = false;
+        vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipeline_layout, 0, 1, &descriptor_set_,
+                                0, nullptr);
     }
 
-    // `count` invocations in groups of 64, laid out over a 2D grid of workgroups (PYR_LINEAR_ID).
-    void dispatch_1d(Entry e, uint32_t count, std::initializer_list<uint32_t> args) {
-        if (count == 0) return;
-        const uint32_t groups = (count + kGroup1D - 1) / kGroup1D;
-        const uint32_t gx = std::min(groups, max_groups_x_);
-        dispatch(e, gx, (groups + gx - 1) / gx, args);
-    }
-
-    void dispatch_2d(Entry e, uint32_t w, uint32_t h, std::initializer_list<uint32_t> args) {
-        if (w == 0 || h == 0) return;
-        dispatch(e, (w + kGroup2D - 1) / kGroup2D, (h + kGroup2D - 1) / kGroup2D, args);
-    }
-
-    // Copies made before are visible to the host after the fence.
-    void to_host_barrier() {
-        auto to_host = make_info<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                             nullptr, 0, nullptr);
+    // `bytes` of a staging buffer, from where the last take ended (4-byte aligned).
+    static VkDeviceSize take(VkDeviceSize& used, VkDeviceSize capacity, size_t bytes, const char* what) {
+        const VkDeviceSize at = used;
+        if (at + bytes > capacity)
+            throw Error(ErrorCode::internal, std::string("Vulkan: the ") + what + " staging buffer is too small");
+        used = (at + bytes + 3) / 4 * 4;
+        return at;
     }
 
     // Everything written before (at src_stage) is visible to the shaders and copies after.
@@ -447,17 +230,9 @@ private:
         vkCmdCopyBuffer(commands_, src, dst, 1, &region);
     }
 
-    // Closes the interval named before and opens one named `name` (nullptr: the frame's end).
-    void timestamp(const char* name) {
-        if (!rt_->timestamps || timestamp_count_ == kMaxTimestamps) return;
-        vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, timestamp_count_);
-        timestamp_names_[timestamp_count_++] = name;
-    }
-
-    // --- host side ---
-
     void create_command_objects() {
         const VkDevice d = rt_->device;
+        max_groups_x_ = rt_->properties.limits.maxComputeWorkGroupCount[0];
         const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
         auto pool = make_info<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
         pool.maxSets = 1;
@@ -504,60 +279,30 @@ private:
         vkUpdateDescriptorSets(rt_->device, kBindingCount, writes.data(), 0, nullptr);
     }
 
-    // The device's limits against this image: buffer sizes, allocation size, memory, workgroup counts.
-    void check_limits() {
+    // The grids this image's dispatches need, against maxComputeWorkGroupCount.
+    void check_workgroups(size_t pixels, size_t largest_1d) const {
         const VkPhysicalDeviceLimits& lim = rt_->properties.limits;
-        max_groups_x_ = lim.maxComputeWorkGroupCount[0];
-        const auto mib = [](VkDeviceSize b) { return std::to_string(b >> 20) + " MiB"; };
-        const std::string image = "a " + std::to_string(plan_.width) + " x " + std::to_string(plan_.height) + " image";
-        const VkDeviceSize largest =
-            std::max({16 * VkDeviceSize(plan_.pixel_count()), 4 * VkDeviceSize(plan_.total_texels), 4 * lut_words()});
-        if (largest > lim.maxStorageBufferRange) {
-            throw Error(ErrorCode::out_of_memory, image + " needs a storage buffer of " + mib(largest) + " but " +
-                                                      rt_->description + " binds at most " +
-                                                      mib(lim.maxStorageBufferRange) + " (maxStorageBufferRange)");
-        }
-        if (24 * VkDeviceSize(plan_.pixel_count()) > rt_->max_allocation) {
-            throw Error(ErrorCode::out_of_memory, image + " needs staging buffers of " +
-                                                      mib(24 * VkDeviceSize(plan_.pixel_count())) + " but " +
-                                                      rt_->description + " allocates at most " +
-                                                      mib(rt_->max_allocation) + " (maxMemoryAllocationSize)");
-        }
-        VkDeviceSize heap = 0;
-        for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
-            heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
-        const VkDeviceSize total = 92 * VkDeviceSize(plan_.pixel_count()) + 8 * VkDeviceSize(plan_.total_texels) +
-                                   4 * lut_words() + 4 * VkDeviceSize(plan_.stats_words());
-        if (total > heap) {
-            throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) +
-                                                      " of buffers but the largest heap of " + rt_->description +
-                                                      " has " + mib(heap));
-        }
-        const uint64_t groups_1d =
-            (uint64_t(std::max<size_t>(plan_.pixel_count(), plan_.lut_size())) + kGroup1D - 1) / kGroup1D;
+        const size_t height = width_ == 0 ? 0 : pixels / width_;
+        const uint64_t groups_1d = (uint64_t(largest_1d) + PYR_GROUP_1D - 1) / PYR_GROUP_1D;
         const uint64_t rows_1d = (groups_1d + max_groups_x_ - 1) / max_groups_x_;
-        const uint64_t gx = (uint64_t(plan_.width) + kGroup2D - 1) / kGroup2D;
-        const uint64_t gy = (uint64_t(plan_.height) + kGroup2D - 1) / kGroup2D;
+        const uint64_t gx = (uint64_t(width_) + PYR_GROUP_2D - 1) / PYR_GROUP_2D;
+        const uint64_t gy = (uint64_t(height) + PYR_GROUP_2D - 1) / PYR_GROUP_2D;
         if (rows_1d > lim.maxComputeWorkGroupCount[1] || gx > lim.maxComputeWorkGroupCount[0] ||
             gy > lim.maxComputeWorkGroupCount[1]) {
-            throw Error(ErrorCode::image_too_large, image + " needs more workgroups than " + rt_->description +
+            throw Error(ErrorCode::image_too_large, "a " + std::to_string(width_) + " x " + std::to_string(height) +
+                                                        " image needs more workgroups than " + rt_->description +
                                                         " dispatches (maxComputeWorkGroupCount " +
                                                         std::to_string(lim.maxComputeWorkGroupCount[0]) + " x " +
                                                         std::to_string(lim.maxComputeWorkGroupCount[1]) + ")");
         }
     }
 
-    [[nodiscard]] uint32_t width() const { return uint32_t(plan_.width); }
-    [[nodiscard]] uint32_t height() const { return uint32_t(plan_.height); }
-    [[nodiscard]] uint32_t pixels() const { return uint32_t(plan_.pixel_count()); }
-    [[nodiscard]] uint32_t stats_runs() const { return plan_.stats_runs_per_row() * height(); }
-    // The compaction table, then the statistics words when asked for (shaders/pyr_vulkan.comp, binding 5).
-    [[nodiscard]] VkDeviceSize lut_words() const { return VkDeviceSize(plan_.lut_size()) + plan_.stats_words(); }
-
-    const core::Plan& plan_;
     std::shared_ptr<Runtime> rt_;
     std::array<VulkanBuffer, kBindingCount> buffers_;
-    VulkanBuffer upload_, download_, readback_, stats_download_;
+    VulkanBuffer upload_, download_;
+    VkDeviceSize upload_used_ = 0;
+    VkDeviceSize download_used_ = 0;
+    std::vector<Download> downloads_;
     VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
     VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
     VkCommandPool command_pool_ = VK_NULL_HANDLE;
@@ -565,23 +310,18 @@ private:
     VkFence fence_ = VK_NULL_HANDLE;
     VkQueryPool query_pool_ = VK_NULL_HANDLE;
     uint32_t max_groups_x_ = 65535;
-    std::array<Op, kMaxOps> ops_{};
-    size_t op_count_ = 0;
-    uint32_t fill_budget_ = kFirstBudget;
-    uint32_t fills_in_frame_ = 0;
+    uint32_t width_ = 0;
     std::array<const char*, kMaxTimestamps> timestamp_names_{};
     uint32_t timestamp_count_ = 0;
-    double host_upload_ms_ = 0;
-    double host_download_ms_ = 0;
-    bool normals_given_ = false;
-    bool from_mask_ = false;
+    bool reset_queries_ = true;
+    bool recording_ = false;
     bool in_flight_ = false;  // submitted and not yet waited for
 };
 
 }  // namespace
 
 std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
-    return std::make_unique<VulkanExecutor>(plan, runtime_for(choose_device()));
+    return gpu::make_gpu_executor(plan, std::make_unique<VulkanDevice>(runtime_for(choose_device())));
 }
 
 std::vector<std::string> describe_devices(std::string* why_none, bool* any_usable) {

@@ -339,14 +339,14 @@ void create_pipelines(Runtime& rt) {
     layout_info.pPushConstantRanges = &push;
     check(vkCreatePipelineLayout(rt.device, &layout_info, nullptr, &rt.pipeline_layout), "vkCreatePipelineLayout");
 
-    for (std::size_t e = 0; e < kEntryCount; ++e) {
+    for (std::size_t e = 0; e < gpu::kKernelCount; ++e) {
+        const char* entry = gpu::kernel_glsl_name(gpu::Kernel(e));
         const SpirvModule* found = nullptr;
         for (std::size_t m = 0; m < kSpirvModuleCount; ++m) {
-            if (std::strcmp(kSpirvModules[m].entry, kEntryNames[e]) == 0) found = &kSpirvModules[m];
+            if (std::strcmp(kSpirvModules[m].entry, entry) == 0) found = &kSpirvModules[m];
         }
         if (found == nullptr) {
-            throw Error(ErrorCode::internal,
-                        std::string("Vulkan: no SPIR-V was built for PYR_ENTRY_") + kEntryNames[e]);
+            throw Error(ErrorCode::internal, std::string("Vulkan: no SPIR-V was built for PYR_ENTRY_") + entry);
         }
         auto module_info = make_info<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
         module_info.codeSize = found->word_count * sizeof(std::uint32_t);
@@ -362,7 +362,7 @@ void create_pipelines(Runtime& rt) {
         const VkResult r = vkCreateComputePipelines(rt.device, VK_NULL_HANDLE, 1, &info, nullptr, &rt.pipelines[e]);
         vkDestroyShaderModule(rt.device, module, nullptr);
         if (r != VK_SUCCESS) {
-            fail(r, (std::string("vkCreateComputePipelines(PYR_ENTRY_") + kEntryNames[e] + ")").c_str());
+            fail(r, (std::string("vkCreateComputePipelines(PYR_ENTRY_") + entry + ")").c_str());
         }
     }
 }

@@ -11,34 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "core/gpu/device.hpp"
+
 namespace pyrseg::vulkan {
 
-// The entry points of shaders/pyr_vulkan.comp, in the order of the runtime's pipelines.
-enum Entry : std::size_t {
-    kNormals,
-    kQuantize,
-    kMetric,
-    kBindMask,
-    kMip,
-    kInitLabels,
-    kAnchor,
-    kSweepRows,
-    kSweepColumns,
-    kEdges,
-    kLutMark,
-    kScanCount,
-    kScanSums,
-    kScanNumber,
-    kCompact,
-    kStats,
-    kEntryCount
-};
-inline constexpr std::array<const char*, kEntryCount> kEntryNames = {
-    "NORMALS",       "QUANTIZE", "METRIC",   "BIND_MASK",  "MIP",       "INIT_LABELS", "ANCHOR",  "SWEEP_ROWS",
-    "SWEEP_COLUMNS", "EDGES",    "LUT_MARK", "SCAN_COUNT", "SCAN_SUMS", "SCAN_NUMBER", "COMPACT", "STATS"};
-
-inline constexpr std::uint32_t kBindingCount = 9;        // the storage buffers of shaders/pyr_vulkan.comp
-inline constexpr std::uint32_t kPushConstantBytes = 32;  // the largest PyrArgs blocks (INIT_LABELS, STATS)
+// The storage buffers of shaders/pyr_vulkan.comp (gpu::Buffer order), and its push constants: the image width, then
+// the dispatch's argument words.
+inline constexpr std::uint32_t kBindingCount = gpu::kBufferCount;
+inline constexpr std::uint32_t kPushConstantBytes = 4 * (1 + PYR_ARG_WORDS);
 
 struct DeviceRef {
     VkPhysicalDevice physical = VK_NULL_HANDLE;
@@ -68,7 +48,7 @@ struct Runtime {
     std::string description;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-    std::array<VkPipeline, kEntryCount> pipelines{};
+    std::array<VkPipeline, gpu::kKernelCount> pipelines{};  // per kernel of the table
 
     Runtime() = default;
     Runtime(const Runtime&) = delete;

@@ -1,0 +1,83 @@
+#pragma once
+// What a GPU API implements for pyrseg: buffers, transfers, dispatches of the kernel table's entry points,
+// timestamps, submit-and-wait. Everything else of a GPU backend (the passes, the buffer table, the memory checks,
+// the fills' convergence, compaction, statistics, read-back) is core/gpu/gpu_executor.cpp, once for all of them.
+// OpenMM's ComputeContext is the model: the backends differ only where their APIs do.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pyrseg/segmenter.hpp"
+#include "shaders/pyr_kernels.h"
+
+namespace pyrseg::gpu {
+
+// The kernel table (shaders/pyr_kernels.h) as host ids.
+enum class Kernel : std::uint32_t {
+#define PYR_HOST_KERNEL_ID(name, NAME, dims) name,
+    PYR_KERNEL_TABLE(PYR_HOST_KERNEL_ID)
+#undef PYR_HOST_KERNEL_ID
+        count
+};
+inline constexpr std::size_t kKernelCount = std::size_t(Kernel::count);
+// pyr_k_<name>, and whether the kernel's grid is 1D (a count) or 2D (width x height).
+[[nodiscard]] const char* kernel_name(Kernel k);        // "normals"
+[[nodiscard]] const char* kernel_entry_name(Kernel k);  // "pyr_k_normals"
+[[nodiscard]] const char* kernel_glsl_name(Kernel k);   // "NORMALS" (PYR_ENTRY_NORMALS)
+[[nodiscard]] int kernel_dims(Kernel k);
+
+// A dispatch's argument words (shaders/pyr_entries.h lists each kernel's).
+struct Args {
+    std::array<std::uint32_t, PYR_ARG_WORDS> words{};
+};
+
+// The buffers every GPU backend binds, in this order (OpenCL's kernel arguments, Vulkan's bindings, CUDA's
+// context). Sizes come from the plan (gpu::buffer_sizes); the mask holds mask_texel_bytes per texel.
+enum class Buffer : std::uint32_t { points, normals, quant, mask, labels, lut, sums, flags, out, count };
+inline constexpr std::size_t kBufferCount = std::size_t(Buffer::count);
+[[nodiscard]] const char* buffer_name(Buffer b);
+using BufferSizes = std::array<std::size_t, kBufferCount>;  // bytes
+
+struct DeviceLimits {
+    std::size_t max_buffer_bytes = 0;  // the largest buffer a kernel may bind
+    std::string max_buffer_what;       // where that limit comes from, for errors: "maxStorageBufferRange"
+    std::size_t memory_bytes = 0;      // what all buffers of a Segmenter may take together
+    std::string memory_what;           // "the largest heap", "free memory"
+    std::size_t mask_texel_bytes = 1;  // 1, or 4 where the shading language has no byte access (GLSL)
+};
+
+class Device {
+public:
+    virtual ~Device() = default;
+    Device() = default;
+    Device(const Device&) = delete;
+    Device& operator=(const Device&) = delete;
+
+    [[nodiscard]] virtual std::string description() const = 0;
+    [[nodiscard]] virtual DeviceLimits limits() const = 0;
+    // Once, before anything else; the executor has checked the sizes against limits(). The image width is part of
+    // every kernel's context (PYR_W).
+    virtual void allocate(const BufferSizes& sizes, std::uint32_t image_width) = 0;
+
+    // Queued in order with the dispatches. upload reads `src` before it returns or before finish() returns (the
+    // caller keeps it until then); download's `dst` is written by the time finish() returns.
+    virtual void upload(Buffer b, std::size_t offset, const void* src, std::size_t bytes) = 0;
+    virtual void download(Buffer b, std::size_t offset, void* dst, std::size_t bytes) = 0;
+    virtual void zero(Buffer b, std::size_t offset, std::size_t bytes) = 0;
+    // A 1D kernel over `nx` invocations (ny = 1), or a 2D kernel over nx x ny texels; nothing when either is 0.
+    virtual void dispatch(Kernel k, std::uint32_t nx, std::uint32_t ny, const Args& args) = 0;
+
+    // A timestamp: the pass `pass` starts here (nullptr: the frame ends here).
+    virtual void mark(const char* pass) = 0;
+    // Submits what is queued and waits for it.
+    virtual void finish() = 0;
+    // After finish(): overwrites `timings` (the pipeline's host times, same pass names) with the device's times
+    // between marks of the frame, and returns true; false when the device keeps none.
+    virtual bool pass_times(std::vector<PassTiming>& timings) = 0;
+    // A new frame starts: forget the last frame's marks.
+    virtual void begin_frame() = 0;
+};
+
+}  // namespace pyrseg::gpu

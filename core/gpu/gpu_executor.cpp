@@ -1,0 +1,310 @@
+// The passes of every GPU backend, written once over gpu::Device: which kernel each pass dispatches with which
+// argument words (shaders/pyr_entries.h lists them per kernel), the buffer table, the fills' convergence, compaction,
+// statistics and read-back.
+#include "core/gpu/gpu_executor.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/segment_stats.hpp"
+#include "core/staging.hpp"
+#include "pyrseg/error.hpp"
+
+namespace pyrseg::gpu {
+
+namespace {
+
+using std::size_t;
+using std::uint32_t;
+
+constexpr uint32_t kMaxBatch = 64;  // fill rounds between two reads of the convergence flags
+
+struct KernelInfo {
+    const char* name;
+    const char* entry;
+    const char* glsl;
+    int dims;
+};
+
+constexpr KernelInfo kKernels[] = {
+#define PYR_HOST_KERNEL_INFO(name, NAME, dims) {#name, "pyr_k_" #name, #NAME, dims},
+    PYR_KERNEL_TABLE(PYR_HOST_KERNEL_INFO)
+#undef PYR_HOST_KERNEL_INFO
+};
+static_assert(std::size(kKernels) == kKernelCount);
+
+constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels", "lut", "sums", "flags", "out"};
+static_assert(std::size(kBufferNames) == kBufferCount);
+
+Args args(std::initializer_list<uint32_t> words) {
+    Args a;
+    std::copy(words.begin(), words.end(), a.words.begin());
+    return a;
+}
+
+uint32_t bits(float f) {
+    return std::bit_cast<uint32_t>(f);
+}
+
+uint32_t bits(std::int32_t i) {
+    return std::bit_cast<uint32_t>(i);
+}
+
+class GpuExecutor final : public core::PassExecutor {
+public:
+    GpuExecutor(const core::Plan& plan, std::unique_ptr<Device> device)
+        : plan_(plan), device_(std::move(device)), limits_(device_->limits()) {
+        const BufferSizes sizes = buffer_sizes(plan_, limits_);
+        check_fits(plan_, sizes, limits_, device_->description());
+        device_->allocate(sizes, uint32_t(plan_.width));
+        const size_t px = plan_.pixel_count();
+        staged_.resize(core::StagedResults::kBytesPerPixel * px);
+        host_flags_.resize(kMaxBatch);
+        host_stats_.resize(plan_.stats_words());
+    }
+
+    [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
+
+    void bind_cloud(const CloudView& cloud) override {
+        start_frame();
+        upload_xyz(cloud, cloud.points, Buffer::points, host_points_);
+        if (cloud.normals != nullptr) upload_xyz(cloud, cloud.normals, Buffer::normals, host_normals_);
+        from_mask_ = false;
+    }
+
+    // The caller's mask travels in the points buffer, which a mask frame does not otherwise use: one word per pixel,
+    // bit 0 fillable, bit 1 valid.
+    void bind_mask(const MaskView& mask) override {
+        start_frame();
+        const size_t w = size_t(plan_.width);
+        const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
+        host_mask_.resize(plan_.pixel_count());
+        for (size_t y = 0; y < size_t(plan_.height); ++y) {
+            for (size_t x = 0; x < w; ++x) {
+                const bool valid = mask.valid == nullptr || mask.valid[y * stride + x] != 0;
+                host_mask_[y * w + x] = (mask.fillable[y * stride + x] != 0 ? 1u : 0u) | (valid ? 2u : 0u);
+            }
+        }
+        device_->upload(Buffer::points, 0, host_mask_.data(), 4 * host_mask_.size());
+        device_->dispatch(Kernel::bind_mask, pixels(), 1, args({pixels(), plan_.full().offset}));
+        from_mask_ = true;
+    }
+
+    void begin_pass(const char* pass) override { device_->mark(pass); }
+
+    void estimate_normals() override {
+        device_->dispatch(Kernel::normals, width(), height(), args({height(), uint32_t(plan_.params.normal_radius)}));
+    }
+
+    void quantize() override { device_->dispatch(Kernel::quantize, pixels(), 1, args({pixels()})); }
+
+    void metric() override {
+        const core::Thresholds t = plan_.thresholds;
+        device_->dispatch(Kernel::metric, width(), height(),
+                          args({height(), plan_.full().offset, bits(t.curvature), bits(t.depth)}));
+    }
+
+    void mip(int parent_level) override {
+        const PyrLevel p = plan_.level(parent_level);
+        const PyrLevel c = plan_.level(parent_level + 1);
+        device_->dispatch(Kernel::mip, p.width, p.height,
+                          args({p.width, p.height, p.offset, c.width, c.height, c.offset}));
+    }
+
+    void init_labels(int level, uint32_t mode) override {
+        const PyrLevel l = plan_.level(level);
+        const PyrLevel p = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
+        device_->dispatch(Kernel::init_labels, l.width, l.height,
+                          args({l.width, l.height, l.offset, p.width, p.height, p.offset, mode}));
+    }
+
+    // Rounds of row and column sweeps in growing batches (2, 4, ... 64 rounds). Within a batch, a round after one
+    // that changed nothing returns at once on the device; the host reads a batch's flags with one download and
+    // stops after the first batch with a round that changed nothing.
+    void fill_to_fixed_point(int level, uint32_t anchor_max) override {
+        const PyrLevel l = plan_.level(level);
+        if (anchor_max != 0) {
+            const uint32_t count = l.width * l.height;
+            device_->dispatch(Kernel::anchor, count, 1, args({l.offset, count, anchor_max}));
+        }
+        for (uint32_t batch = 2;; batch = std::min(kMaxBatch, batch * 2)) {
+            device_->zero(Buffer::flags, 0, 4 * size_t(batch));
+            for (uint32_t slot = 0; slot < batch; ++slot) sweep_round(l, 0, slot);
+            device_->download(Buffer::flags, 0, host_flags_.data(), 4 * size_t(batch));
+            device_->finish();
+            const auto unchanged = std::find(host_flags_.begin(), host_flags_.begin() + batch, 0u);
+            if (unchanged != host_flags_.begin() + batch) {
+                fill_rounds_ += uint32_t(unchanged - host_flags_.begin()) + 1;
+                break;
+            }
+            fill_rounds_ += batch;
+        }
+    }
+
+    void fill_once(int level) override { sweep_round(plan_.level(level), 1, 0); }
+
+    void label_edges() override {
+        device_->dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset}));
+    }
+
+    void compact(bool apply) override {
+        const uint32_t count = plan_.lut_size();
+        const uint32_t chunks = plan_.scan_chunks();
+        device_->zero(Buffer::lut, 0, 4 * size_t(count));
+        device_->dispatch(Kernel::lut_mark, pixels(), 1, args({pixels(), plan_.full().offset}));
+        device_->dispatch(Kernel::scan_count, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
+        device_->dispatch(Kernel::scan_sums, 1, 1, args({chunks}));
+        device_->dispatch(Kernel::scan_number, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
+        device_->dispatch(Kernel::compact, pixels(), 1, args({pixels(), plan_.full().offset, apply ? 1u : 0u}));
+        device_->download(Buffer::sums, 4 * size_t(chunks), &segment_count_, 4);
+    }
+
+    // K is known on the device only: every slot is cleared, and read_back fetches the K used.
+    void segment_stats() override {
+        device_->zero(Buffer::lut, 4 * size_t(plan_.lut_size()), 4 * plan_.stats_words());
+        const uint32_t runs = plan_.stats_runs_per_row() * height();
+        device_->dispatch(Kernel::stats, runs, 1,
+                          args({height(), plan_.full().offset, runs, from_mask_ ? 0u : 1u,
+                                bits(plan_.stats_point_scale()), plan_.lut_size(), plan_.stats_slots}));
+    }
+
+    void read_back(Result& out, const Outputs& outputs) override {
+        device_->mark("download");
+        const size_t px = plan_.pixel_count();
+        const size_t full = plan_.full().offset;
+        const size_t texel = limits_.mask_texel_bytes;
+        using S = core::StagedResults;
+        unsigned char* staged = staged_.data();
+        device_->download(Buffer::out, 0, staged + S::kLabels * px, 4 * px);
+        if (outputs.raw_labels) device_->download(Buffer::labels, 4 * full, staged + S::kRawLabels * px, 4 * px);
+        if (outputs.fillable_mask) device_->download(Buffer::mask, texel * full, staged + S::kMask * px, texel * px);
+        if (outputs.normals && !from_mask_) device_->download(Buffer::normals, 0, staged + S::kNormals * px, 12 * px);
+        device_->mark(nullptr);
+        device_->finish();
+        out.width = plan_.width;
+        out.height = plan_.height;
+        out.segment_count = segment_count_;
+        core::unstage_results(staged, px, texel == 4, outputs, !from_mask_, out);
+        out.segments.clear();
+        if (plan_.stats_slots != 0) {
+            const size_t words = std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
+            if (words != 0) {
+                device_->download(Buffer::lut, 4 * size_t(plan_.lut_size()), host_stats_.data(), 4 * words);
+                device_->finish();
+            }
+            core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
+        }
+    }
+
+    bool device_timings(std::vector<PassTiming>& timings) override { return device_->pass_times(timings); }
+
+private:
+    void start_frame() {
+        fill_rounds_ = 0;
+        device_->begin_frame();
+        device_->mark("upload");
+    }
+
+    // Round `slot` of a batch: rows, then columns (shaders/pyr_entries.h: sweep_rows, sweep_columns).
+    void sweep_round(const PyrLevel& l, uint32_t once, uint32_t slot) {
+        device_->dispatch(Kernel::sweep_rows, l.height, 1, args({l.width, l.height, l.offset, once, slot, 0}));
+        device_->dispatch(Kernel::sweep_columns, l.width, 1, args({l.width, l.height, l.offset, once, slot, 0}));
+    }
+
+    // Packed clouds go straight from the caller's memory; strided ones through staging sized once per Segmenter.
+    void upload_xyz(const CloudView& cloud, const float* data, Buffer b, std::vector<float>& staging) {
+        const float* src = data;
+        if (!core::is_packed_xyz(cloud)) {
+            staging.resize(3 * plan_.pixel_count());
+            core::pack_xyz(cloud, data, staging.data());
+            src = staging.data();
+        }
+        device_->upload(b, 0, src, 12 * plan_.pixel_count());
+    }
+
+    [[nodiscard]] uint32_t width() const { return uint32_t(plan_.width); }
+    [[nodiscard]] uint32_t height() const { return uint32_t(plan_.height); }
+    [[nodiscard]] uint32_t pixels() const { return uint32_t(plan_.pixel_count()); }
+
+    const core::Plan& plan_;
+    std::unique_ptr<Device> device_;
+    DeviceLimits limits_;
+    std::vector<float> host_points_, host_normals_;  // staging for strided clouds
+    std::vector<uint32_t> host_mask_;
+    std::vector<unsigned char> staged_;  // the frame's results, laid out as core::StagedResults
+    std::vector<uint32_t> host_flags_;
+    std::vector<uint32_t> host_stats_;
+    uint32_t segment_count_ = 0;
+    uint32_t fill_rounds_ = 0;
+    bool from_mask_ = false;
+};
+
+}  // namespace
+
+const char* kernel_name(Kernel k) {
+    return kKernels[size_t(k)].name;
+}
+const char* kernel_entry_name(Kernel k) {
+    return kKernels[size_t(k)].entry;
+}
+const char* kernel_glsl_name(Kernel k) {
+    return kKernels[size_t(k)].glsl;
+}
+int kernel_dims(Kernel k) {
+    return kKernels[size_t(k)].dims;
+}
+const char* buffer_name(Buffer b) {
+    return kBufferNames[size_t(b)];
+}
+
+BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
+    const size_t px = plan.pixel_count();
+    const size_t texels = size_t(plan.total_texels);
+    BufferSizes s{};
+    s[size_t(Buffer::points)] = 12 * px;  // also a mask frame's input words (4 per pixel)
+    s[size_t(Buffer::normals)] = 12 * px;
+    s[size_t(Buffer::quant)] = 16 * px;
+    s[size_t(Buffer::mask)] = limits.mask_texel_bytes * texels;
+    s[size_t(Buffer::labels)] = 4 * texels;
+    s[size_t(Buffer::lut)] = 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
+    s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1);               // K last
+    s[size_t(Buffer::flags)] = 4 * size_t(kMaxBatch);
+    s[size_t(Buffer::out)] = 4 * px;
+    for (size_t& bytes : s) bytes = std::max<size_t>(bytes, 4);
+    return s;
+}
+
+void check_fits(const core::Plan& plan, const BufferSizes& sizes, const DeviceLimits& limits,
+                const std::string& device) {
+    size_t largest = 0;
+    Buffer which = Buffer::points;
+    size_t total = 0;
+    for (size_t b = 0; b < kBufferCount; ++b) {
+        total += sizes[b];
+        if (sizes[b] > largest) {
+            largest = sizes[b];
+            which = Buffer(b);
+        }
+    }
+    const auto mib = [](size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; };
+    const std::string image = "a " + std::to_string(plan.width) + " x " + std::to_string(plan.height) + " image";
+    if (largest > limits.max_buffer_bytes) {
+        throw Error(ErrorCode::out_of_memory, image + " needs a " + buffer_name(which) + " buffer of " + mib(largest) +
+                                                  " but " + device + " binds at most " + mib(limits.max_buffer_bytes) +
+                                                  " (" + limits.max_buffer_what + ")");
+    }
+    if (total > limits.memory_bytes) {
+        throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) + " of buffers but " + device + " has " +
+                                                  mib(limits.memory_bytes) + " (" + limits.memory_what + ")");
+    }
+}
+
+std::unique_ptr<core::PassExecutor> make_gpu_executor(const core::Plan& plan, std::unique_ptr<Device> device) {
+    return std::make_unique<GpuExecutor>(plan, std::move(device));
+}
+
+}  // namespace pyrseg::gpu

@@ -1,0 +1,205 @@
+/* Every GPU entry point, written once for OpenCL C, CUDA and GLSL: thin wrappers over the shared pass functions
+ * (shaders/pyr_*.h), one per line of the kernel table (shaders/pyr_kernels.h). Each dialect's file
+ * (pyr_opencl.cl, pyr_cuda.cuh, pyr_vulkan.comp) defines, before including this one:
+ *  - PYR_KERNEL_1D(name) / PYR_KERNEL_2D(name): the entry point's head;
+ *  - PYR_I (1D: the invocation's index), PYR_X and PYR_Y (2D: its texel);
+ *  - PYR_ARG(k), PYR_ARG_I32(k), PYR_ARG_F32(k): word k of the dispatch's PyrArgs;
+ *  - PYR_W (the image width) and PYR_ENTRY_CTX (the context an entry point passes to shared functions);
+ *  - the buffers pyr_buf_points, _normals, _quant, _mask, _labels, _lut, _sums, _flags, _out; PYR_STORE_MASK(i, v)
+ *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer);
+ *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
+ * The host side of every dispatch is core/gpu/gpu_executor.cpp; the argument words of each kernel are listed
+ * above it. */
+#ifndef PYR_ENTRIES_H
+#define PYR_ENTRIES_H
+#include "pyr_kernels.h"
+
+/* normals (2D, w x h): h, radius */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_NORMALS)
+PYR_KERNEL_2D(normals) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    PyrIVec3 q = pyr_normal_q(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1));
+    pyr_u32 i = y * PYR_W + x;
+    pyr_buf_normals[i * 3u + 0u] = PYR_F32(q.x) * PYR_NORMAL_UNIT;
+    pyr_buf_normals[i * 3u + 1u] = PYR_F32(q.y) * PYR_NORMAL_UNIT;
+    pyr_buf_normals[i * 3u + 2u] = PYR_F32(q.z) * PYR_NORMAL_UNIT;
+}
+#endif
+
+/* quantize (1D, pixels): pixels */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_QUANTIZE)
+PYR_KERNEL_1D(quantize) {
+    pyr_u32 i = PYR_I;
+    if (i >= PYR_ARG(0)) return;
+    PyrQuant q = pyr_quantize(pyr_buf_points[i * 3u], pyr_buf_points[i * 3u + 1u], pyr_buf_points[i * 3u + 2u],
+                              pyr_buf_normals[i * 3u], pyr_buf_normals[i * 3u + 1u], pyr_buf_normals[i * 3u + 2u]);
+    pyr_buf_quant[i * 4u + 0u] = q.qx;
+    pyr_buf_quant[i * 4u + 1u] = q.qy;
+    pyr_buf_quant[i * 4u + 2u] = q.qz;
+    pyr_buf_quant[i * 4u + 3u] = PYR_I32(q.valid);
+}
+#endif
+
+/* metric (2D, w x h): h, offset of level N, Tc (int), dt (float) */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_METRIC)
+PYR_KERNEL_2D(metric) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    PYR_STORE_MASK(PYR_ARG(1) + y * PYR_W + x,
+                   pyr_metric_fillable(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG_I32(2), PYR_ARG_F32(3)));
+}
+#endif
+
+/* bind_mask (1D, pixels): pixels, offset of level N. The caller's mask arrives in the points buffer, one word per
+ * pixel: bit 0 fillable, bit 1 valid. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_BIND_MASK)
+PYR_KERNEL_1D(bind_mask) {
+    pyr_u32 i = PYR_I;
+    if (i >= PYR_ARG(0)) return;
+    pyr_u32 packed = PYR_MASK_INPUT(i);
+    PYR_STORE_MASK(PYR_ARG(1) + i, packed & 1u);
+    pyr_buf_quant[i * 4u + 3u] = PYR_I32((packed >> 1u) & 1u);
+}
+#endif
+
+/* mip (2D, parent level): parent width, height, offset; child width, height, offset */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MIP)
+PYR_KERNEL_2D(mip) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
+    PYR_STORE_MASK(PYR_ARG(2) + y * PYR_ARG(0) + x,
+                   pyr_mip_texel(PYR_ENTRY_CTX, pyr_level(PYR_ARG(3), PYR_ARG(4), PYR_ARG(5)), x, y));
+}
+#endif
+
+/* init_labels (2D, the level): level width, height, offset; parent width, height, offset; mode (PYR_INIT_*) */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_INIT_LABELS)
+PYR_KERNEL_2D(init_labels) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
+    pyr_buf_labels[PYR_ARG(2) + y * PYR_ARG(0) + x] =
+        pyr_label_init_texel(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)),
+                             pyr_level(PYR_ARG(3), PYR_ARG(4), PYR_ARG(5)), x, y, PYR_ARG(6));
+}
+#endif
+
+/* anchor (1D, texels of the level): offset, count, anchor_max */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_ANCHOR)
+PYR_KERNEL_1D(anchor) {
+    pyr_u32 i = PYR_I;
+    if (i >= PYR_ARG(1)) return;
+    i += PYR_ARG(0);
+    PYR_STORE_MASK(i, pyr_anchor_mask(PYR_U32(pyr_buf_mask[i]), pyr_buf_labels[i], PYR_ARG(2)));
+}
+#endif
+
+/* sweep_rows (1D, rows) and sweep_columns (1D, columns): level width, height, offset; once; slot; first.
+ * One invocation per line, there and back. Rounds are dispatched ahead in batches: round `slot` sets flags[slot]
+ * when it changed a label, and returns at once when round slot - 1 of the same batch (from `first`) changed
+ * nothing (the fixed point was reached). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SWEEP_ROWS)
+PYR_KERNEL_1D(sweep_rows) {
+    pyr_u32 line = PYR_I;
+    pyr_u32 slot = PYR_ARG(4);
+    if (line >= PYR_ARG(1) || (slot != PYR_ARG(5) && pyr_buf_flags[slot - 1u] == 0u)) return;
+    if (pyr_sweep_row(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, PYR_ARG(3)) != 0u)
+        pyr_buf_flags[slot] = 1u;
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SWEEP_COLUMNS)
+PYR_KERNEL_1D(sweep_columns) {
+    pyr_u32 line = PYR_I;
+    pyr_u32 slot = PYR_ARG(4);
+    if (line >= PYR_ARG(0) || (slot != PYR_ARG(5) && pyr_buf_flags[slot - 1u] == 0u)) return;
+    if (pyr_sweep_column(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, PYR_ARG(3)) != 0u)
+        pyr_buf_flags[slot] = 1u;
+}
+#endif
+
+/* edges (2D, w x h): h, offset of level N. In place: only valid, non-fillable, unlabelled pixels change, and no
+ * pixel reads those. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_EDGES)
+PYR_KERNEL_2D(edges) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= PYR_ARG(0)) return;
+    pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
+    pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y);
+    if (l != pyr_buf_labels[i]) pyr_buf_labels[i] = l;
+}
+#endif
+
+/* lut_mark (1D, pixels): pixels, offset of level N. Every invocation that marks a label writes the same value: the
+ * race is benign. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_LUT_MARK)
+PYR_KERNEL_1D(lut_mark) {
+    pyr_u32 i = PYR_I;
+    if (i >= PYR_ARG(0)) return;
+    pyr_u32 l = pyr_buf_labels[PYR_ARG(1) + i];
+    if (l != 0u) pyr_buf_lut[l] = 1u;
+}
+#endif
+
+/* Marks to new ids 1..K in three steps: count marks per chunk, scan the chunk counts (K last), number within chunks.
+ * scan_count and scan_number (1D, chunks): count, chunk, chunks. scan_sums (1D, one invocation): chunks. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SCAN_COUNT)
+PYR_KERNEL_1D(scan_count) {
+    pyr_u32 c = PYR_I;
+    if (c >= PYR_ARG(2)) return;
+    pyr_u32 begin = c * PYR_ARG(1);
+    pyr_buf_sums[c] = pyr_count_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)));
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SCAN_SUMS)
+PYR_KERNEL_1D(scan_sums) {
+    if (PYR_I != 0u) return;
+    pyr_u32 running = 0u;
+    for (pyr_u32 c = 0u; c < PYR_ARG(0); ++c) {
+        pyr_u32 n = pyr_buf_sums[c];
+        pyr_buf_sums[c] = running;
+        running += n;
+    }
+    pyr_buf_sums[PYR_ARG(0)] = running;
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SCAN_NUMBER)
+PYR_KERNEL_1D(scan_number) {
+    pyr_u32 c = PYR_I;
+    if (c >= PYR_ARG(2)) return;
+    pyr_u32 begin = c * PYR_ARG(1);
+    pyr_number_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)), pyr_buf_sums[c]);
+}
+#endif
+
+/* compact (1D, pixels): pixels, offset of level N, apply */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_COMPACT)
+PYR_KERNEL_1D(compact) {
+    pyr_u32 i = PYR_I;
+    if (i >= PYR_ARG(0)) return;
+    pyr_u32 raw = pyr_buf_labels[PYR_ARG(1) + i];
+    pyr_buf_out[i] = PYR_ARG(2) != 0u ? pyr_compact_label(PYR_ENTRY_CTX, raw) : raw;
+}
+#endif
+
+/* stats (1D, runs): h, offset of level N, runs, with_points, point_scale (float), base (the first statistics word,
+ * after the label table in the lut buffer), slots */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_STATS)
+PYR_KERNEL_1D(stats) {
+    pyr_u32 run = PYR_I;
+    if (run >= PYR_ARG(2)) return;
+    pyr_stats_run(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), run, PYR_ARG(3), PYR_ARG_F32(4), PYR_ARG(5),
+                  PYR_ARG(6));
+}
+#endif
+
+#endif /* PYR_ENTRIES_H */

@@ -1,0 +1,37 @@
+/* The kernel table: every GPU entry point, once. K(name, NAME, dims) per kernel:
+ *  - name: the entry point is pyr_k_<name> (OpenCL, CUDA) and the host's gpu::Kernel::<name>;
+ *  - NAME: the GLSL build compiles shaders/pyr_entries.h once per kernel with -DPYR_ENTRY_<NAME>
+ *    (core/CMakeLists.txt reads the names from this table);
+ *  - dims: 1, invocations over a count (PYR_I), or 2, over a width x height grid (PYR_X, PYR_Y).
+ * Every kernel takes the Segmenter's buffers (bound once) and one PyrArgs of PYR_ARG_WORDS words per dispatch;
+ * the words of each are listed where it is defined, in shaders/pyr_entries.h. Adding a kernel: one line here, its
+ * body there, and its dispatch in core/gpu/gpu_executor.cpp. */
+#ifndef PYR_KERNELS_H
+#define PYR_KERNELS_H
+
+#define PYR_KERNEL_TABLE(K)            \
+    K(normals, NORMALS, 2)             \
+    K(quantize, QUANTIZE, 1)           \
+    K(metric, METRIC, 2)               \
+    K(bind_mask, BIND_MASK, 1)         \
+    K(mip, MIP, 2)                     \
+    K(init_labels, INIT_LABELS, 2)     \
+    K(anchor, ANCHOR, 1)               \
+    K(sweep_rows, SWEEP_ROWS, 1)       \
+    K(sweep_columns, SWEEP_COLUMNS, 1) \
+    K(edges, EDGES, 2)                 \
+    K(lut_mark, LUT_MARK, 1)           \
+    K(scan_count, SCAN_COUNT, 1)       \
+    K(scan_sums, SCAN_SUMS, 1)         \
+    K(scan_number, SCAN_NUMBER, 1)     \
+    K(compact, COMPACT, 1)             \
+    K(stats, STATS, 1)
+
+/* Per-dispatch argument words (uint32; ints and floats by their bits). */
+#define PYR_ARG_WORDS 8
+
+/* Workgroup sizes of the GLSL entry points (compile-time there); other dialects choose their own. */
+#define PYR_GROUP_1D 64u
+#define PYR_GROUP_2D 8u
+
+#endif /* PYR_KERNELS_H */
