@@ -45,8 +45,8 @@ public:
     // times its device measured, and returns true. Called after read_back.
     virtual bool device_timings(std::vector<PassTiming>& /*timings*/) { return false; }
     // Rounds of row and column sweeps the fixed-point fills (steps 2 and 4) of the last frame took, each fill
-    // counted up to and including its first round that changed nothing; 0 for a backend that does not fill by
-    // sweeps (the CPU's union-find). Depends only on the mask, not on the device. Read after read_back.
+    // counted up to and including its first round that changed nothing; 0 for the union-find fills every backend
+    // uses by default (only the CPU's PYRSEG_CPU_FILL=sweeps sweeps). Read after read_back.
     [[nodiscard]] virtual std::uint32_t fill_rounds() const { return 0; }
 };
 

@@ -15,7 +15,7 @@ struct PyrCudaCtx {
     unsigned* labels;
     unsigned* lut; /* then the statistics words, PYR_STATS_WORDS per slot */
     unsigned* sums;
-    unsigned* flags;
+    unsigned* fill; /* the fills' union-find: parents, then minima */
     unsigned* out;
     unsigned w;
 };
@@ -63,7 +63,7 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 #define pyr_buf_labels pyr_ctx.labels
 #define pyr_buf_lut pyr_ctx.lut
 #define pyr_buf_sums pyr_ctx.sums
-#define pyr_buf_flags pyr_ctx.flags
+#define pyr_buf_fill pyr_ctx.fill
 #define pyr_buf_out pyr_ctx.out
 
 #define PYR_KERNEL_1D(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)
@@ -78,6 +78,9 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 #define PYR_ENTRY_CTX pyr_ctx
 #define PYR_STORE_MASK(i, v) (pyr_ctx.mask[i] = static_cast<unsigned char>(v))
 #define PYR_MASK_INPUT(i) (reinterpret_cast<const unsigned*>(pyr_ctx.points)[i])
+#define PYR_UF_LOAD(i) (*static_cast<volatile unsigned*>(&pyr_ctx.fill[i]))
+#define PYR_UF_STORE(i, v) (pyr_ctx.fill[i] = (v))
+#define PYR_UF_MIN(i, v) pyr_cuda_atomic_min(&pyr_ctx.fill[i], (v))
 #define PYR_ENTRY_ALL 1
 
 #include "pyr_entries.h"

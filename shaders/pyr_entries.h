@@ -5,14 +5,16 @@
  *  - PYR_I (1D: the invocation's index), PYR_X and PYR_Y (2D: its texel);
  *  - PYR_ARG(k), PYR_ARG_I32(k), PYR_ARG_F32(k): word k of the dispatch's PyrArgs;
  *  - PYR_W (the image width) and PYR_ENTRY_CTX (the context an entry point passes to shared functions);
- *  - the buffers pyr_buf_points, _normals, _quant, _mask, _labels, _lut, _sums, _flags, _out; PYR_STORE_MASK(i, v)
- *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer);
+ *  - the buffers pyr_buf_points, _normals, _quant, _mask, _labels, _lut, _sums, _fill, _out; PYR_STORE_MASK(i, v)
+ *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer); PYR_UF_LOAD, PYR_UF_STORE
+ *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h);
  *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
  * The host side of every dispatch is core/gpu/gpu_executor.cpp; the argument words of each kernel are listed
  * above it. */
 #ifndef PYR_ENTRIES_H
 #define PYR_ENTRIES_H
 #include "pyr_kernels.h"
+#include "pyr_uf.h"
 
 /* normals (2D, w x h): h, radius */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_NORMALS)
@@ -100,27 +102,63 @@ PYR_KERNEL_1D(anchor) {
 }
 #endif
 
-/* sweep_rows (1D, rows) and sweep_columns (1D, columns): level width, height, offset; once; slot; first.
- * One invocation per line, there and back. Rounds are dispatched ahead in batches: round `slot` sets flags[slot]
- * when it changed a label, and returns at once when round slot - 1 of the same batch (from `first`) changed
- * nothing (the fixed point was reached). */
-#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SWEEP_ROWS)
-PYR_KERNEL_1D(sweep_rows) {
-    pyr_u32 line = PYR_I;
-    pyr_u32 slot = PYR_ARG(4);
-    if (line >= PYR_ARG(1) || (slot != PYR_ARG(5) && pyr_buf_flags[slot - 1u] == 0u)) return;
-    if (pyr_sweep_row(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, PYR_ARG(3)) != 0u)
-        pyr_buf_flags[slot] = 1u;
+/* Steps 2 and 4 (shaders/pyr_uf.h), four dispatches per fill over a level of n texels:
+ * uf_init (1D, n): n. Every texel its own parent, every minimum none. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_INIT)
+PYR_KERNEL_1D(uf_init) {
+    pyr_u32 k = PYR_I;
+    if (k >= PYR_ARG(0)) return;
+    PYR_UF_STORE(k, k);
+    PYR_UF_STORE(PYR_ARG(0) + k, PYR_UF_NONE);
 }
 #endif
 
-#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_SWEEP_COLUMNS)
-PYR_KERNEL_1D(sweep_columns) {
+/* uf_merge and uf_resolve (2D, the level): level width, height, offset; n */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_MERGE)
+PYR_KERNEL_2D(uf_merge) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
+    pyr_uf_merge(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), x, y);
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_RESOLVE)
+PYR_KERNEL_2D(uf_resolve) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
+    pyr_uf_resolve(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), PYR_ARG(3), x, y);
+}
+#endif
+
+/* uf_gather (1D, n): offset, n. Every eligible texel takes its component's minimum, 0 when it has none. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_GATHER)
+PYR_KERNEL_1D(uf_gather) {
+    pyr_u32 k = PYR_I;
+    if (k >= PYR_ARG(1)) return;
+    pyr_u32 i = PYR_ARG(0) + k;
+    if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[i])) == 0u) return;
+    pyr_u32 m = PYR_UF_LOAD(PYR_ARG(1) + PYR_UF_LOAD(k));
+    pyr_buf_labels[i] = m == PYR_UF_NONE ? 0u : m;
+}
+#endif
+
+/* Step 6 a and b: final_rows (1D, rows) and final_columns (1D, columns): level width, height, offset. One
+ * invocation per line, there and back (the contract's sequential schedule). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_ROWS)
+PYR_KERNEL_1D(final_rows) {
     pyr_u32 line = PYR_I;
-    pyr_u32 slot = PYR_ARG(4);
-    if (line >= PYR_ARG(0) || (slot != PYR_ARG(5) && pyr_buf_flags[slot - 1u] == 0u)) return;
-    if (pyr_sweep_column(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, PYR_ARG(3)) != 0u)
-        pyr_buf_flags[slot] = 1u;
+    if (line >= PYR_ARG(1)) return;
+    pyr_sweep_row(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, 1u);
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_COLUMNS)
+PYR_KERNEL_1D(final_columns) {
+    pyr_u32 line = PYR_I;
+    if (line >= PYR_ARG(0)) return;
+    pyr_sweep_column(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, 1u);
 }
 #endif
 

@@ -17,8 +17,12 @@
     K(mip, MIP, 2)                     \
     K(init_labels, INIT_LABELS, 2)     \
     K(anchor, ANCHOR, 1)               \
-    K(sweep_rows, SWEEP_ROWS, 1)       \
-    K(sweep_columns, SWEEP_COLUMNS, 1) \
+    K(uf_init, UF_INIT, 1)             \
+    K(uf_merge, UF_MERGE, 2)           \
+    K(uf_resolve, UF_RESOLVE, 2)       \
+    K(uf_gather, UF_GATHER, 1)         \
+    K(final_rows, FINAL_ROWS, 1)       \
+    K(final_columns, FINAL_COLUMNS, 1) \
     K(edges, EDGES, 2)                 \
     K(lut_mark, LUT_MARK, 1)           \
     K(scan_count, SCAN_COUNT, 1)       \

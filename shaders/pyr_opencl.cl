@@ -3,10 +3,10 @@
 #define PYR_CTX_PARAM                                                                                              \
     __global const float *pyr_buf_points, __global float *pyr_buf_normals, __global int *pyr_buf_quant,          \
         __global uchar *pyr_buf_mask, __global uint *pyr_buf_labels, __global uint *pyr_buf_lut,                 \
-        __global uint *pyr_buf_sums, __global uint *pyr_buf_flags, __global uint *pyr_buf_out, uint pyr_w
+        __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out, uint pyr_w
 #define PYR_CTX_ARG                                                                                               \
     pyr_buf_points, pyr_buf_normals, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut, pyr_buf_sums,     \
-        pyr_buf_flags, pyr_buf_out, pyr_w
+        pyr_buf_fill, pyr_buf_out, pyr_w
 #define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
 #define PYR_Q_VALID(i) ((uint)pyr_buf_quant[(i) * 4u + 3u])
 #define PYR_QN(i, c) pyr_buf_quant[(i) * 4u + (c)]
@@ -49,6 +49,9 @@ typedef struct PyrArgs {
 #define PYR_ENTRY_CTX PYR_CTX_ARG
 #define PYR_STORE_MASK(i, v) (pyr_buf_mask[i] = (uchar)(v))
 #define PYR_MASK_INPUT(i) (((__global const uint *)pyr_buf_points)[i])
+#define PYR_UF_LOAD(i) (((volatile __global uint *)pyr_buf_fill)[i])
+#define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
+#define PYR_UF_MIN(i, v) atomic_min(&pyr_buf_fill[i], (v))
 #define PYR_ENTRY_ALL 1
 
 #include "pyr_entries.h"

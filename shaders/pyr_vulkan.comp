@@ -16,7 +16,7 @@ layout(std430, set = 0, binding = 3) buffer PyrMaskBuf { uint pyr_buf_mask[]; };
 layout(std430, set = 0, binding = 4) buffer PyrLabelsBuf { uint pyr_buf_labels[]; };
 layout(std430, set = 0, binding = 5) buffer PyrLutBuf { uint pyr_buf_lut[]; }; /* then the statistics words */
 layout(std430, set = 0, binding = 6) buffer PyrSumsBuf { uint pyr_buf_sums[]; };   /* compaction scan; K last */
-layout(std430, set = 0, binding = 7) buffer PyrFlagsBuf { uint pyr_buf_flags[]; }; /* fill convergence */
+layout(std430, set = 0, binding = 7) coherent buffer PyrFillBuf { uint pyr_buf_fill[]; }; /* fills' union-find */
 layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };     /* compacted labels */
 #if defined(PYR_ENTRY_BIND_MASK)
 /* A mask frame's input words share binding 0 with the points (gpu_executor.cpp: bind_mask). */
@@ -66,5 +66,8 @@ layout(push_constant) uniform PyrPush {
 #define PYR_ENTRY_CTX pyr_push.w
 #define PYR_STORE_MASK(i, v) (pyr_buf_mask[i] = (v))
 #define PYR_MASK_INPUT(i) pyr_buf_mask_input[i]
+#define PYR_UF_LOAD(i) pyr_buf_fill[i]
+#define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
+#define PYR_UF_MIN(i, v) atomicMin(pyr_buf_fill[i], (v))
 
 #include "pyr_entries.h"

@@ -130,13 +130,12 @@ public:
         const size_t pixels = sizes[size_t(gpu::Buffer::out)] / 4;
         upload_ = Memory<true>(sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)],
                                "cudaMallocHost(upload staging)");
-        download_ = Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + sizes[size_t(gpu::Buffer::flags)] +
-                                     sizes[size_t(gpu::Buffer::sums)],
-                                 "cudaMallocHost(download staging)");
+        download_ =
+            Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + 64, "cudaMallocHost(download staging)");
         ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points), buffer<float>(gpu::Buffer::normals),
                           buffer<int>(gpu::Buffer::quant),          buffer<unsigned char>(gpu::Buffer::mask),
                           buffer<unsigned>(gpu::Buffer::labels),    buffer<unsigned>(gpu::Buffer::lut),
-                          buffer<unsigned>(gpu::Buffer::sums),      buffer<unsigned>(gpu::Buffer::flags),
+                          buffer<unsigned>(gpu::Buffer::sums),      buffer<unsigned>(gpu::Buffer::fill),
                           buffer<unsigned>(gpu::Buffer::out),       image_width};
     }
 

@@ -68,11 +68,10 @@ public:
             const std::string what = std::string("the ") + gpu::buffer_name(gpu::Buffer(b)) + " buffer";
             buffers_[b] = VulkanBuffer(*rt_, sizes[b], VulkanBuffer::Memory::device, what.c_str());
         }
-        // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count, fill
-        // flags, statistics), each packed from offset 0 between two finish() calls.
+        // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count,
+        // statistics), each packed from offset 0 between two finish() calls.
         const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)];
-        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] +
-                                  sizes[size_t(gpu::Buffer::flags)] + sizes[size_t(gpu::Buffer::sums)];
+        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] + 64;
         upload_ = VulkanBuffer(*rt_, up, VulkanBuffer::Memory::host, "the upload staging buffer");
         download_ = VulkanBuffer(*rt_, down, VulkanBuffer::Memory::host, "the download staging buffer");
         write_descriptors();

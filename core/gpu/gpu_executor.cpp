@@ -21,8 +21,6 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr uint32_t kMaxBatch = 64;  // fill rounds between two reads of the convergence flags
-
 struct KernelInfo {
     const char* name;
     const char* entry;
@@ -37,7 +35,7 @@ constexpr KernelInfo kKernels[] = {
 };
 static_assert(std::size(kKernels) == kKernelCount);
 
-constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels", "lut", "sums", "flags", "out"};
+constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels", "lut", "sums", "fill", "out"};
 static_assert(std::size(kBufferNames) == kBufferCount);
 
 Args args(std::initializer_list<uint32_t> words) {
@@ -63,11 +61,8 @@ public:
         device_->allocate(sizes, uint32_t(plan_.width));
         const size_t px = plan_.pixel_count();
         staged_.resize(core::StagedResults::kBytesPerPixel * px);
-        host_flags_.resize(kMaxBatch);
         host_stats_.resize(plan_.stats_words());
     }
-
-    [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
 
     void bind_cloud(const CloudView& cloud) override {
         start_frame();
@@ -122,30 +117,24 @@ public:
                           args({l.width, l.height, l.offset, p.width, p.height, p.offset, mode}));
     }
 
-    // Rounds of row and column sweeps in growing batches (2, 4, ... 64 rounds). Within a batch, a round after one
-    // that changed nothing returns at once on the device; the host reads a batch's flags with one download and
-    // stops after the first batch with a round that changed nothing.
+    // Steps 2 and 4: the fixed point directly, by union-find over the components of eligible texels (shaders/pyr_uf.h),
+    // in four dispatches whatever the mask, with no host synchronisation.
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
         const PyrLevel l = plan_.level(level);
-        if (anchor_max != 0) {
-            const uint32_t count = l.width * l.height;
-            device_->dispatch(Kernel::anchor, count, 1, args({l.offset, count, anchor_max}));
-        }
-        for (uint32_t batch = 2;; batch = std::min(kMaxBatch, batch * 2)) {
-            device_->zero(Buffer::flags, 0, 4 * size_t(batch));
-            for (uint32_t slot = 0; slot < batch; ++slot) sweep_round(l, 0, slot);
-            device_->download(Buffer::flags, 0, host_flags_.data(), 4 * size_t(batch));
-            device_->finish();
-            const auto unchanged = std::find(host_flags_.begin(), host_flags_.begin() + batch, 0u);
-            if (unchanged != host_flags_.begin() + batch) {
-                fill_rounds_ += uint32_t(unchanged - host_flags_.begin()) + 1;
-                break;
-            }
-            fill_rounds_ += batch;
-        }
+        const uint32_t n = l.width * l.height;
+        if (anchor_max != 0) device_->dispatch(Kernel::anchor, n, 1, args({l.offset, n, anchor_max}));
+        device_->dispatch(Kernel::uf_init, n, 1, args({n}));
+        device_->dispatch(Kernel::uf_merge, l.width, l.height, args({l.width, l.height, l.offset, n}));
+        device_->dispatch(Kernel::uf_resolve, l.width, l.height, args({l.width, l.height, l.offset, n}));
+        device_->dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
     }
 
-    void fill_once(int level) override { sweep_round(plan_.level(level), 1, 0); }
+    // Step 6 a and b: rows there and back, then columns.
+    void fill_once(int level) override {
+        const PyrLevel l = plan_.level(level);
+        device_->dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset}));
+        device_->dispatch(Kernel::final_columns, l.width, 1, args({l.width, l.height, l.offset}));
+    }
 
     void label_edges() override {
         device_->dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset}));
@@ -204,15 +193,8 @@ public:
 
 private:
     void start_frame() {
-        fill_rounds_ = 0;
         device_->begin_frame();
         device_->mark("upload");
-    }
-
-    // Round `slot` of a batch: rows, then columns (shaders/pyr_entries.h: sweep_rows, sweep_columns).
-    void sweep_round(const PyrLevel& l, uint32_t once, uint32_t slot) {
-        device_->dispatch(Kernel::sweep_rows, l.height, 1, args({l.width, l.height, l.offset, once, slot, 0}));
-        device_->dispatch(Kernel::sweep_columns, l.width, 1, args({l.width, l.height, l.offset, once, slot, 0}));
     }
 
     // Packed clouds go straight from the caller's memory; strided ones through staging sized once per Segmenter.
@@ -236,10 +218,8 @@ private:
     std::vector<float> host_points_, host_normals_;  // staging for strided clouds
     std::vector<uint32_t> host_mask_;
     std::vector<unsigned char> staged_;  // the frame's results, laid out as core::StagedResults
-    std::vector<uint32_t> host_flags_;
     std::vector<uint32_t> host_stats_;
     uint32_t segment_count_ = 0;
-    uint32_t fill_rounds_ = 0;
     bool from_mask_ = false;
 };
 
@@ -272,7 +252,9 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     s[size_t(Buffer::labels)] = 4 * texels;
     s[size_t(Buffer::lut)] = 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
     s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1);               // K last
-    s[size_t(Buffer::flags)] = 4 * size_t(kMaxBatch);
+    // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
+    const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
+    s[size_t(Buffer::fill)] = 2 * 4 * size_t(fill_level.width) * fill_level.height;
     s[size_t(Buffer::out)] = 4 * px;
     for (size_t& bytes : s) bytes = std::max<size_t>(bytes, 4);
     return s;

@@ -68,4 +68,16 @@ struct Scene {
 // 0..max_object_count, noise_mm negative or not finite, hole_fraction outside 0..1, or threads negative.
 Scene generate(const SceneOptions& options);
 
+// Fillable masks whose one region winds across the whole frame, the worst cases of fills that carry labels a step
+// at a time: corridors 8 pixels wide between 8-pixel walls (so that they survive to level N - 2), 1 = fillable.
+struct FillMask {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> fillable;  // W*H, row-major
+};
+// A square spiral from the border inwards; each lap turns four times.
+FillMask spiral_mask(int width, int height);
+// A perfect maze (depth-first from the top-left cell, seeded) on a grid of 16-pixel cells.
+FillMask maze_mask(int width, int height, std::uint32_t seed = 12345);
+
 }  // namespace pyrseg::synthetic

@@ -8,9 +8,11 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
 #include "support/oracle.hpp"
 
 namespace pyrseg::test {
@@ -246,8 +248,9 @@ TEST_P(HandCases, AnEmptyMaskHasNoSegments) {
 }
 
 // A staircase corridor from the top-left to the bottom-right: each round of row and column sweeps carries the
-// smallest label down only one step, so the fixed point takes about as many rounds as there are steps (63). Backends
-// that run a fixed number of rounds between convergence checks (OpenCL, Vulkan) must keep going until it is reached.
+// smallest label down only one step, so a sweep scheme needs about as many rounds as there are steps (63). Every
+// backend reaches the fixed point; only the CPU's sweep scheme (PYRSEG_CPU_FILL=sweeps) counts rounds, since the
+// CPU's and the GPUs' union-find fills compute the fixed point directly and report 0.
 TEST_P(HandCases, AFillNeedingManyRoundsReachesTheFixedPoint) {
     Mask m(512, 512);
     for (int step = 0; step < 63; ++step) {
@@ -261,25 +264,44 @@ TEST_P(HandCases, AFillNeedingManyRoundsReachesTheFixedPoint) {
     params.bridge_levels = 1;  // new labels on level N - 1, where the corridor is 2 texels wide
     const Result first = run(m, params);
     EXPECT_EQ(first.labels[m.at(0, 0)], first.labels[m.at(500, 500)]) << "the corridor is one segment";
-    // Sweeping backends report the same round count, which depends only on the mask: the CPU's sweep scheme
-    // (PYRSEG_CPU_FILL=sweeps) gives it; its union-find reports 0.
     const char* cpu_fill = std::getenv("PYRSEG_CPU_FILL");
-    if (GetParam() == "cpu" && (cpu_fill == nullptr || std::string(cpu_fill) != "sweeps")) {
-        EXPECT_EQ(fill_rounds_, 0u);
-        return;
-    }
-    EXPECT_GE(fill_rounds_, 63u) << "a round crosses one step of the staircase";
-    const std::uint32_t rounds = fill_rounds_;
-    ::setenv("PYRSEG_CPU_FILL", "sweeps", 1);
-    Segmenter cpu_sweeps(m.width, m.height, params, "cpu");
-    if (cpu_fill == nullptr) {
-        ::unsetenv("PYRSEG_CPU_FILL");
+    if (GetParam() == "cpu" && cpu_fill != nullptr && std::string(cpu_fill) == "sweeps") {
+        EXPECT_GE(fill_rounds_, 63u) << "a round crosses one step of the staircase";
     } else {
-        ::setenv("PYRSEG_CPU_FILL", cpu_fill, 1);
+        EXPECT_EQ(fill_rounds_, 0u) << "union-find fills take no rounds";
     }
-    Result r;
-    cpu_sweeps.segment_mask(MaskView{m.fillable.data(), m.valid.data(), m.width, m.height}, r);
-    EXPECT_EQ(rounds, cpu_sweeps.last_fill_rounds());
+}
+
+// The fills' worst cases for any propagation scheme, at sizes that are no multiple of anything: one region winding
+// through the whole frame (a spiral; mazes of three seeds), every label carried the whole way.
+TEST_P(HandCases, WindingRegionsMatchTheReference) {
+    for (const auto& [w, h] : {std::pair{333, 251}, std::pair{640, 480}}) {
+        std::vector<synthetic::FillMask> masks = {synthetic::spiral_mask(w, h)};
+        for (const std::uint32_t seed : {1u, 2u, 12345u}) masks.push_back(synthetic::maze_mask(w, h, seed));
+        for (const synthetic::FillMask& f : masks) {
+            Mask m(w, h);
+            m.fillable = f.fillable;
+            ASSERT_EQ(plain_components(m), 1);
+            SCOPED_TRACE(std::to_string(w) + " x " + std::to_string(h));
+            (void)run(m);
+        }
+    }
+}
+
+// One component over the whole frame: every texel's candidate goes to one root (atomic contention on GPUs).
+TEST_P(HandCases, OneHugeComponent) {
+    Mask m(1031, 772);
+    m.fill_rect(0, 0, 1030, 771);
+    const Result r = run(m);
+    EXPECT_EQ(r.segment_count, 1u);
+}
+
+// Stripes too thin to reach level U: no label is old, so step 4 has no anchors at all.
+TEST_P(HandCases, FramesWhoseLabelsAreAllYoung) {
+    Mask m(256, 192);
+    for (int x = 0; x + 6 <= 256; x += 8) m.fill_rect(x, 0, x + 5, 191);
+    m.fill_rect(0, 100, 255, 101);  // a thin bridge across all of them
+    (void)run(m);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, HandCases, ::testing::ValuesIn(available_backend_names()),
