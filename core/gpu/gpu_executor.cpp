@@ -254,7 +254,7 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1);               // K last
     // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
     const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
-    s[size_t(Buffer::fill)] = 2 * 4 * size_t(fill_level.width) * fill_level.height;
+    s[size_t(Buffer::fill)] = size_t(8) * fill_level.width * fill_level.height;
     s[size_t(Buffer::out)] = 4 * px;
     for (size_t& bytes : s) bytes = std::max<size_t>(bytes, 4);
     return s;
