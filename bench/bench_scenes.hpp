@@ -71,7 +71,8 @@ inline const SceneMask& scene_mask(int width, int height) {
 // Times `frame(segmenter, result)` (one frame into result) on a Segmenter of `backend`: once to size everything,
 // then once per iteration. Reports per-pass counters (`<pass>_ms`, milliseconds per frame as
 // Segmenter::last_timings() gives them: host times, or the device's timestamps where a backend queues the frame),
-// the fills' sweep rounds, the segment count, Mpix/s and input bytes/s. A backend that cannot take the frame (a device
+// the fills' sweep rounds, a GPU backend's dispatches and host waits per frame, the segment count, Mpix/s and input
+// bytes/s. A backend that cannot take the frame (a device
 // limit) is reported as skipped with its reason.
 template <class Frame>
 void time_frames(benchmark::State& state, const std::string& backend, int width, int height, std::size_t input_bytes,
@@ -95,6 +96,8 @@ void time_frames(benchmark::State& state, const std::string& backend, int width,
         state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
     }
     state.counters["fill_rounds"] = segmenter->last_fill_rounds();
+    state.counters["dispatches"] = segmenter->last_dispatches();
+    state.counters["host_syncs"] = segmenter->last_host_syncs();
     state.counters["segments"] = result.segment_count;
     state.counters["Mpix/s"] =
         benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);

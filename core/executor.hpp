@@ -48,6 +48,9 @@ public:
     // counted up to and including its first round that changed nothing; 0 for the union-find fills every backend
     // uses by default (only the CPU's PYRSEG_CPU_FILL=sweeps sweeps). Read after read_back.
     [[nodiscard]] virtual std::uint32_t fill_rounds() const { return 0; }
+    // A device's dispatches and host waits in the last frame (Segmenter::last_dispatches, last_host_syncs).
+    [[nodiscard]] virtual std::uint32_t dispatches() const { return 0; }
+    [[nodiscard]] virtual std::uint32_t host_syncs() const { return 0; }
 };
 
 }  // namespace pyrseg::core

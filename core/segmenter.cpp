@@ -128,5 +128,11 @@ const std::vector<PassTiming>& Segmenter::last_timings() const noexcept {
 std::uint32_t Segmenter::last_fill_rounds() const {
     return impl_->executor->fill_rounds();
 }
+std::uint32_t Segmenter::last_dispatches() const {
+    return impl_->executor->dispatches();
+}
+std::uint32_t Segmenter::last_host_syncs() const {
+    return impl_->executor->host_syncs();
+}
 
 }  // namespace pyrseg

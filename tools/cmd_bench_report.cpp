@@ -31,7 +31,7 @@ constexpr const char* kUsage =
     "    and PCL's organized segmentation (its own integral-image normals) divided by pyrseg's time;\n"
     "  - the segmentation stage (fillable mask to compacted labels) per backend, and OpenCV's connectedComponents\n"
     "    (SAUF, Spaghetti; 4- and 8-connected) of the same mask: pyrseg's time divided by OpenCV's;\n"
-    "  - the fills' worst cases (spiral, maze) with the sweep rounds each backend needed;\n"
+    "  - the fills' worst cases (spiral, maze) with each GPU backend's dispatches and host waits per frame;\n"
     "  - the per-pass times of the full-size frame;\n"
     "and two plots, DIR/bench_vs_pcl.png and DIR/bench_vs_opencv.png. Ratios come from one run on one machine;\n"
     "the report starts with that machine's description.\n"
@@ -225,7 +225,8 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
                     : "## Whole pipeline, points to labels (normals estimated)\n\n";
         md +=
             "Milliseconds per frame; in brackets, multiples of a memcpy of the same input bytes; fill rounds: the "
-            "sweep rounds a sweeping backend needed. PCL: OrganizedConnectedComponentSegmentation with "
+            "sweep rounds of the CPU's PYRSEG_CPU_FILL=sweeps (0 for the union-find fills). PCL: "
+            "OrganizedConnectedComponentSegmentation with "
             "EdgeAwarePlaneComparator, ";
         md += given ? "once with its integral-image normals (its whole pipeline) and once with the scene's normals "
                       "(its labelling alone).\n\n"
@@ -309,9 +310,10 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
 
     // The fills' worst cases.
     md +=
-        "## The fills' worst cases\n\nOne winding region of 8-pixel corridors; sweep rounds are what a sweeping "
-        "backend needed (the CPU fills by union-find: 0).\n\n";
-    md += header({"case", "frame", "backend", "frame time", "fill time", "sweep rounds"});
+        "## The fills' worst cases\n\nOne winding region of 8-pixel corridors. Every backend fills by union-find, "
+        "whatever the region's shape; sweep rounds are counted only by the CPU's PYRSEG_CPU_FILL=sweeps. A GPU "
+        "backend's dispatches and host waits per frame are the same as for any other frame of that size.\n\n";
+    md += header({"case", "frame", "backend", "frame time", "fill time", "sweep rounds", "dispatches", "host waits"});
     for (const auto& named : entries) {
         const std::string& name = named.first;
         const Entry& e =
@@ -326,8 +328,13 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
             return it == e.counters.end() ? std::string("—") : sig3(it->second);
         };
         const auto rounds = e.counters.find("fill_rounds");
+        const auto whole = [&](const char* key) {
+            const auto it = e.counters.find(key);
+            return it == e.counters.end() ? std::string("—") : fixed(it->second, 0);
+        };
         md += table_row({parts[1], parts[3], parts[2], ms_cell(&e), counter("fill_ms") + " ms",
-                         rounds == e.counters.end() ? "—" : fixed(rounds->second, 0)});
+                         rounds == e.counters.end() ? "—" : fixed(rounds->second, 0), whole("dispatches"),
+                         whole("host_syncs")});
     }
     md += "\n";
 

@@ -85,36 +85,35 @@ public:
             }
         }
         device_->upload(Buffer::points, 0, host_mask_.data(), 4 * host_mask_.size());
-        device_->dispatch(Kernel::bind_mask, pixels(), 1, args({pixels(), plan_.full().offset}));
+        dispatch(Kernel::bind_mask, pixels(), 1, args({pixels(), plan_.full().offset}));
         from_mask_ = true;
     }
 
     void begin_pass(const char* pass) override { device_->mark(pass); }
 
     void estimate_normals() override {
-        device_->dispatch(Kernel::normals, width(), height(), args({height(), uint32_t(plan_.params.normal_radius)}));
+        dispatch(Kernel::normals, width(), height(), args({height(), uint32_t(plan_.params.normal_radius)}));
     }
 
-    void quantize() override { device_->dispatch(Kernel::quantize, pixels(), 1, args({pixels()})); }
+    void quantize() override { dispatch(Kernel::quantize, pixels(), 1, args({pixels()})); }
 
     void metric() override {
         const core::Thresholds t = plan_.thresholds;
-        device_->dispatch(Kernel::metric, width(), height(),
-                          args({height(), plan_.full().offset, bits(t.curvature), bits(t.depth)}));
+        dispatch(Kernel::metric, width(), height(),
+                 args({height(), plan_.full().offset, bits(t.curvature), bits(t.depth)}));
     }
 
     void mip(int parent_level) override {
         const PyrLevel p = plan_.level(parent_level);
         const PyrLevel c = plan_.level(parent_level + 1);
-        device_->dispatch(Kernel::mip, p.width, p.height,
-                          args({p.width, p.height, p.offset, c.width, c.height, c.offset}));
+        dispatch(Kernel::mip, p.width, p.height, args({p.width, p.height, p.offset, c.width, c.height, c.offset}));
     }
 
     void init_labels(int level, uint32_t mode) override {
         const PyrLevel l = plan_.level(level);
         const PyrLevel p = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
-        device_->dispatch(Kernel::init_labels, l.width, l.height,
-                          args({l.width, l.height, l.offset, p.width, p.height, p.offset, mode}));
+        dispatch(Kernel::init_labels, l.width, l.height,
+                 args({l.width, l.height, l.offset, p.width, p.height, p.offset, mode}));
     }
 
     // Steps 2 and 4: the fixed point directly, by union-find over the components of eligible texels (shaders/pyr_uf.h),
@@ -122,33 +121,31 @@ public:
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
         const PyrLevel l = plan_.level(level);
         const uint32_t n = l.width * l.height;
-        if (anchor_max != 0) device_->dispatch(Kernel::anchor, n, 1, args({l.offset, n, anchor_max}));
-        device_->dispatch(Kernel::uf_init, n, 1, args({n}));
-        device_->dispatch(Kernel::uf_merge, l.width, l.height, args({l.width, l.height, l.offset, n}));
-        device_->dispatch(Kernel::uf_resolve, l.width, l.height, args({l.width, l.height, l.offset, n}));
-        device_->dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
+        if (anchor_max != 0) dispatch(Kernel::anchor, n, 1, args({l.offset, n, anchor_max}));
+        dispatch(Kernel::uf_init, n, 1, args({n}));
+        dispatch(Kernel::uf_merge, l.width, l.height, args({l.width, l.height, l.offset, n}));
+        dispatch(Kernel::uf_resolve, l.width, l.height, args({l.width, l.height, l.offset, n}));
+        dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
     }
 
     // Step 6 a and b: rows there and back, then columns.
     void fill_once(int level) override {
         const PyrLevel l = plan_.level(level);
-        device_->dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset}));
-        device_->dispatch(Kernel::final_columns, l.width, 1, args({l.width, l.height, l.offset}));
+        dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset}));
+        dispatch(Kernel::final_columns, l.width, 1, args({l.width, l.height, l.offset}));
     }
 
-    void label_edges() override {
-        device_->dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset}));
-    }
+    void label_edges() override { dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset})); }
 
     void compact(bool apply) override {
         const uint32_t count = plan_.lut_size();
         const uint32_t chunks = plan_.scan_chunks();
         device_->zero(Buffer::lut, 0, 4 * size_t(count));
-        device_->dispatch(Kernel::lut_mark, pixels(), 1, args({pixels(), plan_.full().offset}));
-        device_->dispatch(Kernel::scan_count, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
-        device_->dispatch(Kernel::scan_sums, 1, 1, args({chunks}));
-        device_->dispatch(Kernel::scan_number, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
-        device_->dispatch(Kernel::compact, pixels(), 1, args({pixels(), plan_.full().offset, apply ? 1u : 0u}));
+        dispatch(Kernel::lut_mark, pixels(), 1, args({pixels(), plan_.full().offset}));
+        dispatch(Kernel::scan_count, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
+        dispatch(Kernel::scan_sums, 1, 1, args({chunks}));
+        dispatch(Kernel::scan_number, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
+        dispatch(Kernel::compact, pixels(), 1, args({pixels(), plan_.full().offset, apply ? 1u : 0u}));
         device_->download(Buffer::sums, 4 * size_t(chunks), &segment_count_, 4);
     }
 
@@ -156,9 +153,9 @@ public:
     void segment_stats() override {
         device_->zero(Buffer::lut, 4 * size_t(plan_.lut_size()), 4 * plan_.stats_words());
         const uint32_t runs = plan_.stats_runs_per_row() * height();
-        device_->dispatch(Kernel::stats, runs, 1,
-                          args({height(), plan_.full().offset, runs, from_mask_ ? 0u : 1u,
-                                bits(plan_.stats_point_scale()), plan_.lut_size(), plan_.stats_slots}));
+        dispatch(Kernel::stats, runs, 1,
+                 args({height(), plan_.full().offset, runs, from_mask_ ? 0u : 1u, bits(plan_.stats_point_scale()),
+                       plan_.lut_size(), plan_.stats_slots}));
     }
 
     void read_back(Result& out, const Outputs& outputs) override {
@@ -173,7 +170,7 @@ public:
         if (outputs.fillable_mask) device_->download(Buffer::mask, texel * full, staged + S::kMask * px, texel * px);
         if (outputs.normals && !from_mask_) device_->download(Buffer::normals, 0, staged + S::kNormals * px, 12 * px);
         device_->mark(nullptr);
-        device_->finish();
+        finish();
         out.width = plan_.width;
         out.height = plan_.height;
         out.segment_count = segment_count_;
@@ -183,18 +180,33 @@ public:
             const size_t words = std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
             if (words != 0) {
                 device_->download(Buffer::lut, 4 * size_t(plan_.lut_size()), host_stats_.data(), 4 * words);
-                device_->finish();
+                finish();
             }
             core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
         }
     }
 
     bool device_timings(std::vector<PassTiming>& timings) override { return device_->pass_times(timings); }
+    [[nodiscard]] uint32_t dispatches() const override { return dispatches_; }
+    [[nodiscard]] uint32_t host_syncs() const override { return host_syncs_; }
 
 private:
     void start_frame() {
+        dispatches_ = 0;
+        host_syncs_ = 0;
         device_->begin_frame();
         device_->mark("upload");
+    }
+
+    void dispatch(Kernel k, uint32_t nx, uint32_t ny, const Args& a) {
+        if (nx == 0 || ny == 0) return;
+        device_->dispatch(k, nx, ny, a);
+        ++dispatches_;
+    }
+
+    void finish() {
+        device_->finish();
+        ++host_syncs_;
     }
 
     // Packed clouds go straight from the caller's memory; strided ones through staging sized once per Segmenter.
@@ -220,6 +232,8 @@ private:
     std::vector<unsigned char> staged_;  // the frame's results, laid out as core::StagedResults
     std::vector<uint32_t> host_stats_;
     uint32_t segment_count_ = 0;
+    uint32_t dispatches_ = 0;
+    uint32_t host_syncs_ = 0;
     bool from_mask_ = false;
 };
 

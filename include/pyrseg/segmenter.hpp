@@ -43,9 +43,14 @@ public:
     [[nodiscard]] const std::string& backend_name() const noexcept;
     // Host wall time of each pass of the last frame, in pass order (accumulated per pass name).
     [[nodiscard]] const std::vector<PassTiming>& last_timings() const noexcept;
-    // Rounds of row and column sweeps the fixed-point fills of the last frame took (the worst case of a GPU
-    // backend: a long winding region needs many); 0 where the backend fills another way (the CPU's union-find).
+    // Rounds of row and column sweeps the fixed-point fills of the last frame took; 0 for the union-find fills every
+    // backend uses (only the CPU's PYRSEG_CPU_FILL=sweeps, kept as a cross-check, sweeps).
     [[nodiscard]] std::uint32_t last_fill_rounds() const;
+    // What the last frame cost a GPU backend besides its kernels: the dispatches (kernel launches) it queued, and
+    // the times the host waited for the device (1 per frame; 2 with Outputs::segment_stats, whose words are fetched
+    // once the segment count is known). Neither depends on the image's content. Both 0 on the CPU backend.
+    [[nodiscard]] std::uint32_t last_dispatches() const;
+    [[nodiscard]] std::uint32_t last_host_syncs() const;
 
     struct Impl;
 

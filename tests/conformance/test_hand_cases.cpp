@@ -304,6 +304,41 @@ TEST_P(HandCases, FramesWhoseLabelsAreAllYoung) {
     (void)run(m);
 }
 
+// A GPU frame's cost besides its kernels does not depend on the image: the same dispatches for a maze, a spiral and
+// a few boxes, and one host wait (two with segment statistics, fetched once K is known).
+TEST_P(HandCases, DispatchesAndHostWaitsDoNotDependOnTheImage) {
+    const int w = 640;
+    const int h = 480;
+    Mask boxes(w, h);
+    boxes.fill_rect(10, 10, 300, 200);
+    boxes.fill_rect(320, 10, 630, 470);
+    boxes.fill_rect(10, 220, 200, 470);
+    std::vector<std::vector<std::uint8_t>> masks = {synthetic::maze_mask(w, h).fillable,
+                                                    synthetic::spiral_mask(w, h).fillable, boxes.fillable};
+    for (const bool stats : {false, true}) {
+        Outputs outputs;
+        outputs.segment_stats = stats;
+        Segmenter segmenter(w, h, {}, GetParam(), outputs);
+        std::set<std::uint32_t> dispatches;
+        std::set<std::uint32_t> waits;
+        Result r;
+        for (const auto& mask : masks) {
+            segmenter.segment_mask(MaskView{mask.data(), nullptr, w, h}, r);
+            dispatches.insert(segmenter.last_dispatches());
+            waits.insert(segmenter.last_host_syncs());
+        }
+        EXPECT_EQ(dispatches.size(), 1u) << "dispatches differ between images";
+        EXPECT_EQ(waits.size(), 1u) << "host waits differ between images";
+        if (GetParam() == "cpu") {
+            EXPECT_EQ(*dispatches.begin(), 0u);
+            EXPECT_EQ(*waits.begin(), 0u);
+        } else {
+            EXPECT_GT(*dispatches.begin(), 10u);
+            EXPECT_EQ(*waits.begin(), stats ? 2u : 1u);
+        }
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, HandCases, ::testing::ValuesIn(available_backend_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
