@@ -10,7 +10,7 @@
 struct PyrCudaCtx {
     const float* points;
     float* normals;
-    int* quant;
+    unsigned* quant; /* two words per pixel: pyr_pack_q16(qx, qy), pyr_pack_q16(qz, valid) */
     unsigned char* mask;
     unsigned* labels;
     unsigned* lut; /* then the statistics words, PYR_STATS_WORDS per slot */
@@ -27,13 +27,14 @@ struct PyrArgs {
 #define PYR_CTX_PARAM const PyrCudaCtx& pyr_ctx
 #define PYR_CTX_ARG pyr_ctx
 #define PYR_PT(x, y, c) pyr_ctx.points[((y)*pyr_ctx.w + (x)) * 3u + (c)]
-#define PYR_Q_VALID(i) static_cast<unsigned>(pyr_ctx.quant[(i)*4u + 3u])
-#define PYR_QN(i, c) pyr_ctx.quant[(i)*4u + (c)]
+#define PYR_Q_VALID(i) (pyr_ctx.quant[(i)*2u + 1u] >> 16u)
+#define PYR_QN(i, c) \
+    pyr_unpack_q16(pyr_ctx.quant[(i)*2u + (static_cast<unsigned>(c) >> 1u)] >> ((static_cast<unsigned>(c) & 1u) * 16u))
 #define PYR_QZ(i) pyr_ctx.points[(i)*3u + 2u]
 #define PYR_MASK(i) static_cast<unsigned>(pyr_ctx.mask[i])
 #define PYR_LABEL(i) pyr_ctx.labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_ctx.labels[i] = (v))
-#define PYR_VALID(p) static_cast<unsigned>(pyr_ctx.quant[(p)*4u + 3u])
+#define PYR_VALID(p) (pyr_ctx.quant[(p)*2u + 1u] >> 16u)
 #define PYR_LUT(l) pyr_ctx.lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_ctx.lut[l] = (v))
 #define PYR_STATS_ADD(w, v) pyr_cuda_atomic_add(&pyr_ctx.lut[w], (v))
@@ -77,6 +78,9 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 #define PYR_W pyr_ctx.w
 #define PYR_ENTRY_CTX pyr_ctx
 #define PYR_STORE_MASK(i, v) (pyr_ctx.mask[i] = static_cast<unsigned char>(v))
+#define PYR_POINT(k) pyr_ctx.points[k]
+#define PYR_NORMAL(k) pyr_ctx.normals[k]
+#define PYR_STORE_NORMAL(k, v) (pyr_ctx.normals[k] = (v))
 #define PYR_MASK_INPUT(i) (reinterpret_cast<const unsigned*>(pyr_ctx.points)[i])
 #define PYR_UF_LOAD(i) (*static_cast<volatile unsigned*>(&pyr_ctx.fill[i]))
 #define PYR_UF_STORE(i, v) (pyr_ctx.fill[i] = (v))

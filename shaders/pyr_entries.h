@@ -5,7 +5,9 @@
  *  - PYR_I (1D: the invocation's index), PYR_X and PYR_Y (2D: its texel);
  *  - PYR_ARG(k), PYR_ARG_I32(k), PYR_ARG_F32(k): word k of the dispatch's PyrArgs;
  *  - PYR_W (the image width) and PYR_ENTRY_CTX (the context an entry point passes to shared functions);
- *  - the buffers pyr_buf_points, _normals, _quant, _mask, _labels, _lut, _sums, _fill, _out; PYR_STORE_MASK(i, v)
+ *  - the buffers pyr_buf_quant (two words per pixel: pyr_pack_q16 of qx, qy and of qz, valid), _mask, _labels,
+ *    _lut, _sums, _fill, _out; PYR_POINT(k) and PYR_NORMAL(k) (float k of the xyz arrays), PYR_STORE_NORMAL(k, v);
+ *    PYR_STORE_MASK(i, v)
  *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer); PYR_UF_LOAD, PYR_UF_STORE
  *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h);
  *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
@@ -25,9 +27,9 @@ PYR_KERNEL_2D(normals) {
     if (x >= PYR_W || y >= h) return;
     PyrIVec3 q = pyr_normal_q(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1));
     pyr_u32 i = y * PYR_W + x;
-    pyr_buf_normals[i * 3u + 0u] = PYR_F32(q.x) * PYR_NORMAL_UNIT;
-    pyr_buf_normals[i * 3u + 1u] = PYR_F32(q.y) * PYR_NORMAL_UNIT;
-    pyr_buf_normals[i * 3u + 2u] = PYR_F32(q.z) * PYR_NORMAL_UNIT;
+    PYR_STORE_NORMAL(i * 3u + 0u, PYR_F32(q.x) * PYR_NORMAL_UNIT);
+    PYR_STORE_NORMAL(i * 3u + 1u, PYR_F32(q.y) * PYR_NORMAL_UNIT);
+    PYR_STORE_NORMAL(i * 3u + 2u, PYR_F32(q.z) * PYR_NORMAL_UNIT);
 }
 #endif
 
@@ -36,12 +38,10 @@ PYR_KERNEL_2D(normals) {
 PYR_KERNEL_1D(quantize) {
     pyr_u32 i = PYR_I;
     if (i >= PYR_ARG(0)) return;
-    PyrQuant q = pyr_quantize(pyr_buf_points[i * 3u], pyr_buf_points[i * 3u + 1u], pyr_buf_points[i * 3u + 2u],
-                              pyr_buf_normals[i * 3u], pyr_buf_normals[i * 3u + 1u], pyr_buf_normals[i * 3u + 2u]);
-    pyr_buf_quant[i * 4u + 0u] = q.qx;
-    pyr_buf_quant[i * 4u + 1u] = q.qy;
-    pyr_buf_quant[i * 4u + 2u] = q.qz;
-    pyr_buf_quant[i * 4u + 3u] = PYR_I32(q.valid);
+    PyrQuant q = pyr_quantize(PYR_POINT(i * 3u), PYR_POINT(i * 3u + 1u), PYR_POINT(i * 3u + 2u), PYR_NORMAL(i * 3u),
+                              PYR_NORMAL(i * 3u + 1u), PYR_NORMAL(i * 3u + 2u));
+    pyr_buf_quant[i * 2u + 0u] = pyr_pack_q16(q.qx, q.qy);
+    pyr_buf_quant[i * 2u + 1u] = pyr_pack_q16(q.qz, PYR_I32(q.valid));
 }
 #endif
 
@@ -65,7 +65,7 @@ PYR_KERNEL_1D(bind_mask) {
     if (i >= PYR_ARG(0)) return;
     pyr_u32 packed = PYR_MASK_INPUT(i);
     PYR_STORE_MASK(PYR_ARG(1) + i, packed & 1u);
-    pyr_buf_quant[i * 4u + 3u] = PYR_I32((packed >> 1u) & 1u);
+    pyr_buf_quant[i * 2u + 1u] = pyr_pack_q16(0, PYR_I32((packed >> 1u) & 1u));
 }
 #endif
 

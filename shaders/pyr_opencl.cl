@@ -1,20 +1,20 @@
 /* OpenCL C 1.2: the dialect of the entry points (shaders/pyr_entries.h). Every kernel takes the Segmenter's buffers
  * and the image width first (PYR_CTX_PARAM, set once per Segmenter by the host), then one PyrArgs by value. */
 #define PYR_CTX_PARAM                                                                                              \
-    __global const float *pyr_buf_points, __global float *pyr_buf_normals, __global int *pyr_buf_quant,          \
+    __global const float *pyr_buf_points, __global float *pyr_buf_normals, __global uint *pyr_buf_quant,          \
         __global uchar *pyr_buf_mask, __global uint *pyr_buf_labels, __global uint *pyr_buf_lut,                 \
         __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out, uint pyr_w
 #define PYR_CTX_ARG                                                                                               \
     pyr_buf_points, pyr_buf_normals, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut, pyr_buf_sums,     \
         pyr_buf_fill, pyr_buf_out, pyr_w
 #define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
-#define PYR_Q_VALID(i) ((uint)pyr_buf_quant[(i) * 4u + 3u])
-#define PYR_QN(i, c) pyr_buf_quant[(i) * 4u + (c)]
+#define PYR_Q_VALID(i) (pyr_buf_quant[(i) * 2u + 1u] >> 16u)
+#define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i) * 2u + ((uint)(c) >> 1u)] >> (((uint)(c) & 1u) * 16u))
 #define PYR_QZ(i) pyr_buf_points[(i) * 3u + 2u]
 #define PYR_MASK(i) ((uint)pyr_buf_mask[i])
 #define PYR_LABEL(i) pyr_buf_labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
-#define PYR_VALID(p) ((uint)pyr_buf_quant[(p) * 4u + 3u])
+#define PYR_VALID(p) (pyr_buf_quant[(p) * 2u + 1u] >> 16u)
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 /* The statistics words follow the label table in its buffer (the host passes where they start). */
@@ -48,6 +48,9 @@ typedef struct PyrArgs {
 #define PYR_W pyr_w
 #define PYR_ENTRY_CTX PYR_CTX_ARG
 #define PYR_STORE_MASK(i, v) (pyr_buf_mask[i] = (uchar)(v))
+#define PYR_POINT(k) pyr_buf_points[k]
+#define PYR_NORMAL(k) pyr_buf_normals[k]
+#define PYR_STORE_NORMAL(k, v) (pyr_buf_normals[k] = (v))
 #define PYR_MASK_INPUT(i) (((__global const uint *)pyr_buf_points)[i])
 #define PYR_UF_LOAD(i) (((volatile __global uint *)pyr_buf_fill)[i])
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))

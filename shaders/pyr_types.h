@@ -41,6 +41,16 @@ struct PyrQuant {
 #define PYR_NORMAL_SCALE 8192.0f
 #define PYR_NORMAL_UNIT 0.0001220703125f /* 2^-13, exact */
 
+/* The GPU backends keep a quantized pixel in two words: qx and qy, then qz and validity, 16 bits each (a component
+ * lies in -8192..8192, pyr_quantize_component). Half the bytes of four int32, and a 4128 x 3088 frame's quantized
+ * normals fit in one 128 MiB storage buffer. Sign extension by arithmetic, not by shifting a negative int. */
+PYR_FN pyr_u32 pyr_pack_q16(pyr_i32 lo, pyr_i32 hi) {
+    return (PYR_U32(lo) & 0xffffu) | ((PYR_U32(hi) & 0xffffu) << 16u);
+}
+PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
+    return PYR_I32((half_word & 0xffffu) ^ 0x8000u) - 32768;
+}
+
 /* Mask bits of a texel. Only the fill at level N-1 (step 4) sets the anchor bit. */
 #define PYR_MASK_FILLABLE 1u
 #define PYR_MASK_ANCHORED 2u

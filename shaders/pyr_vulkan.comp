@@ -11,13 +11,17 @@
 
 layout(std430, set = 0, binding = 0) readonly buffer PyrPointsBuf { float pyr_buf_points[]; };
 layout(std430, set = 0, binding = 1) buffer PyrNormalsBuf { float pyr_buf_normals[]; };
-layout(std430, set = 0, binding = 2) buffer PyrQuantBuf { int pyr_buf_quant[]; };
+layout(std430, set = 0, binding = 2) buffer PyrQuantBuf { uint pyr_buf_quant[]; }; /* two words per pixel */
 layout(std430, set = 0, binding = 3) buffer PyrMaskBuf { uint pyr_buf_mask[]; }; /* one uint per texel */
 layout(std430, set = 0, binding = 4) buffer PyrLabelsBuf { uint pyr_buf_labels[]; };
 layout(std430, set = 0, binding = 5) buffer PyrLutBuf { uint pyr_buf_lut[]; }; /* then the statistics words */
 layout(std430, set = 0, binding = 6) buffer PyrSumsBuf { uint pyr_buf_sums[]; };   /* compaction scan; K last */
 layout(std430, set = 0, binding = 7) coherent buffer PyrFillBuf { uint pyr_buf_fill[]; }; /* fills' union-find */
 layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };     /* compacted labels */
+/* The points and normals from float pyr_push.split on: the rest of the same buffers, bound from there when a frame's
+ * xyz arrays exceed one binding's range (vulkan_backend.cpp). */
+layout(std430, set = 0, binding = 9) readonly buffer PyrPointsHiBuf { float pyr_buf_points_hi[]; };
+layout(std430, set = 0, binding = 10) buffer PyrNormalsHiBuf { float pyr_buf_normals_hi[]; };
 #if defined(PYR_ENTRY_BIND_MASK)
 /* A mask frame's input words share binding 0 with the points (gpu_executor.cpp: bind_mask). */
 layout(std430, set = 0, binding = 0) readonly buffer PyrMaskInputBuf { uint pyr_buf_mask_input[]; };
@@ -26,18 +30,33 @@ layout(std430, set = 0, binding = 0) readonly buffer PyrMaskInputBuf { uint pyr_
 layout(push_constant) uniform PyrPush {
     uint w;
     uint a[PYR_ARG_WORDS];
+    uint split;
 } pyr_push;
+
+float pyr_point(uint k) {
+    return k < pyr_push.split ? pyr_buf_points[k] : pyr_buf_points_hi[k - pyr_push.split];
+}
+float pyr_normal(uint k) {
+    return k < pyr_push.split ? pyr_buf_normals[k] : pyr_buf_normals_hi[k - pyr_push.split];
+}
+void pyr_store_normal(uint k, float v) {
+    if (k < pyr_push.split) {
+        pyr_buf_normals[k] = v;
+    } else {
+        pyr_buf_normals_hi[k - pyr_push.split] = v;
+    }
+}
 
 #define PYR_CTX_PARAM uint pyr_w
 #define PYR_CTX_ARG pyr_w
-#define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
-#define PYR_Q_VALID(i) uint(pyr_buf_quant[(i) * 4u + 3u])
-#define PYR_QN(i, c) pyr_buf_quant[(i) * 4u + (c)]
-#define PYR_QZ(i) pyr_buf_points[(i) * 3u + 2u]
+#define PYR_PT(x, y, c) pyr_point(((y) * pyr_w + (x)) * 3u + (c))
+#define PYR_Q_VALID(i) (pyr_buf_quant[(i) * 2u + 1u] >> 16u)
+#define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i) * 2u + (uint(c) >> 1u)] >> ((uint(c) & 1u) * 16u))
+#define PYR_QZ(i) pyr_point((i) * 3u + 2u)
 #define PYR_MASK(i) pyr_buf_mask[i]
 #define PYR_LABEL(i) pyr_buf_labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
-#define PYR_VALID(p) uint(pyr_buf_quant[(p) * 4u + 3u])
+#define PYR_VALID(p) (pyr_buf_quant[(p) * 2u + 1u] >> 16u)
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 #define PYR_STATS_ADD(w, v) atomicAdd(pyr_buf_lut[w], (v))
@@ -66,6 +85,9 @@ layout(push_constant) uniform PyrPush {
 #define PYR_ENTRY_CTX pyr_push.w
 #define PYR_STORE_MASK(i, v) (pyr_buf_mask[i] = (v))
 #define PYR_MASK_INPUT(i) pyr_buf_mask_input[i]
+#define PYR_POINT(k) pyr_point(k)
+#define PYR_NORMAL(k) pyr_normal(k)
+#define PYR_STORE_NORMAL(k, v) pyr_store_normal((k), (v))
 #define PYR_UF_LOAD(i) pyr_buf_fill[i]
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
 #define PYR_UF_MIN(i, v) atomicMin(pyr_buf_fill[i], (v))

@@ -118,7 +118,12 @@ public:
         size_t free_bytes = 0;
         size_t total_bytes = 0;
         check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
-        return {free_bytes, "its free memory", free_bytes, "its free memory", 1};
+        gpu::DeviceLimits l;
+        l.max_buffer_bytes.fill(free_bytes);
+        l.max_buffer_what = "its free memory";
+        l.memory_bytes = free_bytes;
+        l.memory_what = "its free memory";
+        return l;
     }
 
     void allocate(const gpu::BufferSizes& sizes, uint32_t image_width) override {
@@ -133,7 +138,7 @@ public:
         download_ =
             Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + 64, "cudaMallocHost(download staging)");
         ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points), buffer<float>(gpu::Buffer::normals),
-                          buffer<int>(gpu::Buffer::quant),          buffer<unsigned char>(gpu::Buffer::mask),
+                          buffer<unsigned>(gpu::Buffer::quant),     buffer<unsigned char>(gpu::Buffer::mask),
                           buffer<unsigned>(gpu::Buffer::labels),    buffer<unsigned>(gpu::Buffer::lut),
                           buffer<unsigned>(gpu::Buffer::sums),      buffer<unsigned>(gpu::Buffer::fill),
                           buffer<unsigned>(gpu::Buffer::out),       image_width};

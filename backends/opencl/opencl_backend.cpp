@@ -57,8 +57,12 @@ public:
     [[nodiscard]] std::string description() const override { return rt_->description; }
 
     [[nodiscard]] gpu::DeviceLimits limits() const override {
-        return {size_t(rt_->max_alloc), "CL_DEVICE_MAX_MEM_ALLOC_SIZE", size_t(rt_->global_mem),
-                "CL_DEVICE_GLOBAL_MEM_SIZE", 1};
+        gpu::DeviceLimits l;
+        l.max_buffer_bytes.fill(size_t(rt_->max_alloc));
+        l.max_buffer_what = "CL_DEVICE_MAX_MEM_ALLOC_SIZE";
+        l.memory_bytes = size_t(rt_->global_mem);
+        l.memory_what = "CL_DEVICE_GLOBAL_MEM_SIZE";
+        return l;
     }
 
     void allocate(const gpu::BufferSizes& sizes, uint32_t image_width) override {

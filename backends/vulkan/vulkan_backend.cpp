@@ -45,12 +45,15 @@ public:
 
     [[nodiscard]] std::string description() const override { return rt_->description; }
 
-    // A storage buffer binds at most maxStorageBufferRange bytes, and is one allocation (maxMemoryAllocationSize).
+    // A storage buffer binds at most maxStorageBufferRange bytes (the points and normals twice that: they are bound
+    // in two ranges), and is one allocation (maxMemoryAllocationSize).
     [[nodiscard]] gpu::DeviceLimits limits() const override {
-        const VkDeviceSize range = rt_->properties.limits.maxStorageBufferRange;
+        const VkDeviceSize range = aligned_range();
         gpu::DeviceLimits l;
-        l.max_buffer_bytes = size_t(std::min(range, rt_->max_allocation));
-        l.max_buffer_what = range <= rt_->max_allocation ? "maxStorageBufferRange" : "maxMemoryAllocationSize";
+        l.max_buffer_bytes.fill(size_t(std::min(range, rt_->max_allocation)));
+        l.max_buffer_bytes[size_t(gpu::Buffer::points)] = size_t(std::min(2 * range, rt_->max_allocation));
+        l.max_buffer_bytes[size_t(gpu::Buffer::normals)] = l.max_buffer_bytes[size_t(gpu::Buffer::points)];
+        l.max_buffer_what = "maxStorageBufferRange, maxMemoryAllocationSize";
         VkDeviceSize heap = 0;
         for (uint32_t h = 0; h < rt_->memory.memoryHeapCount; ++h)
             heap = std::max(heap, rt_->memory.memoryHeaps[h].size);
@@ -64,10 +67,13 @@ public:
         width_ = image_width;
         const size_t pixels = sizes[size_t(gpu::Buffer::out)] / 4;
         check_workgroups(pixels, std::max(pixels, sizes[size_t(gpu::Buffer::lut)] / 4));
-        for (size_t b = 0; b < kBindingCount; ++b) {
+        for (size_t b = 0; b < gpu::kBufferCount; ++b) {
             const std::string what = std::string("the ") + gpu::buffer_name(gpu::Buffer(b)) + " buffer";
             buffers_[b] = VulkanBuffer(*rt_, sizes[b], VulkanBuffer::Memory::device, what.c_str());
         }
+        // Points and normals (same size) beyond one binding's range continue in bindings 9 and 10.
+        const VkDeviceSize xyz = sizes[size_t(gpu::Buffer::points)];
+        split_bytes_ = xyz <= rt_->properties.limits.maxStorageBufferRange ? xyz : aligned_range();
         // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count,
         // statistics), each packed from offset 0 between two finish() calls.
         const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)];
@@ -116,6 +122,7 @@ public:
         std::array<uint32_t, kPushConstantBytes / 4> constants{};
         constants[0] = width_;
         std::copy(args.words.begin(), args.words.end(), constants.begin() + 1);
+        constants.back() = uint32_t(split_bytes_ / 4);
         vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipelines[size_t(k)]);
         vkCmdPushConstants(commands_, rt_->pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushConstantBytes,
                            constants.data());
@@ -263,11 +270,29 @@ private:
         }
     }
 
+    // maxStorageBufferRange, rounded down to minStorageBufferOffsetAlignment (where a second range may start).
+    [[nodiscard]] VkDeviceSize aligned_range() const {
+        const VkPhysicalDeviceLimits& lim = rt_->properties.limits;
+        const VkDeviceSize align = std::max<VkDeviceSize>(lim.minStorageBufferOffsetAlignment, 4);
+        return VkDeviceSize(lim.maxStorageBufferRange) / align * align;
+    }
+
     void write_descriptors() {
         std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
         std::array<VkWriteDescriptorSet, kBindingCount> writes{};
         for (uint32_t b = 0; b < kBindingCount; ++b) {
-            infos[b] = VkDescriptorBufferInfo{buffers_[b].get(), 0, VK_WHOLE_SIZE};
+            if (b < gpu::kBufferCount) {
+                const VkDeviceSize size = buffers_[b].size();
+                const bool xyz = b == uint32_t(gpu::Buffer::points) || b == uint32_t(gpu::Buffer::normals);
+                infos[b] = VkDescriptorBufferInfo{buffers_[b].get(), 0, xyz ? std::min(size, split_bytes_) : size};
+            } else {
+                // The upper part (or, when the whole array fits below, the lower one again: never read).
+                const VulkanBuffer& whole =
+                    buffers_[size_t(b == kPointsHiBinding ? gpu::Buffer::points : gpu::Buffer::normals)];
+                const bool split = whole.size() > split_bytes_;
+                infos[b] = VkDescriptorBufferInfo{whole.get(), split ? split_bytes_ : 0,
+                                                  split ? whole.size() - split_bytes_ : whole.size()};
+            }
             writes[b] = make_info<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
             writes[b].dstSet = descriptor_set_;
             writes[b].dstBinding = b;
@@ -297,7 +322,8 @@ private:
     }
 
     std::shared_ptr<Runtime> rt_;
-    std::array<VulkanBuffer, kBindingCount> buffers_;
+    std::array<VulkanBuffer, gpu::kBufferCount> buffers_;
+    VkDeviceSize split_bytes_ = 0;  // where the points' and normals' second binding starts
     VulkanBuffer upload_, download_;
     VkDeviceSize upload_used_ = 0;
     VkDeviceSize download_used_ = 0;

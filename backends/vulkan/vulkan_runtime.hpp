@@ -15,10 +15,13 @@
 
 namespace pyrseg::vulkan {
 
-// The storage buffers of shaders/pyr_vulkan.comp (gpu::Buffer order), and its push constants: the image width, then
-// the dispatch's argument words.
-inline constexpr std::uint32_t kBindingCount = gpu::kBufferCount;
-inline constexpr std::uint32_t kPushConstantBytes = 4 * (1 + PYR_ARG_WORDS);
+// The storage bindings of shaders/pyr_vulkan.comp: the buffers in gpu::Buffer order, then the upper parts of the points
+// and normals buffers (a frame whose xyz arrays exceed maxStorageBufferRange binds them in two ranges). Its push
+// constants: the image width, the dispatch's argument words, and where the upper parts start (in floats).
+inline constexpr std::uint32_t kBindingCount = gpu::kBufferCount + 2;
+inline constexpr std::uint32_t kPointsHiBinding = gpu::kBufferCount;
+inline constexpr std::uint32_t kNormalsHiBinding = gpu::kBufferCount + 1;
+inline constexpr std::uint32_t kPushConstantBytes = 4 * (2 + PYR_ARG_WORDS);
 
 struct DeviceRef {
     VkPhysicalDevice physical = VK_NULL_HANDLE;

@@ -41,8 +41,8 @@ inline constexpr std::size_t kBufferCount = std::size_t(Buffer::count);
 using BufferSizes = std::array<std::size_t, kBufferCount>;  // bytes
 
 struct DeviceLimits {
-    std::size_t max_buffer_bytes = 0;  // the largest buffer a kernel may bind
-    std::string max_buffer_what;       // where that limit comes from, for errors: "maxStorageBufferRange"
+    BufferSizes max_buffer_bytes{};    // per buffer, the largest one the device can allocate and its kernels bind
+    std::string max_buffer_what;       // where those limits come from, for errors: "maxStorageBufferRange"
     std::size_t memory_bytes = 0;      // what all buffers of a Segmenter may take together
     std::string memory_what;           // "the largest heap", "free memory"
     std::size_t mask_texel_bytes = 1;  // 1, or 4 where the shading language has no byte access (GLSL)

@@ -261,7 +261,7 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     BufferSizes s{};
     s[size_t(Buffer::points)] = 12 * px;  // also a mask frame's input words (4 per pixel)
     s[size_t(Buffer::normals)] = 12 * px;
-    s[size_t(Buffer::quant)] = 16 * px;
+    s[size_t(Buffer::quant)] = 8 * px;  // two words per pixel (shaders/pyr_types.h: pyr_pack_q16)
     s[size_t(Buffer::mask)] = limits.mask_texel_bytes * texels;
     s[size_t(Buffer::labels)] = 4 * texels;
     s[size_t(Buffer::lut)] = 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
@@ -276,22 +276,17 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
 
 void check_fits(const core::Plan& plan, const BufferSizes& sizes, const DeviceLimits& limits,
                 const std::string& device) {
-    size_t largest = 0;
-    Buffer which = Buffer::points;
+    const auto mib = [](size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; };
+    const std::string image = "a " + std::to_string(plan.width) + " x " + std::to_string(plan.height) + " image";
     size_t total = 0;
     for (size_t b = 0; b < kBufferCount; ++b) {
         total += sizes[b];
-        if (sizes[b] > largest) {
-            largest = sizes[b];
-            which = Buffer(b);
+        if (sizes[b] > limits.max_buffer_bytes[b]) {
+            throw Error(ErrorCode::out_of_memory, image + " needs a " + buffer_name(Buffer(b)) + " buffer of " +
+                                                      mib(sizes[b]) + " but " + device + " takes at most " +
+                                                      mib(limits.max_buffer_bytes[b]) + " there (" +
+                                                      limits.max_buffer_what + ")");
         }
-    }
-    const auto mib = [](size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; };
-    const std::string image = "a " + std::to_string(plan.width) + " x " + std::to_string(plan.height) + " image";
-    if (largest > limits.max_buffer_bytes) {
-        throw Error(ErrorCode::out_of_memory, image + " needs a " + buffer_name(which) + " buffer of " + mib(largest) +
-                                                  " but " + device + " binds at most " + mib(limits.max_buffer_bytes) +
-                                                  " (" + limits.max_buffer_what + ")");
     }
     if (total > limits.memory_bytes) {
         throw Error(ErrorCode::out_of_memory, image + " needs " + mib(total) + " of buffers but " + device + " has " +
