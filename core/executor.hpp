@@ -28,8 +28,8 @@ public:
     virtual void mip(int parent_level) = 0;                       // level parent_level from level parent_level + 1
     virtual void init_labels(int level, std::uint32_t mode) = 0;  // PYR_INIT_* (shaders/pyr_types.h)
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4
-    virtual void fill_once(int level) = 0;                                      // step 6 a and b
-    virtual void label_edges() = 0;                                             // step 6 c
+    virtual void final_fill(int level) = 0;  // steps 5 and 6 a, b (level N): one call, so a backend may fuse them
+    virtual void label_edges() = 0;          // step 6 c
     // Step 7: counts the distinct labels of level N (the segment count K, reported by read_back) and, when apply,
     // renumbers them.
     virtual void compact(bool apply) = 0;

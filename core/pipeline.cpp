@@ -59,8 +59,7 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
             for (int k = m + 1; k <= n - 1; ++k) ex.init_labels(k, PYR_INIT_INHERIT);  // step 3
         });
         clock.run("fill", [&] { ex.fill_to_fixed_point(n - 1, plan.old_label_max); });  // step 4
-        clock.run("labels", [&] { ex.init_labels(n, PYR_INIT_INHERIT); });              // step 5
-        clock.run("final_fill", [&] { ex.fill_once(n); });                              // step 6 a, b
+        clock.run("final_fill", [&] { ex.final_fill(n); });                             // steps 5, 6 a, b
         if (plan.params.label_edges) clock.run("edges", [&] { ex.label_edges(); });     // step 6 c
     }
     clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7

@@ -69,7 +69,14 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 
 #define PYR_KERNEL_1D(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)
 #define PYR_KERNEL_2D(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)
+#define PYR_KERNEL_GROUPS(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)
 #define PYR_I pyr_linear_id()
+#define PYR_GID (blockIdx.y * gridDim.x + blockIdx.x)
+#define PYR_LID threadIdx.x
+#define PYR_LSIZE blockDim.x
+#define PYR_GROUP_SHARED(type, name, count)
+#define PYR_LOCAL_SHARED(type, name, count) __shared__ type name[count];
+#define PYR_BARRIER() __syncthreads()
 #define PYR_X (blockIdx.x * blockDim.x + threadIdx.x)
 #define PYR_Y (blockIdx.y * blockDim.y + threadIdx.y)
 #define PYR_ARG(k) pyr_args.a[k]

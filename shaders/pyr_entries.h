@@ -1,8 +1,11 @@
 /* Every GPU entry point, written once for OpenCL C, CUDA and GLSL: thin wrappers over the shared pass functions
  * (shaders/pyr_*.h), one per line of the kernel table (shaders/pyr_kernels.h). Each dialect's file
  * (pyr_opencl.cl, pyr_cuda.cuh, pyr_vulkan.comp) defines, before including this one:
- *  - PYR_KERNEL_1D(name) / PYR_KERNEL_2D(name): the entry point's head;
- *  - PYR_I (1D: the invocation's index), PYR_X and PYR_Y (2D: its texel);
+ *  - PYR_KERNEL_1D(name) / PYR_KERNEL_2D(name) / PYR_KERNEL_GROUPS(name): the entry point's head;
+ *  - PYR_I (1D: the invocation's index), PYR_X and PYR_Y (2D: its texel), PYR_GID, PYR_LID and PYR_LSIZE (one
+ *    workgroup per index: the workgroup's index, the invocation's within it, and how many there are);
+ *  - PYR_GROUP_SHARED(type, name, count) before an entry point and PYR_LOCAL_SHARED(type, name, count) at the top
+ *    of its body (a workgroup's shared array is declared in one or the other, by dialect), PYR_BARRIER();
  *  - PYR_ARG(k), PYR_ARG_I32(k), PYR_ARG_F32(k): word k of the dispatch's PyrArgs;
  *  - PYR_W (the image width) and PYR_ENTRY_CTX (the context an entry point passes to shared functions);
  *  - the buffers pyr_buf_quant (two words per pixel: pyr_pack_q16 of qx, qy and of qz, valid), _mask, _labels,
@@ -17,6 +20,8 @@
 #define PYR_ENTRIES_H
 #include "pyr_kernels.h"
 #include "pyr_uf.h"
+
+#define PYR_SCAN_NONE 0xffffffffu /* no event yet (a barrier is an event of value 0) */
 
 /* normals (2D, w x h): h, radius */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_NORMALS)
@@ -144,16 +149,81 @@ PYR_KERNEL_1D(uf_gather) {
 }
 #endif
 
-/* Step 6 a and b: final_rows (1D, rows) and final_columns (1D, columns): level width, height, offset. One
- * invocation per line, there and back (the contract's sequential schedule). */
+/* Steps 5 and 6a: final_rows (one workgroup per row of level N): level width, height, offset; parent (level N - 1)
+ * width, height, offset. Step 5's labels, then the row pass of step 6 in its closed form, a segmented scan
+ * (docs/algorithm.md section 9): call a pixel an event when it is labelled or not fillable (a barrier, value 0);
+ * F(x) is the label of the last event at or before x, B(x) that of the first event at or after x (0 when there is
+ * none); an unlabelled fillable pixel takes F(x) when non-zero, else B(x). That is exactly the sequential left to
+ * right, then right to left pass. Each invocation takes a chunk of the row; the chunks' first and last events are
+ * scanned across the workgroup in shared memory (the operator "the later event wins" is associative, so the
+ * grouping cannot change a result). */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_ROWS)
-PYR_KERNEL_1D(final_rows) {
-    pyr_u32 line = PYR_I;
-    if (line >= PYR_ARG(1)) return;
-    pyr_sweep_row(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, 1u);
+PYR_GROUP_SHARED(pyr_u32, pyr_scan_last, PYR_SCAN_GROUP_MAX)
+PYR_GROUP_SHARED(pyr_u32, pyr_scan_first, PYR_SCAN_GROUP_MAX)
+PYR_KERNEL_GROUPS(final_rows) {
+    PYR_LOCAL_SHARED(pyr_u32, pyr_scan_last, PYR_SCAN_GROUP_MAX)
+    PYR_LOCAL_SHARED(pyr_u32, pyr_scan_first, PYR_SCAN_GROUP_MAX)
+    pyr_u32 y = PYR_GID; /* the same for the whole workgroup: its early return skips no barrier of another */
+    if (y >= PYR_ARG(1)) return;
+    PyrLevel lv = pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2));
+    PyrLevel parent = pyr_level(PYR_ARG(3), PYR_ARG(4), PYR_ARG(5));
+    pyr_u32 t = PYR_LID;
+    pyr_u32 g = PYR_LSIZE;
+    pyr_u32 chunk = (lv.width + g - 1u) / g;
+    pyr_u32 x0 = min(lv.width, t * chunk);
+    pyr_u32 x1 = min(lv.width, x0 + chunk);
+    pyr_u32 row = lv.offset + y * lv.width;
+    /* Step 5 into the labels, and the chunk's last and first events. */
+    pyr_u32 last = PYR_SCAN_NONE;
+    pyr_u32 first = PYR_SCAN_NONE;
+    for (pyr_u32 x = x0; x < x1; ++x) {
+        pyr_u32 l = pyr_label_init_texel(PYR_ENTRY_CTX, lv, parent, x, y, PYR_INIT_INHERIT);
+        pyr_buf_labels[row + x] = l;
+        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x]) & PYR_MASK_FILLABLE) == 0u) {
+            last = l;
+            if (first == PYR_SCAN_NONE) first = l;
+        }
+    }
+    pyr_scan_last[t] = last;
+    pyr_scan_first[t] = first;
+    PYR_BARRIER();
+    /* Inclusive scans over the invocations: the last event up to each chunk, the first one from each chunk on. */
+    for (pyr_u32 d = 1u; d < g; d <<= 1u) {
+        pyr_u32 before = t >= d ? pyr_scan_last[t - d] : PYR_SCAN_NONE;
+        pyr_u32 after = t + d < g ? pyr_scan_first[t + d] : PYR_SCAN_NONE;
+        PYR_BARRIER();
+        if (pyr_scan_last[t] == PYR_SCAN_NONE) pyr_scan_last[t] = before;
+        if (pyr_scan_first[t] == PYR_SCAN_NONE) pyr_scan_first[t] = after;
+        PYR_BARRIER();
+    }
+    pyr_u32 f = t > 0u ? pyr_scan_last[t - 1u] : PYR_SCAN_NONE;
+    pyr_u32 b = t + 1u < g ? pyr_scan_first[t + 1u] : PYR_SCAN_NONE;
+    /* Left to right: an unlabelled fillable pixel takes F when non-zero. */
+    f = f == PYR_SCAN_NONE ? 0u : f;
+    for (pyr_u32 x = x0; x < x1; ++x) {
+        pyr_u32 l = pyr_buf_labels[row + x];
+        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x]) & PYR_MASK_FILLABLE) == 0u) {
+            f = l;
+        } else if (f != 0u) {
+            pyr_buf_labels[row + x] = f;
+        }
+    }
+    /* Right to left: what is still 0 takes B. Pixels filled just now count as events: they lie after the run's
+     * first labelled pixel, so no pixel still 0 can see past them to a different one. */
+    b = b == PYR_SCAN_NONE ? 0u : b;
+    for (pyr_u32 x = x1; x > x0; --x) {
+        pyr_u32 l = pyr_buf_labels[row + x - 1u];
+        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x - 1u]) & PYR_MASK_FILLABLE) == 0u) {
+            b = l;
+        } else if (b != 0u) {
+            pyr_buf_labels[row + x - 1u] = b;
+        }
+    }
 }
 #endif
 
+/* Step 6b: final_columns (1D, columns): level width, height, offset. One invocation per column (neighbouring
+ * invocations read neighbouring texels), down and up: the contract's sequential schedule. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_COLUMNS)
 PYR_KERNEL_1D(final_columns) {
     pyr_u32 line = PYR_I;

@@ -2,7 +2,8 @@
  *  - name: the entry point is pyr_k_<name> (OpenCL, CUDA) and the host's gpu::Kernel::<name>;
  *  - NAME: the GLSL build compiles shaders/pyr_entries.h once per kernel with -DPYR_ENTRY_<NAME>
  *    (core/CMakeLists.txt reads the names from this table);
- *  - dims: 1, invocations over a count (PYR_I), or 2, over a width x height grid (PYR_X, PYR_Y).
+ *  - dims: 1, invocations over a count (PYR_I); 2, over a width x height grid (PYR_X, PYR_Y); or 3, one workgroup
+ *    per index of a count (PYR_GID; PYR_LID of PYR_LSIZE invocations, at most PYR_SCAN_GROUP_MAX).
  * Every kernel takes the Segmenter's buffers (bound once) and one PyrArgs of PYR_ARG_WORDS words per dispatch;
  * the words of each are listed where it is defined, in shaders/pyr_entries.h. Adding a kernel: one line here, its
  * body there, and its dispatch in core/gpu/gpu_executor.cpp. */
@@ -21,7 +22,7 @@
     K(uf_merge, UF_MERGE, 2)           \
     K(uf_resolve, UF_RESOLVE, 2)       \
     K(uf_gather, UF_GATHER, 1)         \
-    K(final_rows, FINAL_ROWS, 1)       \
+    K(final_rows, FINAL_ROWS, 3)       \
     K(final_columns, FINAL_COLUMNS, 1) \
     K(edges, EDGES, 2)                 \
     K(lut_mark, LUT_MARK, 1)           \
@@ -34,8 +35,10 @@
 /* Per-dispatch argument words (uint32; ints and floats by their bits). */
 #define PYR_ARG_WORDS 8
 
-/* Workgroup sizes of the GLSL entry points (compile-time there); other dialects choose their own. */
+/* Workgroup sizes of the GLSL entry points (compile-time there); other dialects choose their own, up to
+ * PYR_SCAN_GROUP_MAX for the workgroup kernels (dims 3), whose shared arrays have that many slots. */
 #define PYR_GROUP_1D 64u
 #define PYR_GROUP_2D 8u
+#define PYR_SCAN_GROUP_MAX 256u
 
 #endif /* PYR_KERNELS_H */

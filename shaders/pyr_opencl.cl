@@ -39,7 +39,14 @@ typedef struct PyrArgs {
 
 #define PYR_KERNEL_1D(name) __kernel void pyr_k_##name(PYR_CTX_PARAM, PyrArgs pyr_args)
 #define PYR_KERNEL_2D(name) __kernel void pyr_k_##name(PYR_CTX_PARAM, PyrArgs pyr_args)
+#define PYR_KERNEL_GROUPS(name) __kernel void pyr_k_##name(PYR_CTX_PARAM, PyrArgs pyr_args)
 #define PYR_I ((uint)(get_global_id(1) * get_global_size(0) + get_global_id(0)))
+#define PYR_GID ((uint)(get_group_id(1) * get_num_groups(0) + get_group_id(0)))
+#define PYR_LID ((uint)get_local_id(0))
+#define PYR_LSIZE ((uint)get_local_size(0))
+#define PYR_GROUP_SHARED(type, name, count)
+#define PYR_LOCAL_SHARED(type, name, count) __local type name[count];
+#define PYR_BARRIER() barrier(CLK_LOCAL_MEM_FENCE)
 #define PYR_X ((uint)get_global_id(0))
 #define PYR_Y ((uint)get_global_id(1))
 #define PYR_ARG(k) pyr_args.a[k]

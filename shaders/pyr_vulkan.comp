@@ -75,7 +75,16 @@ void pyr_store_normal(uint k, float v) {
 
 #define PYR_KERNEL_1D(name) layout(local_size_x = PYR_GROUP_1D) in; void main()
 #define PYR_KERNEL_2D(name) layout(local_size_x = PYR_GROUP_2D, local_size_y = PYR_GROUP_2D) in; void main()
+#define PYR_KERNEL_GROUPS(name) layout(local_size_x = PYR_GROUP_1D) in; void main()
 #define PYR_I (gl_GlobalInvocationID.y * gl_NumWorkGroups.x * PYR_GROUP_1D + gl_GlobalInvocationID.x)
+#define PYR_GID (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x)
+#define PYR_LID gl_LocalInvocationID.x
+#define PYR_LSIZE gl_WorkGroupSize.x
+#define PYR_GROUP_SHARED(type, name, count) shared type name[count];
+#define PYR_LOCAL_SHARED(type, name, count)
+#define PYR_BARRIER() \
+    memoryBarrierShared(); \
+    barrier()
 #define PYR_X gl_GlobalInvocationID.x
 #define PYR_Y gl_GlobalInvocationID.y
 #define PYR_ARG(k) pyr_push.a[k]

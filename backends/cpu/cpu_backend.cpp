@@ -146,16 +146,10 @@ public:
         const PassContext c = context();
         const PyrLevel lv = plan_.level(level);
         const PyrLevel parent = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
-        // Step 5 is done row by row inside step 6a's row sweeps (fill_once), while each row is in cache.
-        if (level == plan_.level_count && mode == PYR_INIT_INHERIT) {
-            pending_init_ = level;
-            return;
-        }
         rows(lv.height, [&](size_t y) { init_row(c, lv, parent, uint32_t(y), mode); });
     }
 
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
-        run_pending_init();
         const PyrLevel lv = plan_.level(level);
         if (anchor_max != 0) {
             rows(lv.height, [&](size_t y) {
@@ -174,15 +168,11 @@ public:
         }
     }
 
-    void fill_once(int level) override {
-        const bool fused = pending_init_ == level;
-        run_pending_init(level);
-        sweep(plan_.level(level), true, fused);
-    }
+    // Steps 5 and 6 a, b: each row's step-5 labels just before its row sweeps, while the row is in cache.
+    void final_fill(int level) override { sweep(plan_.level(level), true, true); }
 
     // Step 6c, and compaction's marking of each row once its labels are final (one pass over the image fewer).
     void label_edges() override {
-        run_pending_init();
         const PassContext c = context();
         const PyrLevel full = plan_.full();
         std::fill(lut_.begin(), lut_.end(), 0u);
@@ -200,7 +190,6 @@ public:
     }
 
     void compact(bool apply) override {
-        run_pending_init();
         if (!marked_) {
             std::fill(lut_.begin(), lut_.end(), 0u);
             rows(size_t(plan_.height), [&](size_t y) { mark_row(y); });
@@ -294,18 +283,6 @@ private:
     void init_row(const PassContext& c, const PyrLevel& lv, const PyrLevel& parent, uint32_t y, uint32_t mode) {
         uint32_t* out = labels_.data() + lv.offset + size_t(y) * lv.width;
         for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, y, mode);
-    }
-
-    // A deferred step-5 init that is not fused into the next fill_once runs on its own (`fused_level` is the level
-    // whose fill_once does it instead).
-    void run_pending_init(int fused_level = 0) {
-        const int level = pending_init_;
-        pending_init_ = 0;
-        if (level == 0 || level == fused_level) return;
-        const PassContext c = context();
-        const PyrLevel lv = plan_.level(level);
-        const PyrLevel parent = plan_.level(level - 1);
-        rows(lv.height, [&](size_t y) { init_row(c, lv, parent, uint32_t(y), PYR_INIT_INHERIT); });
     }
 
     [[nodiscard]] PassContext context() {
@@ -441,8 +418,7 @@ private:
     bool sweeps_;
     uint32_t segment_count_ = 0;
     uint32_t fill_rounds_ = 0;
-    int pending_init_ = 0;  // a level whose step-5 init waits for its fill_once (0: none)
-    bool marked_ = false;   // label_edges marked the compaction table already
+    bool marked_ = false;  // label_edges marked the compaction table already
     bool compacted_ = false;
     bool normals_estimated_ = false;
     bool from_mask_ = false;

@@ -24,7 +24,8 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr uint32_t kBlock1D = 256;
+constexpr uint32_t kBlock1D = 256;  // at most PYR_SCAN_GROUP_MAX: also the workgroup kernels' size
+static_assert(kBlock1D <= PYR_SCAN_GROUP_MAX);
 constexpr uint32_t kBlock2DX = 32;  // a warp along a row: coalesced loads
 constexpr uint32_t kBlock2DY = 8;
 constexpr uint32_t kMaxEvents = 64;
@@ -169,8 +170,9 @@ public:
         if (nx == 0 || ny == 0) return;
         dim3 grid;
         dim3 block;
-        if (gpu::kernel_dims(k) == 1) {
-            const uint32_t blocks = (nx + kBlock1D - 1) / kBlock1D;
+        if (gpu::kernel_dims(k) != 2) {
+            // 1D: blocks of 256 threads; 3: one block of 256 threads per index (PYR_GID).
+            const uint32_t blocks = gpu::kernel_dims(k) == 3 ? nx : (nx + kBlock1D - 1) / kBlock1D;
             const uint32_t x = std::min<uint32_t>(blocks, 65535u);
             grid = dim3(x, (blocks + x - 1) / x);
             block = dim3(kBlock1D);

@@ -101,9 +101,15 @@ public:
         check(clSetKernelArg(kernel, kContextArgs, sizeof(args.words), args.words.data()), gpu::kernel_entry_name(k));
         std::array<size_t, 2> local = {64, 1};
         if (gpu::kernel_dims(k) == 2) local = {8, 8};
-        const std::array<size_t, 2> global = {round_up(nx, local[0]), round_up(ny, local[1])};
+        std::array<size_t, 2> global = {round_up(nx, local[0]), round_up(ny, local[1])};
+        if (gpu::kernel_dims(k) == 3) global = {size_t(nx) * local[0], 1};  // one workgroup per index
         // A device may allow fewer work-items per group than the fixed sizes ask: then the runtime chooses.
         const size_t* local_size = local[0] * local[1] <= max_group(k) ? local.data() : nullptr;
+        if (local_size == nullptr && gpu::kernel_dims(k) == 3) {
+            throw Error(ErrorCode::backend_unavailable, std::string(gpu::kernel_entry_name(k)) +
+                                                            " needs workgroups of " + std::to_string(local[0]) +
+                                                            " on " + rt_->description);
+        }
         check(clEnqueueNDRangeKernel(queue_, kernel, 2, nullptr, global.data(), local_size, 0, nullptr, nullptr),
               gpu::kernel_entry_name(k));
     }

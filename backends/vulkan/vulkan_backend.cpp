@@ -105,14 +105,16 @@ public:
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     }
 
-    // 1D: `nx` invocations in groups of PYR_GROUP_1D over a 2D grid of workgroups (PYR_I); 2D: 8 x 8 groups.
+    // 1D: `nx` invocations in groups of PYR_GROUP_1D over a 2D grid of workgroups (PYR_I); 2D: 8 x 8 groups;
+    // 3: `nx` workgroups (PYR_GID), over a 2D grid likewise.
     void dispatch(gpu::Kernel k, uint32_t nx, uint32_t ny, const gpu::Args& args) override {
         if (nx == 0 || ny == 0) return;
         recording();
         uint32_t gx = 0;
         uint32_t gy = 0;
-        if (gpu::kernel_dims(k) == 1) {
-            const uint32_t groups = (nx + PYR_GROUP_1D - 1) / PYR_GROUP_1D;
+        if (gpu::kernel_dims(k) != 2) {
+            // 1D: groups of PYR_GROUP_1D invocations; 3: one workgroup per index.
+            const uint32_t groups = gpu::kernel_dims(k) == 3 ? nx : (nx + PYR_GROUP_1D - 1) / PYR_GROUP_1D;
             gx = std::min(groups, max_groups_x_);
             gy = (groups + gx - 1) / gx;
         } else {

@@ -128,10 +128,11 @@ public:
         dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
     }
 
-    // Step 6 a and b: rows there and back, then columns.
-    void fill_once(int level) override {
+    // Steps 5 and 6a in one workgroup per row (a segmented scan), then 6b: one invocation per column.
+    void final_fill(int level) override {
         const PyrLevel l = plan_.level(level);
-        dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset}));
+        const PyrLevel p = plan_.level(level - 1);
+        dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset, p.width, p.height, p.offset}));
         dispatch(Kernel::final_columns, l.width, 1, args({l.width, l.height, l.offset}));
     }
 
