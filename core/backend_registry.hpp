@@ -1,11 +1,35 @@
 #pragma once
+// The registry of backends. Each backend describes itself once, as a BackendEntry in its own files
+// (backends/<name>/<name>_backend.hpp); core/CMakeLists.txt generates the list of every backend pyrseg knows, in the
+// order 'auto' prefers them, with the built ones' entries and why the others are not built. Adding a backend: its
+// entry, and its name in that list.
 #include <memory>
+#include <span>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/executor.hpp"
 #include "core/plan.hpp"
 
 namespace pyrseg::core {
+
+struct BackendEntry {
+    // The devices the backend can see (an unusable one says why); sets *available, and *why_none when no device
+    // can run pyrseg here. Never throws.
+    std::vector<std::string> (*describe)(std::string* why_none, bool* available);
+    // The executor on the chosen device; throws pyrseg::Error. `plan` must outlive it.
+    std::unique_ptr<PassExecutor> (*make_executor)(const Plan& plan);
+};
+
+struct KnownBackend {
+    const char* name;
+    const BackendEntry* entry;  // nullptr when this build does not have the backend
+    const char* why_not_built;  // when entry is nullptr
+};
+
+// Every backend pyrseg knows, GPUs first and the CPU last (generated: core/CMakeLists.txt).
+[[nodiscard]] std::span<const KnownBackend> known_backends();
 
 // Creates the executor of a backend that resolve_backend_name() accepted. `plan` must outlive it.
 [[nodiscard]] std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan);

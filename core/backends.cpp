@@ -1,59 +1,25 @@
-#include <algorithm>
 #include <cstdlib>
 #include <string>
-#include <thread>
+#include <utility>
 
-#include "backends/cpu/cpu_backend.hpp"
-#include "core/backends_config.hpp"
-#if PYRSEG_HAVE_CUDA
-#include "backends/cuda/cuda_backend.hpp"
-#endif
-#if PYRSEG_HAVE_OPENCL
-#include "backends/opencl/opencl_backend.hpp"
-#endif
-#if PYRSEG_HAVE_VULKAN
-#include "backends/vulkan/vulkan_backend.hpp"
-#endif
 #include "core/backend_registry.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg {
 
+// In the registry's order (core/backend_registry.hpp): GPUs first, the CPU always last and always there.
 std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;
-    // Preference order for "auto": GPUs first, the CPU always last and always there.
-#if PYRSEG_HAVE_CUDA
-    {
-        BackendInfo cuda{"cuda", false, "", {}};
-        cuda.devices = cuda::describe_devices(&cuda.reason);
-        cuda.available = !cuda.devices.empty();
-        all.push_back(cuda);
+    for (const core::KnownBackend& k : core::known_backends()) {
+        BackendInfo info{k.name, false, "", {}};
+        if (k.entry == nullptr) {
+            info.reason = k.why_not_built;
+        } else {
+            info.devices = k.entry->describe(&info.reason, &info.available);
+        }
+        all.push_back(std::move(info));
     }
-#else
-    all.push_back({"cuda", false, kWhyCuda, {}});
-#endif
-#if PYRSEG_HAVE_VULKAN
-    {
-        BackendInfo vulkan{"vulkan", false, "", {}};
-        vulkan.devices = vulkan::describe_devices(&vulkan.reason, &vulkan.available);
-        all.push_back(vulkan);
-    }
-#else
-    all.push_back({"vulkan", false, kWhyVulkan, {}});
-#endif
-#if PYRSEG_HAVE_OPENCL
-    {
-        BackendInfo opencl{"opencl", false, "", {}};
-        opencl.devices = opencl::describe_devices(&opencl.reason);
-        opencl.available = !opencl.devices.empty();
-        all.push_back(opencl);
-    }
-#else
-    all.push_back({"opencl", false, kWhyOpencl, {}});
-#endif
-    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-    all.push_back({"cpu", true, "", {"host CPU, " + std::to_string(threads) + " hardware threads"}});
     return all;
 }
 
@@ -95,16 +61,9 @@ std::string resolve_backend_name(std::string_view requested) {
 namespace core {
 
 std::unique_ptr<PassExecutor> make_executor(std::string_view backend, const Plan& plan) {
-    if (backend == "cpu") return cpu::make_executor(plan);
-#if PYRSEG_HAVE_CUDA
-    if (backend == "cuda") return cuda::make_executor(plan);
-#endif
-#if PYRSEG_HAVE_VULKAN
-    if (backend == "vulkan") return vulkan::make_executor(plan);
-#endif
-#if PYRSEG_HAVE_OPENCL
-    if (backend == "opencl") return opencl::make_executor(plan);
-#endif
+    for (const KnownBackend& k : known_backends()) {
+        if (k.entry != nullptr && backend == k.name) return k.entry->make_executor(plan);
+    }
     throw Error(ErrorCode::backend_unavailable, "backend '" + std::string(backend) + "' is not built in");
 }
 

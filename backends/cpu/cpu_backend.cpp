@@ -8,6 +8,7 @@
 #include <cstring>
 #include <new>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "backends/cpu/cpu_kernels.hpp"
@@ -458,5 +459,15 @@ std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
         throw Error(ErrorCode::out_of_memory, what + ", and allocating it failed");
     }
 }
+
+namespace {
+std::vector<std::string> describe_host(std::string* /*why_none*/, bool* available) {
+    *available = true;
+    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    return {"host CPU, " + std::to_string(threads) + " hardware threads"};
+}
+}  // namespace
+
+const core::BackendEntry kBackend = {describe_host, make_executor};
 
 }  // namespace pyrseg::cpu

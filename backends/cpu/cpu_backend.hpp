@@ -1,6 +1,7 @@
 #pragma once
 #include <memory>
 
+#include "core/backend_registry.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
 
@@ -9,5 +10,8 @@ namespace pyrseg::cpu {
 // The CPU backend: the shared pass functions run over the image on a thread pool. `plan` must outlive it.
 // Throws pyrseg::Error(out_of_memory) when the buffers would not fit in this machine's memory.
 [[nodiscard]] std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan);
+
+// This backend in the registry (core/backend_registry.hpp).
+extern const core::BackendEntry kBackend;
 
 }  // namespace pyrseg::cpu

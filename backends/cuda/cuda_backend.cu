@@ -310,4 +310,11 @@ std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
     return gpu::make_gpu_executor(plan, std::make_unique<CudaDevice>(int(chosen.value_or(0))));
 }
 
+const core::BackendEntry kBackend = {[](std::string* why_none, bool* available) {
+                                         std::vector<std::string> devices = describe_devices(why_none);
+                                         *available = !devices.empty();
+                                         return devices;
+                                     },
+                                     make_executor};
+
 }  // namespace pyrseg::cuda

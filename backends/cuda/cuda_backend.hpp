@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/backend_registry.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
 
@@ -15,5 +16,8 @@ namespace pyrseg::cuda {
 
 // For `pyrseg backends`: the devices, or why there are none (then the vector is empty).
 [[nodiscard]] std::vector<std::string> describe_devices(std::string* why_none);
+
+// This backend in the registry (core/backend_registry.hpp).
+extern const core::BackendEntry kBackend;
 
 }  // namespace pyrseg::cuda

@@ -186,4 +186,11 @@ std::vector<std::string> describe_devices(std::string* why_none) {
     return out;
 }
 
+const core::BackendEntry kBackend = {[](std::string* why_none, bool* available) {
+                                         std::vector<std::string> devices = describe_devices(why_none);
+                                         *available = !devices.empty();
+                                         return devices;
+                                     },
+                                     make_executor};
+
 }  // namespace pyrseg::opencl

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/backend_registry.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
 
@@ -14,5 +15,8 @@ namespace pyrseg::opencl {
 
 // For `pyrseg backends`: the devices, or why there are none (then the vector is empty).
 [[nodiscard]] std::vector<std::string> describe_devices(std::string* why_none);
+
+// This backend in the registry (core/backend_registry.hpp).
+extern const core::BackendEntry kBackend;
 
 }  // namespace pyrseg::opencl

@@ -361,4 +361,6 @@ std::vector<std::string> describe_devices(std::string* why_none, bool* any_usabl
     return out;
 }
 
+const core::BackendEntry kBackend = {describe_devices, make_executor};
+
 }  // namespace pyrseg::vulkan

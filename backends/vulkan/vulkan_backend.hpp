@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/backend_registry.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
 
@@ -15,5 +16,8 @@ namespace pyrseg::vulkan {
 // For `pyrseg backends`: the devices (unusable ones say why), and *why_none when none is usable (then the
 // vector may still list the unusable ones).
 [[nodiscard]] std::vector<std::string> describe_devices(std::string* why_none, bool* any_usable);
+
+// This backend in the registry (core/backend_registry.hpp).
+extern const core::BackendEntry kBackend;
 
 }  // namespace pyrseg::vulkan
