@@ -15,6 +15,7 @@
 #include "core/device_choice.hpp"
 #include "core/gpu/device.hpp"
 #include "core/gpu/gpu_executor.hpp"
+#include "core/gpu/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_cuda.cuh"
 
@@ -97,7 +98,6 @@ public:
         description_ = "CUDA device " + std::to_string(device_) + " (" + p.name + ")";
         check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
-        downloads_.reserve(16);
     }
 
     ~CudaDevice() override {
@@ -134,10 +134,11 @@ public:
             buffers_[b] = Memory<false>(sizes[b], what.c_str());
         }
         const size_t pixels = sizes[size_t(gpu::Buffer::out)] / 4;
-        upload_ = Memory<true>(sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)],
+        upload_ = Memory<true>(sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)] + 256,
                                "cudaMallocHost(upload staging)");
         download_ =
-            Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + 64, "cudaMallocHost(download staging)");
+            Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + 256, "cudaMallocHost(download staging)");
+        staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
         ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points), buffer<float>(gpu::Buffer::normals),
                           buffer<unsigned>(gpu::Buffer::quant),     buffer<unsigned char>(gpu::Buffer::mask),
                           buffer<unsigned>(gpu::Buffer::labels),    buffer<unsigned>(gpu::Buffer::lut),
@@ -146,19 +147,15 @@ public:
     }
 
     void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
-        const size_t at = take(upload_used_, upload_.bytes(), bytes, "upload");
-        unsigned char* staged = upload_.as<unsigned char>() + at;
-        std::memcpy(staged, src, bytes);
+        const unsigned char* staged = upload_.as<unsigned char>() + staging_.stage_upload(src, bytes);
         check(cudaMemcpyAsync(buffer<unsigned char>(b) + offset, staged, bytes, cudaMemcpyHostToDevice, stream_),
               "cudaMemcpyAsync(upload)");
     }
 
     void download(gpu::Buffer b, size_t offset, void* dst, size_t bytes) override {
-        const size_t at = take(download_used_, download_.bytes(), bytes, "download");
-        check(cudaMemcpyAsync(download_.as<unsigned char>() + at, buffer<unsigned char>(b) + offset, bytes,
-                              cudaMemcpyDeviceToHost, stream_),
+        unsigned char* staged = download_.as<unsigned char>() + staging_.stage_download(dst, bytes);
+        check(cudaMemcpyAsync(staged, buffer<unsigned char>(b) + offset, bytes, cudaMemcpyDeviceToHost, stream_),
               "cudaMemcpyAsync(download)");
-        downloads_.push_back({dst, at, bytes});
     }
 
     void zero(gpu::Buffer b, size_t offset, size_t bytes) override {
@@ -195,10 +192,7 @@ public:
 
     void finish() override {
         check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
-        for (const Download& d : downloads_) std::memcpy(d.dst, download_.as<unsigned char>() + d.at, d.bytes);
-        downloads_.clear();
-        upload_used_ = 0;
-        download_used_ = 0;
+        staging_.complete();
     }
 
     // Each pass runs from its event to the next one.
@@ -222,12 +216,6 @@ public:
     }
 
 private:
-    struct Download {
-        void* dst;
-        size_t at;
-        size_t bytes;
-    };
-
     void select() const { check(cudaSetDevice(device_), "cudaSetDevice"); }
 
     template <class T>
@@ -235,23 +223,12 @@ private:
         return buffers_[size_t(b)].as<T>();
     }
 
-    // `bytes` of a staging buffer, from where the last take ended (16-byte aligned).
-    static size_t take(size_t& used, size_t capacity, size_t bytes, const char* what) {
-        const size_t at = used;
-        if (at + bytes > capacity)
-            throw Error(ErrorCode::internal, std::string("CUDA: the ") + what + " staging buffer is too small");
-        used = (at + bytes + 15) / 16 * 16;
-        return at;
-    }
-
     int device_;
     std::string description_;
     cudaStream_t stream_ = nullptr;
     std::array<Memory<false>, gpu::kBufferCount> buffers_;
     Memory<true> upload_, download_;
-    size_t upload_used_ = 0;
-    size_t download_used_ = 0;
-    std::vector<Download> downloads_;
+    gpu::StagingArena staging_;
     PyrCudaCtx ctx_{};
     std::array<cudaEvent_t, kMaxEvents> events_{};
     std::array<const char*, kMaxEvents> event_names_{};

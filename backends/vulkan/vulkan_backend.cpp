@@ -15,6 +15,7 @@
 #include "backends/vulkan/vulkan_runtime.hpp"
 #include "core/gpu/device.hpp"
 #include "core/gpu/gpu_executor.hpp"
+#include "core/gpu/staging.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::vulkan {
@@ -27,10 +28,7 @@ constexpr uint32_t kMaxTimestamps = 64;  // pass boundaries per frame
 
 class VulkanDevice final : public gpu::Device {
 public:
-    explicit VulkanDevice(std::shared_ptr<Runtime> runtime) : rt_(std::move(runtime)) {
-        create_command_objects();
-        downloads_.reserve(16);
-    }
+    explicit VulkanDevice(std::shared_ptr<Runtime> runtime) : rt_(std::move(runtime)) { create_command_objects(); }
 
     ~VulkanDevice() override {
         const VkDevice d = rt_->device;
@@ -75,28 +73,26 @@ public:
         const VkDeviceSize xyz = sizes[size_t(gpu::Buffer::points)];
         split_bytes_ = xyz <= rt_->properties.limits.maxStorageBufferRange ? xyz : aligned_range();
         // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count,
-        // statistics), each packed from offset 0 between two finish() calls.
-        const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)];
-        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] + 64;
+        // statistics), with room for the arena's alignment (core/gpu/staging.hpp).
+        const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)] + 256;
+        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] + 256;
         upload_ = VulkanBuffer(*rt_, up, VulkanBuffer::Memory::host, "the upload staging buffer");
         download_ = VulkanBuffer(*rt_, down, VulkanBuffer::Memory::host, "the download staging buffer");
+        staging_.reset(static_cast<unsigned char*>(upload_.mapped()), size_t(up),
+                       static_cast<unsigned char*>(download_.mapped()), size_t(down));
         write_descriptors();
         throw_on_validation_messages("the creation of a Vulkan Segmenter");
     }
 
     void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
         recording();
-        const VkDeviceSize at = take(upload_used_, upload_.size(), bytes, "upload");
-        std::memcpy(static_cast<unsigned char*>(upload_.mapped()) + at, src, bytes);
-        copy(upload_.get(), at, buffer(b), offset, bytes);
+        copy(upload_.get(), staging_.stage_upload(src, bytes), buffer(b), offset, bytes);
         barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     }
 
     void download(gpu::Buffer b, size_t offset, void* dst, size_t bytes) override {
         recording();
-        const VkDeviceSize at = take(download_used_, download_.size(), bytes, "download");
-        copy(buffer(b), offset, download_.get(), at, bytes);
-        downloads_.push_back({dst, at, bytes});
+        copy(buffer(b), offset, download_.get(), staging_.stage_download(dst, bytes), bytes);
     }
 
     void zero(gpu::Buffer b, size_t offset, size_t bytes) override {
@@ -161,11 +157,7 @@ public:
         check(vkWaitForFences(rt_->device, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
         in_flight_ = false;
         throw_on_validation_messages("a frame");
-        const auto* staged = static_cast<const unsigned char*>(download_.mapped());
-        for (const Download& d : downloads_) std::memcpy(d.dst, staged + d.at, d.bytes);
-        downloads_.clear();
-        upload_used_ = 0;
-        download_used_ = 0;
+        staging_.complete();
     }
 
     bool pass_times(std::vector<PassTiming>& timings) override {
@@ -191,12 +183,6 @@ public:
     }
 
 private:
-    struct Download {
-        void* dst;
-        VkDeviceSize at;
-        size_t bytes;
-    };
-
     [[nodiscard]] VkBuffer buffer(gpu::Buffer b) const { return buffers_[size_t(b)].get(); }
 
     // Begins the command buffer when nothing is being recorded; the frame's first one resets the timestamps.
@@ -211,15 +197,6 @@ private:
         reset_queries_ = false;
         vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, rt_->pipeline_layout, 0, 1, &descriptor_set_,
                                 0, nullptr);
-    }
-
-    // `bytes` of a staging buffer, from where the last take ended (4-byte aligned).
-    static VkDeviceSize take(VkDeviceSize& used, VkDeviceSize capacity, size_t bytes, const char* what) {
-        const VkDeviceSize at = used;
-        if (at + bytes > capacity)
-            throw Error(ErrorCode::internal, std::string("Vulkan: the ") + what + " staging buffer is too small");
-        used = (at + bytes + 3) / 4 * 4;
-        return at;
     }
 
     // Everything written before (at src_stage) is visible to the shaders and copies after.
@@ -327,9 +304,7 @@ private:
     std::array<VulkanBuffer, gpu::kBufferCount> buffers_;
     VkDeviceSize split_bytes_ = 0;  // where the points' and normals' second binding starts
     VulkanBuffer upload_, download_;
-    VkDeviceSize upload_used_ = 0;
-    VkDeviceSize download_used_ = 0;
-    std::vector<Download> downloads_;
+    gpu::StagingArena staging_;
     VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
     VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
     VkCommandPool command_pool_ = VK_NULL_HANDLE;
