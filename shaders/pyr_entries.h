@@ -149,86 +149,90 @@ PYR_KERNEL_1D(uf_gather) {
 }
 #endif
 
-/* Steps 5 and 6a: final_rows (one workgroup per row of level N): level width, height, offset; parent (level N - 1)
- * width, height, offset. Step 5's labels, then the row pass of step 6 in its closed form, a segmented scan
- * (docs/algorithm.md section 9): call a pixel an event when it is labelled or not fillable (a barrier, value 0);
- * F(x) is the label of the last event at or before x, B(x) that of the first event at or after x (0 when there is
- * none); an unlabelled fillable pixel takes F(x) when non-zero, else B(x). That is exactly the sequential left to
- * right, then right to left pass. Each invocation takes a chunk of the row; the chunks' first and last events are
- * scanned across the workgroup in shared memory (the operator "the later event wins" is associative, so the
- * grouping cannot change a result). */
-#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_ROWS)
+/* Step 6 a and b (and step 5, fused into the row pass): final_lines, one workgroup per PYR_SCAN_STRIP lines.
+ * Arguments: level N's width, height, offset; level N - 1's width, height, offset; rows (1: the rows, each after
+ * step 5's labels, one row per workgroup; 0: the columns, PYR_SCAN_STRIP adjacent ones per workgroup, so that
+ * neighbouring invocations read neighbouring texels).
+ * Each line's pass is the closed form of the contract's sequential one (docs/algorithm.md section 9): call a pixel an
+ * event when it is labelled or not fillable (a barrier, value 0); F(x) is the label of the last event at or before
+ * x, B(x) that of the first event at or after x (0 when there is none); an unlabelled fillable pixel takes F(x) when
+ * non-zero, else B(x). That is exactly the pass there and back. Each invocation takes a chunk of a line; the
+ * chunks' last and first events are scanned across the line's invocations in shared memory (the operator "the later
+ * event wins" is associative, so how a line is cut into chunks cannot change a result). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_LINES)
 PYR_GROUP_SHARED(pyr_u32, pyr_scan_last, PYR_SCAN_GROUP_MAX)
 PYR_GROUP_SHARED(pyr_u32, pyr_scan_first, PYR_SCAN_GROUP_MAX)
-PYR_KERNEL_GROUPS(final_rows) {
+PYR_KERNEL_GROUPS(final_lines) {
     PYR_LOCAL_SHARED(pyr_u32, pyr_scan_last, PYR_SCAN_GROUP_MAX)
     PYR_LOCAL_SHARED(pyr_u32, pyr_scan_first, PYR_SCAN_GROUP_MAX)
-    pyr_u32 y = PYR_GID; /* the same for the whole workgroup: its early return skips no barrier of another */
-    if (y >= PYR_ARG(1)) return;
     PyrLevel lv = pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2));
     PyrLevel parent = pyr_level(PYR_ARG(3), PYR_ARG(4), PYR_ARG(5));
-    pyr_u32 t = PYR_LID;
-    pyr_u32 g = PYR_LSIZE;
-    pyr_u32 chunk = (lv.width + g - 1u) / g;
-    pyr_u32 x0 = min(lv.width, t * chunk);
-    pyr_u32 x1 = min(lv.width, x0 + chunk);
-    pyr_u32 row = lv.offset + y * lv.width;
-    /* Step 5 into the labels, and the chunk's last and first events. */
+    pyr_u32 rows = PYR_ARG(6);
+    pyr_u32 strip = rows != 0u ? 1u : PYR_SCAN_STRIP; /* lines per workgroup */
+    pyr_u32 parts = PYR_LSIZE / strip;                /* invocations per line */
+    pyr_u32 lane = PYR_LID % strip;                   /* the invocation's line within the strip */
+    pyr_u32 part = PYR_LID / strip;                   /* and its chunk of that line */
+    pyr_u32 line = PYR_GID * strip + lane;            /* a row, or a column */
+    pyr_u32 lines = rows != 0u ? lv.height : lv.width;
+    pyr_u32 length = rows != 0u ? lv.width : lv.height;
+    pyr_u32 step = rows != 0u ? 1u : lv.width;
+    pyr_u32 start = lv.offset + (rows != 0u ? line * lv.width : line);
+    pyr_u32 chunk = (length + parts - 1u) / parts;
+    pyr_u32 k0 = min(length, part * chunk);
+    pyr_u32 k1 = line < lines ? min(length, k0 + chunk) : k0; /* past the last line: no work, but every barrier */
+    /* The chunk's last and first events; on rows, step 5's labels first. */
     pyr_u32 last = PYR_SCAN_NONE;
     pyr_u32 first = PYR_SCAN_NONE;
-    for (pyr_u32 x = x0; x < x1; ++x) {
-        pyr_u32 l = pyr_label_init_texel(PYR_ENTRY_CTX, lv, parent, x, y, PYR_INIT_INHERIT);
-        pyr_buf_labels[row + x] = l;
-        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x]) & PYR_MASK_FILLABLE) == 0u) {
+    for (pyr_u32 k = k0; k < k1; ++k) {
+        pyr_u32 i = start + k * step;
+        pyr_u32 l = pyr_buf_labels[i];
+        if (rows != 0u) {
+            l = pyr_label_init_texel(PYR_ENTRY_CTX, lv, parent, k, line, PYR_INIT_INHERIT);
+            pyr_buf_labels[i] = l;
+        }
+        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
             last = l;
             if (first == PYR_SCAN_NONE) first = l;
         }
     }
-    pyr_scan_last[t] = last;
-    pyr_scan_first[t] = first;
+    pyr_u32 slot = part * strip + lane;
+    pyr_scan_last[slot] = last;
+    pyr_scan_first[slot] = first;
     PYR_BARRIER();
-    /* Inclusive scans over the invocations: the last event up to each chunk, the first one from each chunk on. */
-    for (pyr_u32 d = 1u; d < g; d <<= 1u) {
-        pyr_u32 before = t >= d ? pyr_scan_last[t - d] : PYR_SCAN_NONE;
-        pyr_u32 after = t + d < g ? pyr_scan_first[t + d] : PYR_SCAN_NONE;
+    /* Inclusive scans over a line's invocations: the last event up to each chunk, the first one from each on. */
+    for (pyr_u32 d = 1u; d < parts; d <<= 1u) {
+        pyr_u32 before = part >= d ? pyr_scan_last[slot - d * strip] : PYR_SCAN_NONE;
+        pyr_u32 after = part + d < parts ? pyr_scan_first[slot + d * strip] : PYR_SCAN_NONE;
         PYR_BARRIER();
-        if (pyr_scan_last[t] == PYR_SCAN_NONE) pyr_scan_last[t] = before;
-        if (pyr_scan_first[t] == PYR_SCAN_NONE) pyr_scan_first[t] = after;
+        if (pyr_scan_last[slot] == PYR_SCAN_NONE) pyr_scan_last[slot] = before;
+        if (pyr_scan_first[slot] == PYR_SCAN_NONE) pyr_scan_first[slot] = after;
         PYR_BARRIER();
     }
-    pyr_u32 f = t > 0u ? pyr_scan_last[t - 1u] : PYR_SCAN_NONE;
-    pyr_u32 b = t + 1u < g ? pyr_scan_first[t + 1u] : PYR_SCAN_NONE;
-    /* Left to right: an unlabelled fillable pixel takes F when non-zero. */
+    pyr_u32 f = part > 0u ? pyr_scan_last[slot - strip] : PYR_SCAN_NONE;
+    pyr_u32 b = part + 1u < parts ? pyr_scan_first[slot + strip] : PYR_SCAN_NONE;
+    /* There: an unlabelled fillable pixel takes F when non-zero. */
     f = f == PYR_SCAN_NONE ? 0u : f;
-    for (pyr_u32 x = x0; x < x1; ++x) {
-        pyr_u32 l = pyr_buf_labels[row + x];
-        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x]) & PYR_MASK_FILLABLE) == 0u) {
+    for (pyr_u32 k = k0; k < k1; ++k) {
+        pyr_u32 i = start + k * step;
+        pyr_u32 l = pyr_buf_labels[i];
+        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
             f = l;
         } else if (f != 0u) {
-            pyr_buf_labels[row + x] = f;
+            pyr_buf_labels[i] = f;
         }
     }
-    /* Right to left: what is still 0 takes B. Pixels filled just now count as events: they lie after the run's
-     * first labelled pixel, so no pixel still 0 can see past them to a different one. */
+    /* Back: what is still 0 takes B. Pixels filled just now count as events: they lie after the run's first
+     * labelled pixel, so no pixel still 0 can see past them to a different one. */
     b = b == PYR_SCAN_NONE ? 0u : b;
-    for (pyr_u32 x = x1; x > x0; --x) {
-        pyr_u32 l = pyr_buf_labels[row + x - 1u];
-        if (l != 0u || (PYR_U32(pyr_buf_mask[row + x - 1u]) & PYR_MASK_FILLABLE) == 0u) {
+    for (pyr_u32 k = k1; k > k0; --k) {
+        pyr_u32 i = start + (k - 1u) * step;
+        pyr_u32 l = pyr_buf_labels[i];
+        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
             b = l;
         } else if (b != 0u) {
-            pyr_buf_labels[row + x - 1u] = b;
+            pyr_buf_labels[i] = b;
         }
     }
-}
-#endif
-
-/* Step 6b: final_columns (1D, columns): level width, height, offset. One invocation per column (neighbouring
- * invocations read neighbouring texels), down and up: the contract's sequential schedule. */
-#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_FINAL_COLUMNS)
-PYR_KERNEL_1D(final_columns) {
-    pyr_u32 line = PYR_I;
-    if (line >= PYR_ARG(0)) return;
-    pyr_sweep_column(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), line, 1u);
 }
 #endif
 

@@ -128,12 +128,16 @@ public:
         dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
     }
 
-    // Steps 5 and 6a in one workgroup per row (a segmented scan), then 6b: one invocation per column.
+    // Steps 5 and 6a in one workgroup per row, then 6b in one per strip of 32 columns (shaders/pyr_entries.h:
+    // final_lines, a segmented scan along each line).
     void final_fill(int level) override {
         const PyrLevel l = plan_.level(level);
         const PyrLevel p = plan_.level(level - 1);
-        dispatch(Kernel::final_rows, l.height, 1, args({l.width, l.height, l.offset, p.width, p.height, p.offset}));
-        dispatch(Kernel::final_columns, l.width, 1, args({l.width, l.height, l.offset}));
+        constexpr uint32_t kStrip = PYR_SCAN_STRIP;
+        dispatch(Kernel::final_lines, l.height, 1,
+                 args({l.width, l.height, l.offset, p.width, p.height, p.offset, 1u}));
+        dispatch(Kernel::final_lines, (l.width + kStrip - 1) / kStrip, 1,
+                 args({l.width, l.height, l.offset, p.width, p.height, p.offset, 0u}));
     }
 
     void label_edges() override { dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset})); }
