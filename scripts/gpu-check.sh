@@ -275,7 +275,7 @@ run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S
     return
   fi
   PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
-    --benchmark_filter="^(pipeline|stage)/($2)/($3)" --benchmark_min_time="$4" \
+    --benchmark_filter="^(pipeline|stage|fills/maze|fills/spiral)/($2)/($3)" --benchmark_min_time="$4" \
     --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
   say "bench $name: $((SECONDS - start)) s, exit $rc"
 }

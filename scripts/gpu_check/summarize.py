@@ -64,16 +64,16 @@ def ms(value):
 
 
 def bench_table(entries):
-    lines = ["| benchmark | frame, wall (ms) | sum of passes (ms) | passes (ms) | fill rounds | segments |",
-             "|---|---:|---:|---|---:|---:|"]
+    lines = ["| benchmark | frame, wall (ms) | sum of passes (ms) | passes (ms) | dispatches | host waits | segments |",
+             "|---|---:|---:|---|---:|---:|---:|"]
     for b in entries:
         if b.get("error_occurred"):
-            lines.append(f"| {b['name'].removesuffix('/real_time')} | skipped: {b.get('error_message', '')} | | | | |")
+            lines.append(f"| {b['name'].removesuffix('/real_time')} | skipped: {b.get('error_message', '')} | | | | | |")
             continue
         passes = {k[:-3]: v for k, v in b.items() if k.endswith("_ms") and isinstance(v, (int, float))}
         detail = ", ".join(f"{k} {ms(v)}" for k, v in passes.items())
         lines.append(f"| {b['name'].removesuffix('/real_time')} | {ms(b.get('real_time'))} | {ms(sum(passes.values()))} | {detail} | "
-                     f"{int(b.get('fill_rounds', 0))} | {int(b.get('segments', 0))} |")
+                     f"{int(b.get('dispatches', 0))} | {int(b.get('host_syncs', 0))} | {int(b.get('segments', 0))} |")
     return lines
 
 
