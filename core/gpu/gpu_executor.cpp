@@ -287,10 +287,13 @@ void check_fits(const core::Plan& plan, const BufferSizes& sizes, const DeviceLi
     for (size_t b = 0; b < kBufferCount; ++b) {
         total += sizes[b];
         if (sizes[b] > limits.max_buffer_bytes[b]) {
-            throw Error(ErrorCode::out_of_memory, image + " needs a " + buffer_name(Buffer(b)) + " buffer of " +
-                                                      mib(sizes[b]) + " but " + device + " takes at most " +
-                                                      mib(limits.max_buffer_bytes[b]) + " there (" +
-                                                      limits.max_buffer_what + ")");
+            std::string message = image;
+            message += " needs a ";
+            message += buffer_name(Buffer(b));
+            message += " buffer of " + mib(sizes[b]) + " but ";
+            message += device;
+            message += " takes at most " + mib(limits.max_buffer_bytes[b]) + " there (" + limits.max_buffer_what + ")";
+            throw Error(ErrorCode::out_of_memory, message);
         }
     }
     if (total > limits.memory_bytes) {
