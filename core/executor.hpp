@@ -29,10 +29,11 @@ public:
     virtual void init_labels(int level, std::uint32_t mode) = 0;  // PYR_INIT_* (shaders/pyr_types.h)
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4
     virtual void final_fill(int level) = 0;  // steps 5 and 6 a, b (level N): one call, so a backend may fuse them
-    virtual void label_edges() = 0;          // step 6 c
+    // Step 6 c. A backend may also mark the labels present for compaction here, while each row is in cache.
+    virtual void label_edges() = 0;
     // Step 7: counts the distinct labels of level N (the segment count K, reported by read_back) and, when apply,
-    // renumbers them.
-    virtual void compact(bool apply) = 0;
+    // renumbers them. after_edges: label_edges ran just before (so a backend that marks there need not again).
+    virtual void compact(bool apply, bool after_edges) = 0;
     // Per-segment statistics into plan.stats_slots slots (docs/algorithm.md section 10), after compact; read_back
     // returns them (core/segment_stats.hpp decodes the words).
     virtual void segment_stats() = 0;

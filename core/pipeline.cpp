@@ -62,7 +62,8 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
         clock.run("final_fill", [&] { ex.final_fill(n); });                             // steps 5, 6 a, b
         if (plan.params.label_edges) clock.run("edges", [&] { ex.label_edges(); });     // step 6 c
     }
-    clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7
+    const bool after_edges = !plan.small_image && plan.params.label_edges;
+    clock.run("compact", [&] { ex.compact(plan.params.compact, after_edges); });  // step 7
     if (plan.stats_slots != 0) clock.run("stats", [&] { ex.segment_stats(); });
 }
 

@@ -187,15 +187,13 @@ public:
             }
             mark_row(y);
         });
-        marked_ = true;
     }
 
-    void compact(bool apply) override {
-        if (!marked_) {
+    void compact(bool apply, bool after_edges) override {
+        if (!after_edges) {  // else label_edges marked every row already
             std::fill(lut_.begin(), lut_.end(), 0u);
             rows(size_t(plan_.height), [&](size_t y) { mark_row(y); });
         }
-        marked_ = false;
         uint32_t count = 0;
         for (uint32_t& entry : lut_) {
             if (entry != 0) entry = ++count;
@@ -419,7 +417,6 @@ private:
     bool sweeps_;
     uint32_t segment_count_ = 0;
     uint32_t fill_rounds_ = 0;
-    bool marked_ = false;  // label_edges marked the compaction table already
     bool compacted_ = false;
     bool normals_estimated_ = false;
     bool from_mask_ = false;

@@ -142,7 +142,7 @@ public:
 
     void label_edges() override { dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset})); }
 
-    void compact(bool apply) override {
+    void compact(bool apply, bool /*after_edges*/) override {
         const uint32_t count = plan_.lut_size();
         const uint32_t chunks = plan_.scan_chunks();
         device_->zero(Buffer::lut, 0, 4 * size_t(count));
