@@ -186,9 +186,12 @@ find_nvidia_drivers() {
   fi
 }
 
-# run_sharded NAME BACKEND: the conformance suite for BACKEND, split over the machine's cores; XML per shard in $work.
+# run_sharded NAME BACKEND [VAR=VALUE...]: the conformance suite for BACKEND (in that environment), split over the
+# machine's cores; XML per shard in $work, the suite's name in $work/suites.
 run_sharded() {
   local name="$1" backend="$2" shards i status=0
+  shift 2
+  echo "$name" >>"$work/suites"
   shards=$(nproc)
   ((shards > 16)) && shards=16
   local filter="*/${backend}_*:*/${backend}"
@@ -200,7 +203,7 @@ run_sharded() {
     return
   fi
   for ((i = 0; i < shards; ++i)); do
-    GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i timeout "$limit" \
+    env "$@" GTEST_TOTAL_SHARDS="$shards" GTEST_SHARD_INDEX="$i" timeout "$limit" \
       "$bundle/bin/pyrseg_test_conformance" --gtest_filter="$filter" --gtest_brief=1 \
       --gtest_output="xml:$work/xml/${name}_$i.xml" >"$work/logs/${name}_$i.log" 2>&1 &
   done
@@ -209,7 +212,7 @@ run_sharded() {
   done
   echo "$((SECONDS - start))" >"$work/time_$name"
   {
-    echo "=== conformance, backend $backend ($shards shards, $((SECONDS - start)) s, exit ${status}) ==="
+    echo "=== conformance, backend $backend $* ($shards shards, $((SECONDS - start)) s, exit ${status}) ==="
     for ((i = 0; i < shards; ++i)); do
       grep -v -e '^Running main()' -e '^Note: This is test shard' "$work/logs/${name}_$i.log" || true
     done
@@ -267,15 +270,16 @@ run_sanitizers() {
     printf '%s %s; ' "$t" "$(cat "$work/sanitizer_$t.status")"; done)"
 }
 
-run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S
-  local name="$1" start=$SECONDS rc=0 limit
+run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S [VAR=VALUE...]
+  local name="$1" backends="$2" sizes="$3" min_time="$4" start=$SECONDS rc=0 limit
   limit=$(step_limit "$5")
+  shift 5
   if ((limit < 20)); then
     say "bench $name: not run, out of time"
     return
   fi
-  PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
-    --benchmark_filter="^(pipeline|stage|fills/maze|fills/spiral)/($2)/($3)" --benchmark_min_time="$4" \
+  env "$@" PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
+    --benchmark_filter="^(pipeline|stage|fills/maze|fills/spiral)/($backends)/($sizes)" --benchmark_min_time="$min_time" \
     --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
   say "bench $name: $((SECONDS - start)) s, exit $rc"
 }
@@ -312,7 +316,7 @@ run() {
   [ -x "$bundle/bin/pyrseg" ] ||
     die "no prepared bundle in $bundle: run 'scripts/gpu-check.sh prepare' on a build machine and bring build/gpu"
   mkdir -p "$report"
-  rm -f "$report"/{summary.md,run.log,environment.txt,conformance.log,sanitizers.log,bench_cuda.json}
+  rm -f "$report"/{summary.md,run.log,conformance.log,sanitizers.log,bench_cuda.json,bench_cuda_graphs.json}
   rm -f "$report"/{bench_other_gpus.json,bench_rehearsal.json,cupy_label.json}
   work="$(mktemp -d)"
   mkdir -p "$work/xml" "$work/logs" "$work/masks"
@@ -357,8 +361,8 @@ run() {
     echo "VK_DRIVER_FILES=${VK_DRIVER_FILES:-} OCL_ICD_VENDORS=${OCL_ICD_VENDORS:-}"
     echo "--- pyrseg backends"
     "$bundle/bin/pyrseg" backends 2>&1 || echo "pyrseg backends failed (exit $?)"
-  } >"$report/environment.txt" 2>&1
-  sed -n '/^--- pyrseg backends/,$p' "$report/environment.txt"
+  } >"$work/environment.txt" 2>&1
+  cat "$work/environment.txt"  # into run.log: the report keeps to 8 files
 
   local gpu_backends=()
   if [ "$rehearse" = 1 ]; then
@@ -408,6 +412,8 @@ run() {
     run_bench bench_rehearsal cpu 640x480 0.01 60
   else
     run_bench bench_cuda cuda "640x480|2064x1544|4128x3088" 0.5 150
+    # The same frames as CUDA graphs (PYRSEG_CUDA_GRAPHS=1: the frame's launches captured once, then replayed).
+    run_bench bench_cuda_graphs cuda "640x480|2064x1544|4128x3088" 0.5 90 PYRSEG_CUDA_GRAPHS=1
   fi
   command -v python3 >/dev/null || die "python3 is missing: no CuPy peer and no summary; the logs are in $report"
   start=$SECONDS
@@ -415,6 +421,7 @@ run() {
     true
   say "cupy label: $((SECONDS - start)) s"
   if [ "$rehearse" = 0 ]; then
+    run_sharded conformance_cuda_graphs cuda PYRSEG_CUDA_GRAPHS=1
     run_sanitizers
     local b others=()
     for b in "${gpu_backends[@]:1}"; do

@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -98,6 +100,9 @@ public:
         description_ = "CUDA device " + std::to_string(device_) + " (" + p.name + ")";
         check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate");
         for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
+        const char* graphs = std::getenv("PYRSEG_CUDA_GRAPHS");
+        graphs_ = graphs != nullptr && std::strcmp(graphs, "1") == 0;
+        ops_.reserve(256);
     }
 
     ~CudaDevice() override {
@@ -105,6 +110,7 @@ public:
             cudaStreamSynchronize(stream_);
             cudaStreamDestroy(stream_);
         }
+        for (const Graph& g : graphs_cache_) cudaGraphExecDestroy(g.exec);
         for (cudaEvent_t e : events_) {
             if (e != nullptr) cudaEventDestroy(e);
         }
@@ -147,19 +153,26 @@ public:
     }
 
     void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
-        const unsigned char* staged = upload_.as<unsigned char>() + staging_.stage_upload(src, bytes);
-        check(cudaMemcpyAsync(buffer<unsigned char>(b) + offset, staged, bytes, cudaMemcpyHostToDevice, stream_),
-              "cudaMemcpyAsync(upload)");
+        Op op{Op::h2d};
+        op.dst = buffer<unsigned char>(b) + offset;
+        op.src = upload_.as<unsigned char>() + staging_.stage_upload(src, bytes);
+        op.bytes = bytes;
+        enqueue(op);
     }
 
     void download(gpu::Buffer b, size_t offset, void* dst, size_t bytes) override {
-        unsigned char* staged = download_.as<unsigned char>() + staging_.stage_download(dst, bytes);
-        check(cudaMemcpyAsync(staged, buffer<unsigned char>(b) + offset, bytes, cudaMemcpyDeviceToHost, stream_),
-              "cudaMemcpyAsync(download)");
+        Op op{Op::d2h};
+        op.dst = download_.as<unsigned char>() + staging_.stage_download(dst, bytes);
+        op.src = buffer<unsigned char>(b) + offset;
+        op.bytes = bytes;
+        enqueue(op);
     }
 
     void zero(gpu::Buffer b, size_t offset, size_t bytes) override {
-        check(cudaMemsetAsync(buffer<unsigned char>(b) + offset, 0, bytes, stream_), "cudaMemsetAsync");
+        Op op{Op::memset};
+        op.dst = buffer<unsigned char>(b) + offset;
+        op.bytes = bytes;
+        enqueue(op);
     }
 
     // 1D: blocks of 256 threads over a 2D grid (PYR_I); 2D: 32 x 8 blocks, a warp along a row.
@@ -177,20 +190,27 @@ public:
             grid = dim3((nx + kBlock2DX - 1) / kBlock2DX, (ny + kBlock2DY - 1) / kBlock2DY);
             block = dim3(kBlock2DX, kBlock2DY);
         }
-        PyrArgs a{};
-        std::copy(args.words.begin(), args.words.end(), a.a);
-        void* params[] = {&ctx_, &a};
-        check(cudaLaunchKernel(reinterpret_cast<const void*>(kKernelFns[size_t(k)]), grid, block, params, 0, stream_),
-              gpu::kernel_entry_name(k));
+        Op op{Op::launch};
+        op.kernel = uint32_t(k);
+        op.grid = grid;
+        op.block = block;
+        std::copy(args.words.begin(), args.words.end(), op.args.a);
+        enqueue(op);
     }
 
     void mark(const char* pass) override {
         if (event_count_ == kMaxEvents) return;
-        check(cudaEventRecord(events_[event_count_], stream_), "cudaEventRecord");
+        Op op{Op::record};
+        op.event = event_count_;
         event_names_[event_count_++] = pass;
+        enqueue(op);
     }
 
+    // With PYRSEG_CUDA_GRAPHS=1 the commands queued since the last finish() run as one CUDA graph: captured from the
+    // stream the first time this exact sequence comes (a frame's commands, their arguments and addresses depend only
+    // on the plan and the input kind, so a Segmenter sees a handful), then replayed with one launch.
     void finish() override {
+        if (!ops_.empty()) run_queued();
         check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
         staging_.complete();
     }
@@ -216,6 +236,110 @@ public:
     }
 
 private:
+    // A command of the stream, issued at once, or queued for a graph.
+    struct Op {
+        enum Kind : std::uint8_t { h2d, d2h, memset, launch, record };
+        explicit Op(Kind k) : kind(k) {}
+        Kind kind;
+        void* dst = nullptr;  // copies and memset
+        const void* src = nullptr;
+        size_t bytes = 0;
+        uint32_t kernel = 0;  // launch
+        dim3 grid;
+        dim3 block;
+        PyrArgs args{};
+        uint32_t event = 0;  // record: which of events_
+
+        [[nodiscard]] bool same(const Op& o) const {
+            const auto same_dim = [](dim3 a, dim3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+            return kind == o.kind && dst == o.dst && src == o.src && bytes == o.bytes && kernel == o.kernel &&
+                   same_dim(grid, o.grid) && same_dim(block, o.block) &&
+                   std::equal(std::begin(args.a), std::end(args.a), std::begin(o.args.a)) && event == o.event;
+        }
+    };
+
+    struct Graph {
+        std::vector<Op> ops;
+        cudaGraphExec_t exec;
+    };
+
+    static constexpr size_t kMinGraphLaunches = 4;  // fewer (the statistics' download) run as they are
+
+    void enqueue(const Op& op) {
+        if (graphs_) {
+            ops_.push_back(op);
+        } else {
+            issue(op, false);
+        }
+    }
+
+    void issue(Op op, bool capturing) {
+        switch (op.kind) {
+            case Op::h2d:
+                check(cudaMemcpyAsync(op.dst, op.src, op.bytes, cudaMemcpyHostToDevice, stream_),
+                      "cudaMemcpyAsync(upload)");
+                break;
+            case Op::d2h:
+                check(cudaMemcpyAsync(op.dst, op.src, op.bytes, cudaMemcpyDeviceToHost, stream_),
+                      "cudaMemcpyAsync(download)");
+                break;
+            case Op::memset:
+                check(cudaMemsetAsync(op.dst, 0, op.bytes, stream_), "cudaMemsetAsync");
+                break;
+            case Op::launch: {
+                void* params[] = {&ctx_, &op.args};
+                check(cudaLaunchKernel(reinterpret_cast<const void*>(kKernelFns[op.kernel]), op.grid, op.block, params,
+                                       0, stream_),
+                      gpu::kernel_entry_name(gpu::Kernel(op.kernel)));
+                break;
+            }
+            case Op::record:
+                // In a capture, an external record: the graph's replays record the event too (pass times).
+                check(capturing ? cudaEventRecordWithFlags(events_[op.event], stream_, cudaEventRecordExternal)
+                                : cudaEventRecord(events_[op.event], stream_),
+                      "cudaEventRecord");
+                break;
+        }
+    }
+
+    void run_queued() {
+        const size_t launches =
+            size_t(std::count_if(ops_.begin(), ops_.end(), [](const Op& op) { return op.kind == Op::launch; }));
+        if (launches < kMinGraphLaunches) {
+            for (const Op& op : ops_) issue(op, false);
+            ops_.clear();
+            return;
+        }
+        const Graph* graph = nullptr;
+        for (const Graph& g : graphs_cache_) {
+            if (g.ops.size() == ops_.size() &&
+                std::equal(ops_.begin(), ops_.end(), g.ops.begin(), [](const Op& a, const Op& b) { return a.same(b); }))
+                graph = &g;
+        }
+        if (graph == nullptr) graph = &capture();
+        ops_.clear();
+        check(cudaGraphLaunch(graph->exec, stream_), "cudaGraphLaunch");
+    }
+
+    const Graph& capture() {
+        check(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeThreadLocal), "cudaStreamBeginCapture");
+        cudaGraph_t captured = nullptr;
+        try {
+            for (const Op& op : ops_) issue(op, true);
+        } catch (...) {
+            cudaStreamEndCapture(stream_, &captured);
+            if (captured != nullptr) cudaGraphDestroy(captured);
+            throw;
+        }
+        check(cudaStreamEndCapture(stream_, &captured), "cudaStreamEndCapture");
+        cudaGraphExec_t exec = nullptr;
+        const cudaError_t err = cudaGraphInstantiate(&exec, captured, 0);
+        cudaGraphDestroy(captured);
+        check(err, "cudaGraphInstantiate");
+        graphs_cache_.push_back(Graph{ops_, exec});
+        return graphs_cache_.back();
+    }
+
     void select() const { check(cudaSetDevice(device_), "cudaSetDevice"); }
 
     template <class T>
@@ -233,6 +357,9 @@ private:
     std::array<cudaEvent_t, kMaxEvents> events_{};
     std::array<const char*, kMaxEvents> event_names_{};
     uint32_t event_count_ = 0;
+    bool graphs_ = false;  // PYRSEG_CUDA_GRAPHS=1
+    std::vector<Op> ops_;  // queued since the last finish(), in graph mode
+    std::vector<Graph> graphs_cache_;
 };
 
 std::string describe(int index, const cudaDeviceProp& p) {

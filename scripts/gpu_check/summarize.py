@@ -3,8 +3,8 @@
 
     summarize.py --work WORK_DIR --report REPORT_DIR [--rehearsal]
 
-Reads WORK/backends, WORK/xml/*.xml (Google Test), WORK/time_*, WORK/sanitizer_*.status and logs, and from REPORT
-environment.txt, bench_*.json (Google Benchmark) and cupy_label.json. Only the Python standard library is used.
+Reads WORK/backends, WORK/suites, WORK/environment.txt, WORK/xml/*.xml (Google Test), WORK/time_*,
+WORK/sanitizer_*.status and logs, and from REPORT bench_*.json (Google Benchmark) and cupy_label.json. Only the Python standard library is used.
 """
 import argparse
 import glob
@@ -89,7 +89,7 @@ def main():
     args = ap.parse_args()
     work, report = args.work, args.report
     backends = read(os.path.join(work, "backends")).split()
-    env = read(os.path.join(report, "environment.txt"))
+    env = read(os.path.join(work, "environment.txt"))
     problems = []
     not_run = []
     out = []
@@ -127,10 +127,11 @@ def main():
     out.append("| suite | passed | failed | skipped | seconds |")
     out.append("|---|---:|---:|---:|---:|")
     all_failures = []
-    for b in backends:
-        xmls = sorted(glob.glob(os.path.join(work, "xml", f"conformance_{b}_*.xml")))
+    for suite in read(os.path.join(work, "suites")).split():
+        b = suite.removeprefix("conformance_")
+        xmls = sorted(glob.glob(os.path.join(work, "xml", f"{suite}_*.xml")))
         p, f, s, fails = gtest_results(xmls)
-        seconds = read(os.path.join(work, f"time_conformance_{b}")).strip()
+        seconds = read(os.path.join(work, f"time_{suite}")).strip()
         out.append(f"| conformance, {b} | {p} | {f} | {s} | {seconds} |")
         all_failures += fails
         if f:
@@ -187,8 +188,24 @@ def main():
         out.extend(bench_table(entries))
         out.append("")
     # Names without Google Benchmark's "/real_time" suffix: pipeline/cuda/2064x1544/given_normals, stage/cuda/640x480.
-    by_name = {b["name"].removesuffix("/real_time"): b
-               for entries in benches.values() for b in entries if not b.get("error_occurred")}
+    def named(entries):
+        return {b["name"].removesuffix("/real_time"): b for b in entries if not b.get("error_occurred")}
+    by_name = {}
+    for file, entries in benches.items():
+        if "graphs" not in file:
+            by_name.update(named(entries))
+    graphs = named(benches.get("bench_cuda_graphs", []))
+    if graphs:
+        out.append("CUDA graphs (PYRSEG_CUDA_GRAPHS=1) against plain launches, the same frames:")
+        out.append("")
+        out.append("| benchmark | plain, wall (ms) | graphs, wall (ms) | plain, passes (ms) | graphs, passes (ms) |")
+        out.append("|---|---:|---:|---:|---:|")
+        for name, g in graphs.items():
+            plain = by_name.get(name)
+            if plain:
+                out.append(f"| {name} | {ms(plain['real_time'])} | {ms(g['real_time'])} | {ms(pass_sum(plain))} | "
+                           f"{ms(pass_sum(g))} |")
+        out.append("")
     scaling = []
     for name, b in by_name.items():
         if "/2064x1544" in name:

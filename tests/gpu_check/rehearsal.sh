@@ -25,7 +25,7 @@ grep -q "using the bundle's own libpyrseg_rehearsal_only.so.0" "$work/rehearsal.
 grep -q '^\*\*REHEARSAL PASS' "$summary" || { cat "$summary"; echo "no REHEARSAL PASS verdict"; exit 1; }
 grep -Eq '^\| conformance, cpu \| [1-9][0-9]* \| 0 \|' "$summary" || { cat "$summary"; echo "no cpu conformance"; exit 1; }
 grep -q '^| stage/cpu/640x480 |' "$summary" || { cat "$summary"; echo "no bench table"; exit 1; }
-for f in run.log environment.txt conformance.log bench_rehearsal.json cupy_label.json; do
+for f in run.log conformance.log bench_rehearsal.json cupy_label.json; do
   [ -s "$work/report/$f" ] || { echo "the report lacks $f"; exit 1; }
 done
 [ "$(find "$work/report" -type f | wc -l)" -le 8 ] || { ls "$work/report"; echo "more than 8 files in the report"; exit 1; }
