@@ -230,9 +230,12 @@ public:
         return true;
     }
 
+    // A frame that an error abandoned leaves nothing behind: no queued commands, no staged transfers.
     void begin_frame() override {
         select();
         event_count_ = 0;
+        ops_.clear();
+        staging_.restart();
     }
 
 private:

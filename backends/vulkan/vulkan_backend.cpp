@@ -177,7 +177,14 @@ public:
         return true;
     }
 
+    // A frame that an error abandoned leaves nothing behind: its half-recorded commands are dropped (recording()
+    // resets the command buffer), and so are its staged transfers.
     void begin_frame() override {
+        if (recording_) {
+            vkEndCommandBuffer(commands_);
+            recording_ = false;
+        }
+        staging_.restart();
         timestamp_count_ = 0;
         reset_queries_ = true;
     }

@@ -43,6 +43,11 @@ public:
     // After the device's copies into the download area: every download to its destination; both areas start over.
     void complete() {
         for (const Download& d : downloads_) std::memcpy(d.dst, down_ + d.at, d.bytes);
+        restart();
+    }
+
+    // Both areas start over, and pending downloads are dropped (a frame abandoned by an error).
+    void restart() {
         downloads_.clear();
         up_used_ = 0;
         down_used_ = 0;
