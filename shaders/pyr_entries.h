@@ -108,13 +108,48 @@ PYR_KERNEL_1D(anchor) {
 #endif
 
 /* Steps 2 and 4 (shaders/pyr_uf.h), four dispatches per fill over a level of n texels:
- * uf_init (1D, n): n. Every texel its own parent, every minimum none. */
+ * uf_init (one workgroup per row of the level): level width, height, offset; n. Every eligible texel's parent is
+ * the first texel of its run of eligible texels in the row (a scan of the row's last non-eligible position, as in
+ * final_lines below), so a row's runs are joined from the start and trees stay one level deep along rows; every
+ * other texel is its own parent; every minimum is none. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_INIT)
-PYR_KERNEL_1D(uf_init) {
-    pyr_u32 k = PYR_I;
-    if (k >= PYR_ARG(0)) return;
-    PYR_UF_STORE(k, k);
-    PYR_UF_STORE(PYR_ARG(0) + k, PYR_UF_NONE);
+PYR_GROUP_SHARED(pyr_u32, pyr_run_start, PYR_SCAN_GROUP_MAX)
+PYR_KERNEL_GROUPS(uf_init) {
+    PYR_LOCAL_SHARED(pyr_u32, pyr_run_start, PYR_SCAN_GROUP_MAX)
+    PyrLevel lv = pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2));
+    pyr_u32 n = PYR_ARG(3);
+    pyr_u32 y = PYR_GID; /* the same for the whole workgroup: its early return skips no barrier of another */
+    if (y >= lv.height) return;
+    pyr_u32 t = PYR_LID;
+    pyr_u32 g = PYR_LSIZE;
+    pyr_u32 chunk = (lv.width + g - 1u) / g;
+    pyr_u32 x0 = min(lv.width, t * chunk);
+    pyr_u32 x1 = min(lv.width, x0 + chunk);
+    pyr_u32 row = y * lv.width;
+    /* Where a run starting in this chunk would start: one past its last non-eligible texel (0: none). */
+    pyr_u32 start = 0u;
+    for (pyr_u32 x = x0; x < x1; ++x) {
+        if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[lv.offset + row + x])) == 0u) start = x + 1u;
+    }
+    pyr_run_start[t] = start;
+    PYR_BARRIER();
+    for (pyr_u32 d = 1u; d < g; d <<= 1u) { /* inclusive max-scan over the chunks */
+        pyr_u32 before = t >= d ? pyr_run_start[t - d] : 0u;
+        PYR_BARRIER();
+        pyr_run_start[t] = max(pyr_run_start[t], before);
+        PYR_BARRIER();
+    }
+    start = t > 0u ? pyr_run_start[t - 1u] : 0u;
+    for (pyr_u32 x = x0; x < x1; ++x) {
+        pyr_u32 k = row + x;
+        if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[lv.offset + k])) == 0u) {
+            start = x + 1u;
+            PYR_UF_STORE(k, k);
+        } else {
+            PYR_UF_STORE(k, row + start);
+        }
+        PYR_UF_STORE(n + k, PYR_UF_NONE);
+    }
 }
 #endif
 

@@ -18,7 +18,7 @@
     K(mip, MIP, 2)                 \
     K(init_labels, INIT_LABELS, 2) \
     K(anchor, ANCHOR, 1)           \
-    K(uf_init, UF_INIT, 1)         \
+    K(uf_init, UF_INIT, 3)         \
     K(uf_merge, UF_MERGE, 2)       \
     K(uf_resolve, UF_RESOLVE, 2)   \
     K(uf_gather, UF_GATHER, 1)     \

@@ -6,6 +6,7 @@
  *  PYR_UF_LOAD(i)      a load that sees other invocations' atomics (volatile / coherent);
  *  PYR_UF_STORE(i, v)  a plain store;
  *  PYR_UF_MIN(i, v)    an atomic 32-bit unsigned min, returning the old value.
+ * uf_init points each texel at the start of its run in the row; uf_merge joins the rows.
  * Parents always point to a smaller index (P[k] <= k), so there are no cycles; a link is an atomic min on a root,
  * and a union whose root was linked meanwhile follows the old parent and tries again (Playne and Hawick 2018;
  * Oliveira and Lotufo 2010). Which texel ends up the root depends on the schedule; the label a component takes
@@ -47,17 +48,17 @@ PYR_FN void pyr_uf_union(PYR_CTX_PARAM, pyr_u32 a, pyr_u32 b) {
     }
 }
 
-/* Merge: texel (x, y) of the level with its eligible left and upper neighbours. The upper union is implied, and
- * skipped, when the left, upper-left and upper texels are all eligible (left and upper-left are joined by the left
- * texel's own unions, upper-left and upper by the upper texel's). */
+/* Merge: texel (x, y) of the level with its eligible upper neighbour (uf_init joined each row's runs already, every
+ * texel of a run under its first one). The upper union is implied, and skipped, when the left and upper-left texels
+ * are eligible too: the texel is joined to its left one by its run, the left one to the upper-left one by its own
+ * upper union (or, recursively, by its left one's), and the upper-left one to the upper one by their run. */
 PYR_FN void pyr_uf_merge(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y) {
     pyr_u32 k = y * lv.width + x;
-    if (pyr_uf_eligible(PYR_MASK(lv.offset + k)) == 0u) return;
-    pyr_u32 left = x > 0u ? pyr_uf_eligible(PYR_MASK(lv.offset + k - 1u)) : 0u;
-    pyr_u32 up = y > 0u ? pyr_uf_eligible(PYR_MASK(lv.offset + k - lv.width)) : 0u;
-    if (left != 0u) pyr_uf_union(PYR_CTX_ARG, k, k - 1u);
-    if (up == 0u) return;
-    if (left != 0u && pyr_uf_eligible(PYR_MASK(lv.offset + k - lv.width - 1u)) != 0u) return;
+    if (y == 0u || pyr_uf_eligible(PYR_MASK(lv.offset + k)) == 0u) return;
+    if (pyr_uf_eligible(PYR_MASK(lv.offset + k - lv.width)) == 0u) return;
+    if (x > 0u && pyr_uf_eligible(PYR_MASK(lv.offset + k - 1u)) != 0u &&
+        pyr_uf_eligible(PYR_MASK(lv.offset + k - lv.width - 1u)) != 0u)
+        return;
     pyr_uf_union(PYR_CTX_ARG, k, k - lv.width);
 }
 

@@ -122,7 +122,7 @@ public:
         const PyrLevel l = plan_.level(level);
         const uint32_t n = l.width * l.height;
         if (anchor_max != 0) dispatch(Kernel::anchor, n, 1, args({l.offset, n, anchor_max}));
-        dispatch(Kernel::uf_init, n, 1, args({n}));
+        dispatch(Kernel::uf_init, l.height, 1, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_merge, l.width, l.height, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_resolve, l.width, l.height, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
