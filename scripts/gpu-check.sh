@@ -73,8 +73,11 @@ prepare() {
   for name in "${fallback_libs[@]}"; do
     if [ -f "$bundle/lib/$name" ]; then mv "$bundle/lib/$name" "$bundle/lib/fallback/"; fi
   done
-  if ldd "$bundle"/bin/* | grep -q "not found"; then
-    ldd "$bundle"/bin/* | grep "not found" >&2
+  # Output captured before grep: `ldd | grep -q` under pipefail fails when grep stops reading first.
+  local resolved
+  resolved="$(ldd "$bundle"/bin/*)"
+  if grep -q "not found" <<<"$resolved"; then
+    grep "not found" <<<"$resolved" >&2
     die "a library the binaries need was not found"
   fi
 
@@ -139,7 +142,7 @@ use_fallback_libs() {
   for so in "$bundle"/lib/fallback/*; do
     [ -f "$so" ] || continue
     name="$(basename "$so")"
-    system="$(ldconfig -p 2>/dev/null | awk -v n="$name" '$1 == n && !found {print $NF; found = 1}')"
+    system="$( (ldconfig -p 2>/dev/null || true) | awk -v n="$name" '$1 == n && !found {print $NF; found = 1}')"
     local dir
     for dir in ${LD_LIBRARY_PATH:+${LD_LIBRARY_PATH//:/ }}; do  # the driver's folders that find_nvidia_drivers added
       [ -z "$system" ] && [ -f "$dir/$name" ] && system="$dir/$name"
@@ -174,7 +177,7 @@ find_nvidia_drivers() {
   fi
   if [ -z "${OCL_ICD_VENDORS:-}" ] && [ ! -f /etc/OpenCL/vendors/nvidia.icd ]; then
     local so
-    so="$(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ && !found {print $NF; found = 1}')"
+    so="$( (ldconfig -p 2>/dev/null || true) | awk '/libnvidia-opencl\.so\.1/ && !found {print $NF; found = 1}')"
     for dir in /usr/local/nvidia/lib64 /usr/local/nvidia/lib; do
       [ -z "$so" ] && [ -f "$dir/libnvidia-opencl.so.1" ] && so="$dir/libnvidia-opencl.so.1"
     done
@@ -329,7 +332,7 @@ run() {
   host_glibc="$(getconf GNU_LIBC_VERSION 2>/dev/null | awk '{print $2}')"
   need_glibc="$(sed -n 's/^glibc needed: //p' "$bundle/MANIFEST.txt" 2>/dev/null || true)"
   if [ -n "$host_glibc" ] && [ -n "$need_glibc" ] &&
-     [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | head -n 1)" != "$need_glibc" ]; then
+     [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | sed -n 1p)" != "$need_glibc" ]; then
     die "this machine's glibc is $host_glibc; the bundle needs $need_glibc (prepare it on an older distribution)" 3
   fi
   export PYRSEG_DATA_DIR="$bundle/data"
@@ -337,7 +340,7 @@ run() {
   use_fallback_libs
   if [ -e "$work/fallback-lib/libstdc++.so.6" ]; then
     need_glibc="$(sed -n 's/^glibc needed by lib\/fallback: //p' "$bundle/MANIFEST.txt")"
-    if [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | head -n 1)" != "$need_glibc" ]; then
+    if [ "$(printf '%s\n%s\n' "$need_glibc" "$host_glibc" | sort -V | sed -n 1p)" != "$need_glibc" ]; then
       die "this machine's C++ runtime is older than the bundle's, and its glibc ($host_glibc) too old for the bundle's own (glibc $need_glibc)" 3
     fi
   fi
@@ -372,13 +375,13 @@ run() {
     local why=""
     if ! command -v nvidia-smi >/dev/null; then
       why="nvidia-smi is not installed"
-    elif ! nvidia-smi -L 2>/dev/null | grep -q "^GPU "; then
+    elif ! grep -q "^GPU " <<<"$(nvidia-smi -L 2>/dev/null || true)"; then
       why="nvidia-smi lists no GPU"
     fi
     if backend_available cuda; then
       gpu_backends+=(cuda)
     else
-      why="${why:+$why; }pyrseg: $("$bundle/bin/pyrseg" backends | awk '$1 == "cuda" {getline; sub(/^ +/, ""); print}')"
+      why="${why:+$why; }pyrseg: $( ("$bundle/bin/pyrseg" backends || true) | awk '$1 == "cuda" {getline; sub(/^ +/, ""); print}')"
     fi
     if [ "${#gpu_backends[@]}" = 0 ]; then
       printf '# pyrseg GPU check: no GPU\n\nNo usable NVIDIA GPU here (%s). Nothing was checked.\n' "$why" \
@@ -386,7 +389,7 @@ run() {
       die "no usable NVIDIA GPU here ($why): nothing was checked" 2
     fi
     local cap archs
-    cap="$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader 2>/dev/null | head -n 1 | tr -d '. ')"
+    cap="$( (nvidia-smi --query-gpu=compute_cap --format=csv,noheader 2>/dev/null || true) | sed -n 1p | tr -d '. ')"
     archs="$(sed -n 's/^cuda architectures: //p' "$bundle/MANIFEST.txt" 2>/dev/null || true)"
     if [ -n "$cap" ] && [ -n "$archs" ] && ! grep -qE "(^|[ ;])$cap(-real)?([ ;]|$)" <<<"$archs" &&
        ! grep -q "virtual" <<<"$archs"; then

@@ -107,7 +107,7 @@ PYR_KERNEL_1D(anchor) {
 }
 #endif
 
-/* Steps 2 and 4 (shaders/pyr_uf.h), four dispatches per fill over a level of n texels:
+/* Steps 2 and 4 (shaders/pyr_uf.h), five dispatches per fill over a level of n texels:
  * uf_init (one workgroup per row of the level): level width, height, offset; n. Every eligible texel's parent is
  * the first texel of its run of eligible texels in the row (a scan of the row's last non-eligible position, as in
  * final_lines below), so a row's runs are joined from the start and trees stay one level deep along rows; every
@@ -153,13 +153,22 @@ PYR_KERNEL_GROUPS(uf_init) {
 }
 #endif
 
-/* uf_merge and uf_resolve (2D, the level): level width, height, offset; n */
+/* uf_merge, uf_flatten and uf_resolve (2D, the level): level width, height, offset; n */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_MERGE)
 PYR_KERNEL_2D(uf_merge) {
     pyr_u32 x = PYR_X;
     pyr_u32 y = PYR_Y;
     if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
     pyr_uf_merge(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), x, y);
+}
+#endif
+
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_UF_FLATTEN)
+PYR_KERNEL_2D(uf_flatten) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
+    pyr_uf_flatten(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)), x, y);
 }
 #endif
 

@@ -20,6 +20,7 @@
     K(anchor, ANCHOR, 1)           \
     K(uf_init, UF_INIT, 3)         \
     K(uf_merge, UF_MERGE, 2)       \
+    K(uf_flatten, UF_FLATTEN, 2)   \
     K(uf_resolve, UF_RESOLVE, 2)   \
     K(uf_gather, UF_GATHER, 1)     \
     K(final_lines, FINAL_LINES, 3) \

@@ -117,13 +117,14 @@ public:
     }
 
     // Steps 2 and 4: the fixed point directly, by union-find over the components of eligible texels (shaders/pyr_uf.h),
-    // in four dispatches whatever the mask, with no host synchronisation.
+    // in five dispatches whatever the mask, with no host synchronisation.
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
         const PyrLevel l = plan_.level(level);
         const uint32_t n = l.width * l.height;
         if (anchor_max != 0) dispatch(Kernel::anchor, n, 1, args({l.offset, n, anchor_max}));
         dispatch(Kernel::uf_init, l.height, 1, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_merge, l.width, l.height, args({l.width, l.height, l.offset, n}));
+        dispatch(Kernel::uf_flatten, l.width, l.height, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_resolve, l.width, l.height, args({l.width, l.height, l.offset, n}));
         dispatch(Kernel::uf_gather, n, 1, args({l.offset, n}));
     }

@@ -18,6 +18,8 @@ grep -q '^CMAKE_CUDA_ARCHITECTURES:[A-Z]*=90-real$' "$work/build/CMakeCache.txt"
 cmake --build "$work/build" --target pyrseg -j 2 >"$work/build.log" 2>&1 || { tail -n 50 "$work/build.log"; exit 1; }
 grep -q 'generate-code=arch=compute_90,code=\[sm_90\]' "$work/build/build.ninja" ||
   { echo "the CUDA backend is not compiled to sm_90 machine code"; exit 1; }
-objdump -h "$work/build/core/CMakeFiles/pyrseg.dir/__/backends/cuda/cuda_backend.cu.o" | grep -q nv_fatbin ||
+# Captured first: `objdump | grep -q` under pipefail fails whenever grep stops reading before objdump ends.
+sections="$(objdump -h "$work/build/core/CMakeFiles/pyrseg.dir/__/backends/cuda/cuda_backend.cu.o")"
+grep -q nv_fatbin <<<"$sections" ||
   { echo "the CUDA backend's object carries no fat binary"; exit 1; }
 echo "gpu-check preset: configured and built the library with sm_90 code"

@@ -31,7 +31,7 @@ done
 [ "$(find "$work/report" -type f | wc -l)" -le 8 ] || { ls "$work/report"; echo "more than 8 files in the report"; exit 1; }
 echo "rehearsal: passed, summary and logs written"
 
-if command -v nvidia-smi >/dev/null && nvidia-smi -L 2>/dev/null | grep -q "^GPU "; then
+if command -v nvidia-smi >/dev/null && grep -q "^GPU " <<<"$(nvidia-smi -L 2>/dev/null || true)"; then
   echo "a GPU is present: the refusal without one is not checked here"
   exit 0
 fi
