@@ -3,13 +3,10 @@
 // scheme (PYRSEG_CPU_FILL=sweeps) needs a round per turn or so, and reports how many (fill_rounds).
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include "bench/bench_scenes.hpp"
 #include "pyrseg/backend.hpp"

@@ -139,11 +139,9 @@ public:
             const std::string what = std::string("cudaMalloc(") + gpu::buffer_name(gpu::Buffer(b)) + ")";
             buffers_[b] = Memory<false>(sizes[b], what.c_str());
         }
-        const size_t pixels = sizes[size_t(gpu::Buffer::out)] / 4;
-        upload_ = Memory<true>(sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)] + 256,
-                               "cudaMallocHost(upload staging)");
-        download_ =
-            Memory<true>(24 * pixels + sizes[size_t(gpu::Buffer::lut)] + 256, "cudaMallocHost(download staging)");
+        const gpu::StagingBytes staging = gpu::staging_bytes(sizes);
+        upload_ = Memory<true>(staging.upload, "cudaMallocHost(upload staging)");
+        download_ = Memory<true>(staging.download, "cudaMallocHost(download staging)");
         staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
         ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points), buffer<float>(gpu::Buffer::normals),
                           buffer<unsigned>(gpu::Buffer::quant),     buffer<unsigned char>(gpu::Buffer::mask),

@@ -72,14 +72,11 @@ public:
         // Points and normals (same size) beyond one binding's range continue in bindings 9 and 10.
         const VkDeviceSize xyz = sizes[size_t(gpu::Buffer::points)];
         split_bytes_ = xyz <= rt_->properties.limits.maxStorageBufferRange ? xyz : aligned_range();
-        // Staging: a frame's uploads (points and normals), and its downloads (results, the segment count,
-        // statistics), with room for the arena's alignment (core/gpu/staging.hpp).
-        const VkDeviceSize up = sizes[size_t(gpu::Buffer::points)] + sizes[size_t(gpu::Buffer::normals)] + 256;
-        const VkDeviceSize down = 24 * VkDeviceSize(pixels) + sizes[size_t(gpu::Buffer::lut)] + 256;
-        upload_ = VulkanBuffer(*rt_, up, VulkanBuffer::Memory::host, "the upload staging buffer");
-        download_ = VulkanBuffer(*rt_, down, VulkanBuffer::Memory::host, "the download staging buffer");
-        staging_.reset(static_cast<unsigned char*>(upload_.mapped()), size_t(up),
-                       static_cast<unsigned char*>(download_.mapped()), size_t(down));
+        const gpu::StagingBytes staging = gpu::staging_bytes(sizes);
+        upload_ = VulkanBuffer(*rt_, staging.upload, VulkanBuffer::Memory::host, "the upload staging buffer");
+        download_ = VulkanBuffer(*rt_, staging.download, VulkanBuffer::Memory::host, "the download staging buffer");
+        staging_.reset(static_cast<unsigned char*>(upload_.mapped()), staging.upload,
+                       static_cast<unsigned char*>(download_.mapped()), staging.download);
         write_descriptors();
         throw_on_validation_messages("the creation of a Vulkan Segmenter");
     }

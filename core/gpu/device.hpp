@@ -22,8 +22,7 @@ enum class Kernel : std::uint32_t {
         count
 };
 inline constexpr std::size_t kKernelCount = std::size_t(Kernel::count);
-// pyr_k_<name>, and whether the kernel's grid is 1D (a count) or 2D (width x height).
-[[nodiscard]] const char* kernel_name(Kernel k);        // "normals"
+// pyr_k_<name>, PYR_ENTRY_<NAME>, and the kernel's grid: 1 (a count), 2 (width x height) or 3 (workgroups).
 [[nodiscard]] const char* kernel_entry_name(Kernel k);  // "pyr_k_normals"
 [[nodiscard]] const char* kernel_glsl_name(Kernel k);   // "NORMALS" (PYR_ENTRY_NORMALS)
 [[nodiscard]] int kernel_dims(Kernel k);

@@ -22,14 +22,13 @@ using std::size_t;
 using std::uint32_t;
 
 struct KernelInfo {
-    const char* name;
     const char* entry;
     const char* glsl;
     int dims;
 };
 
 constexpr KernelInfo kKernels[] = {
-#define PYR_HOST_KERNEL_INFO(name, NAME, dims) {#name, "pyr_k_" #name, #NAME, dims},
+#define PYR_HOST_KERNEL_INFO(name, NAME, dims) {"pyr_k_" #name, #NAME, dims},
     PYR_KERNEL_TABLE(PYR_HOST_KERNEL_INFO)
 #undef PYR_HOST_KERNEL_INFO
 };
@@ -245,9 +244,6 @@ private:
 
 }  // namespace
 
-const char* kernel_name(Kernel k) {
-    return kKernels[size_t(k)].name;
-}
 const char* kernel_entry_name(Kernel k) {
     return kKernels[size_t(k)].entry;
 }
