@@ -35,6 +35,33 @@ int stats_point_shift(double unit_mm) {
     return std::clamp(shift, -126, 127);
 }
 
+void check_metric_parameters(const Params& p) {
+    if (p.metric != Metric::paper && p.metric != Metric::robust) bad_parameter("metric must be paper or robust");
+    const auto finite_nonnegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+    if (!finite_nonnegative(p.dt_per_m2)) {
+        bad_parameter("dt_per_m2 must be a finite number of millimetres per square metre >= 0, got " +
+                      std::to_string(p.dt_per_m2));
+    }
+    if (!finite_nonnegative(p.ct_growth_per_m2)) {
+        bad_parameter("ct_growth_per_m2 must be finite and >= 0, got " + std::to_string(p.ct_growth_per_m2));
+    }
+    if (p.normal_window < 1 || p.normal_window > kMaxNormalWindow) {
+        bad_parameter("normal_window must be in 1.." + std::to_string(kMaxNormalWindow) + ", got " +
+                      std::to_string(p.normal_window));
+    }
+    if (p.curvature_stride < 1 || p.curvature_stride > kMaxCurvatureStride) {
+        bad_parameter("curvature_stride must be in 1.." + std::to_string(kMaxCurvatureStride) + ", got " +
+                      std::to_string(p.curvature_stride));
+    }
+    if (p.metric == Metric::paper &&
+        (p.normal_window != kDefaultNormalWindow || p.curvature_stride != kDefaultCurvatureStride ||
+         p.dt_per_m2 != 0.0 || p.ct_growth_per_m2 != 0.0)) {
+        bad_parameter(
+            "normal_window, curvature_stride, dt_per_m2 and ct_growth_per_m2 belong to the robust metric "
+            "(metric = robust); the paper metric takes none of them");
+    }
+}
+
 }  // namespace
 
 Thresholds compute_thresholds(const Params& params) {
@@ -54,6 +81,17 @@ Thresholds compute_thresholds(const Params& params) {
                       ? -(std::int32_t{1} << 28)
                       : static_cast<std::int32_t>(std::floor(std::cos(params.ct) * 67108864.0));  // 2^26
     t.depth = static_cast<float>(params.dt / params.unit_mm);
+    check_metric_parameters(params);
+    if (params.metric == Metric::robust) {
+        const double c0 = 1.0 - std::cos(params.ct);
+        const double unit_m2 = (params.unit_mm / 1000.0) * (params.unit_mm / 1000.0);
+        constexpr double kCurvatureOne = 67108864.0;  // 2^26
+        const bool always = params.ct >= std::numbers::pi;
+        t.curvature_base = always ? 134217728.0f : static_cast<float>(c0 * kCurvatureOne);  // 2^27: always passes
+        t.curvature_growth = always ? 0.0f : static_cast<float>(c0 * kCurvatureOne * params.ct_growth_per_m2 * unit_m2);
+        t.depth_growth = static_cast<float>(params.dt_per_m2 * 1e-6 * params.unit_mm);
+        t.point_scale = std::ldexp(1.0f, stats_point_shift(params.unit_mm));
+    }
     return t;
 }
 

@@ -13,6 +13,12 @@ namespace pyrseg::core {
 struct Thresholds {
     std::int32_t curvature;  // Tc
     float depth;             // dt in input units
+    // The robust metric (section 2b): the curvature limit A + Bc * z^2 (units of 2^-26), the depth growth Bd (dt in
+    // units + Bd * z^2) and the fixed-point scale 2^e of its normals (section 8b).
+    float curvature_base = 0;
+    float curvature_growth = 0;
+    float depth_growth = 0;
+    float point_scale = 1;
 };
 
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.

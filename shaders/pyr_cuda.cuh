@@ -48,6 +48,7 @@ struct PyrArgs {
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_robust.h"
 #include "pyr_scan.h"
 #include "pyr_stats.h"
 

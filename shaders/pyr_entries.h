@@ -38,6 +38,21 @@ PYR_KERNEL_2D(normals) {
 }
 #endif
 
+/* normals_robust (2D, w x h): h, radius, window, point scale (float 2^e) */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_NORMALS_ROBUST)
+PYR_KERNEL_2D(normals_robust) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    PyrIVec3 q = pyr_robust_normal_q(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1), PYR_ARG(2), PYR_ARG_F32(3));
+    pyr_u32 i = y * PYR_W + x;
+    PYR_STORE_NORMAL(i * 3u + 0u, PYR_F32(q.x) * PYR_NORMAL_UNIT);
+    PYR_STORE_NORMAL(i * 3u + 1u, PYR_F32(q.y) * PYR_NORMAL_UNIT);
+    PYR_STORE_NORMAL(i * 3u + 2u, PYR_F32(q.z) * PYR_NORMAL_UNIT);
+}
+#endif
+
 /* quantize (1D, pixels): pixels */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_QUANTIZE)
 PYR_KERNEL_1D(quantize) {
@@ -59,6 +74,20 @@ PYR_KERNEL_2D(metric) {
     if (x >= PYR_W || y >= h) return;
     PYR_STORE_MASK(PYR_ARG(1) + y * PYR_W + x,
                    pyr_metric_fillable(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG_I32(2), PYR_ARG_F32(3)));
+}
+#endif
+
+/* metric_robust (2D, w x h): h, offset of level N, stride, curvature base A, curvature growth Bc, dt, depth growth
+ * Bd (the last four float) */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_METRIC_ROBUST)
+PYR_KERNEL_2D(metric_robust) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    PYR_STORE_MASK(PYR_ARG(1) + y * PYR_W + x,
+                   pyr_metric_robust_fillable(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(2), PYR_ARG_F32(3), PYR_ARG_F32(4),
+                                              PYR_ARG_F32(5), PYR_ARG_F32(6)));
 }
 #endif
 

@@ -10,26 +10,28 @@
 #ifndef PYR_KERNELS_H
 #define PYR_KERNELS_H
 
-#define PYR_KERNEL_TABLE(K)        \
-    K(normals, NORMALS, 2)         \
-    K(quantize, QUANTIZE, 1)       \
-    K(metric, METRIC, 2)           \
-    K(bind_mask, BIND_MASK, 1)     \
-    K(mip, MIP, 2)                 \
-    K(init_labels, INIT_LABELS, 2) \
-    K(anchor, ANCHOR, 1)           \
-    K(uf_init, UF_INIT, 3)         \
-    K(uf_merge, UF_MERGE, 2)       \
-    K(uf_flatten, UF_FLATTEN, 2)   \
-    K(uf_resolve, UF_RESOLVE, 2)   \
-    K(uf_gather, UF_GATHER, 1)     \
-    K(final_lines, FINAL_LINES, 3) \
-    K(edges, EDGES, 2)             \
-    K(lut_mark, LUT_MARK, 1)       \
-    K(scan_count, SCAN_COUNT, 1)   \
-    K(scan_sums, SCAN_SUMS, 1)     \
-    K(scan_number, SCAN_NUMBER, 1) \
-    K(compact, COMPACT, 1)         \
+#define PYR_KERNEL_TABLE(K)              \
+    K(normals, NORMALS, 2)               \
+    K(normals_robust, NORMALS_ROBUST, 2) \
+    K(quantize, QUANTIZE, 1)             \
+    K(metric, METRIC, 2)                 \
+    K(metric_robust, METRIC_ROBUST, 2)   \
+    K(bind_mask, BIND_MASK, 1)           \
+    K(mip, MIP, 2)                       \
+    K(init_labels, INIT_LABELS, 2)       \
+    K(anchor, ANCHOR, 1)                 \
+    K(uf_init, UF_INIT, 3)               \
+    K(uf_merge, UF_MERGE, 2)             \
+    K(uf_flatten, UF_FLATTEN, 2)         \
+    K(uf_resolve, UF_RESOLVE, 2)         \
+    K(uf_gather, UF_GATHER, 1)           \
+    K(final_lines, FINAL_LINES, 3)       \
+    K(edges, EDGES, 2)                   \
+    K(lut_mark, LUT_MARK, 1)             \
+    K(scan_count, SCAN_COUNT, 1)         \
+    K(scan_sums, SCAN_SUMS, 1)           \
+    K(scan_number, SCAN_NUMBER, 1)       \
+    K(compact, COMPACT, 1)               \
     K(stats, STATS, 1)
 
 /* Per-dispatch argument words (uint32; ints and floats by their bits). */

@@ -60,6 +60,45 @@ PYR_FN pyr_i32 pyr_unit_component(pyr_i32 d, pyr_u32 len) {
     return d < 0 ? -q : q;
 }
 
+/* Steps 2 to 6 of section 8 from the fixed-point tangents U and V (each with at most 15 significant bits): the
+ * unit normal q (|q_c| <= 2^13) toward the camera at the origin, seen from the point P, or (0, 0, 0). Shared by the
+ * robust normals (section 8b). */
+PYR_FN PyrIVec3 pyr_unit_normal_from_tangents(PyrIVec3 u, PyrIVec3 v, pyr_f32 px, pyr_f32 py, pyr_f32 pz) {
+    PyrIVec3 none;
+    none.x = 0;
+    none.y = 0;
+    none.z = 0;
+    /* Each product < 2^30, each difference < 2^31. */
+    PyrIVec3 c;
+    c.x = u.y * v.z - u.z * v.y;
+    c.y = u.z * v.x - u.x * v.z;
+    c.z = u.x * v.y - u.y * v.x;
+    pyr_i32 m = pyr_iabs(c.x);
+    m = pyr_iabs(c.y) > m ? pyr_iabs(c.y) : m;
+    m = pyr_iabs(c.z) > m ? pyr_iabs(c.z) : m;
+    if (m == 0) return none;
+
+    pyr_i32 s = PYR_MSB(PYR_U32(m)) - 14;
+    PyrIVec3 d;
+    d.x = pyr_shift_magnitude(c.x, s);
+    d.y = pyr_shift_magnitude(c.y, s);
+    d.z = pyr_shift_magnitude(c.z, s);
+    pyr_u32 len = pyr_isqrt(PYR_U32(d.x * d.x) + PYR_U32(d.y * d.y) + PYR_U32(d.z * d.z));
+    PyrIVec3 q;
+    q.x = pyr_unit_component(d.x, len);
+    q.y = pyr_unit_component(d.y, len);
+    q.z = pyr_unit_component(d.z, len);
+
+    /* Toward the camera at the origin: q . P < 0. |q| <= 2^13 and |F(P)| < 2^15, so the dot fits int32. */
+    PyrIVec3 p = pyr_to_fixed(px, py, pz);
+    if (q.x * p.x + q.y * p.y + q.z * p.z > 0) {
+        q.x = -q.x;
+        q.y = -q.y;
+        q.z = -q.z;
+    }
+    return q;
+}
+
 PYR_FN PyrIVec3 pyr_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r) {
     PyrIVec3 none;
     none.x = 0;
@@ -92,37 +131,7 @@ PYR_FN PyrIVec3 pyr_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr
     PYR_PRECISE pyr_f32 vy = PYR_PT(x, ya, 1) - PYR_PT(x, yb, 1);
     PYR_PRECISE pyr_f32 vz = PYR_PT(x, ya, 2) - PYR_PT(x, yb, 2);
 
-    PyrIVec3 u = pyr_to_fixed(ux, uy, uz);
-    PyrIVec3 v = pyr_to_fixed(vx, vy, vz);
-    /* Each product < 2^30, each difference < 2^31. */
-    PyrIVec3 c;
-    c.x = u.y * v.z - u.z * v.y;
-    c.y = u.z * v.x - u.x * v.z;
-    c.z = u.x * v.y - u.y * v.x;
-    pyr_i32 m = pyr_iabs(c.x);
-    m = pyr_iabs(c.y) > m ? pyr_iabs(c.y) : m;
-    m = pyr_iabs(c.z) > m ? pyr_iabs(c.z) : m;
-    if (m == 0) return none;
-
-    pyr_i32 s = PYR_MSB(PYR_U32(m)) - 14;
-    PyrIVec3 d;
-    d.x = pyr_shift_magnitude(c.x, s);
-    d.y = pyr_shift_magnitude(c.y, s);
-    d.z = pyr_shift_magnitude(c.z, s);
-    pyr_u32 len = pyr_isqrt(PYR_U32(d.x * d.x) + PYR_U32(d.y * d.y) + PYR_U32(d.z * d.z));
-    PyrIVec3 q;
-    q.x = pyr_unit_component(d.x, len);
-    q.y = pyr_unit_component(d.y, len);
-    q.z = pyr_unit_component(d.z, len);
-
-    /* Toward the camera at the origin: q . P < 0. |q| <= 2^13 and |F(P)| < 2^15, so the dot fits int32. */
-    PyrIVec3 p = pyr_to_fixed(px, py, pz);
-    if (q.x * p.x + q.y * p.y + q.z * p.z > 0) {
-        q.x = -q.x;
-        q.y = -q.y;
-        q.z = -q.z;
-    }
-    return q;
+    return pyr_unit_normal_from_tangents(pyr_to_fixed(ux, uy, uz), pyr_to_fixed(vx, vy, vz), px, py, pz);
 }
 
 #endif /* PYR_NORMALS_H */

@@ -30,6 +30,7 @@
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_robust.h"
 #include "pyr_scan.h"
 #include "pyr_stats.h"
 

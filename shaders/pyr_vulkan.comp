@@ -70,6 +70,7 @@ void pyr_store_normal(uint k, float v) {
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_robust.h"
 #include "pyr_scan.h"
 #include "pyr_stats.h"
 

@@ -1,6 +1,7 @@
 #include <set>
 #include <string>
 
+#include "pyrseg/error.hpp"
 #include "tools/commands.hpp"
 
 namespace pyrseg::cli {
@@ -16,11 +17,18 @@ const char* const kParameterHelp =
     "                        3 for scenes with many bridges).\n"
     "  --unjoinable-gap G    levels between the seeding level and the level whose regions never merge (default 2).\n"
     "  --normal-radius R     neighbour distance in pixels for estimated normals (default 2); larger smooths noise.\n"
+    "  --metric NAME         paper (default: the contract's metric, for low-noise scanners) or robust (window\n"
+    "                        normals, thresholds that grow with depth; for consumer depth cameras).\n"
+    "  --normal-window R     robust: estimated normals sum tangents over a (2R+1)^2 window (1..7, default 3).\n"
+    "  --curvature-stride S  robust: normals compared S pixels apart (1..64, default 4).\n"
+    "  --dt-per-m2 MM        robust: millimetres added to --dt per square metre of depth (default 0).\n"
+    "  --ct-growth G         robust: 1 - cos(ct) grows by G per square metre of depth (default 0).\n"
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const std::set<std::string> kParameterValueOptions = {
-    "ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap", "normal-radius"};
+    "ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap", "normal-radius",
+    "metric", "normal-window", "curvature-stride", "dt-per-m2", "ct-growth"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
 
 Params parse_params(const Args& args) {
@@ -31,6 +39,19 @@ Params parse_params(const Args& args) {
     if (auto v = args.integer("bridge-levels")) p.bridge_levels = *v;
     if (auto v = args.integer("unjoinable-gap")) p.unjoinable_gap = *v;
     if (auto v = args.integer("normal-radius")) p.normal_radius = *v;
+    if (auto v = args.value("metric")) {
+        if (*v == "paper") {
+            p.metric = Metric::paper;
+        } else if (*v == "robust") {
+            p.metric = Metric::robust;
+        } else {
+            throw Error(ErrorCode::invalid_argument, "--metric must be paper or robust, got '" + *v + "'");
+        }
+    }
+    if (auto v = args.integer("normal-window")) p.normal_window = *v;
+    if (auto v = args.integer("curvature-stride")) p.curvature_stride = *v;
+    if (auto v = args.number("dt-per-m2")) p.dt_per_m2 = *v;
+    if (auto v = args.number("ct-growth")) p.ct_growth_per_m2 = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

@@ -89,10 +89,15 @@ public:
         if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
         const PassContext c = context();
         const auto radius = uint32_t(plan_.params.normal_radius);
+        const auto window = uint32_t(plan_.params.normal_window);
+        const float scale = plan_.thresholds.point_scale;
+        const bool robust = plan_.params.metric == Metric::robust;
+        const auto h = uint32_t(plan_.height);
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
-                const PyrIVec3 q =
-                    kernels::pyr_normal_q(c, uint32_t(w), uint32_t(plan_.height), uint32_t(x), uint32_t(y), radius);
+                const PyrIVec3 q = robust ? kernels::pyr_robust_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y),
+                                                                         radius, window, scale)
+                                          : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
                 float* n = normals_.data() + 3 * (y * w + x);
                 n[0] = float(q.x) * PYR_NORMAL_UNIT;
                 n[1] = float(q.y) * PYR_NORMAL_UNIT;
@@ -123,11 +128,16 @@ public:
         const PassContext c = context();
         const PyrLevel full = plan_.full();
         const core::Thresholds t = plan_.thresholds;
+        const bool robust = plan_.params.metric == Metric::robust;
+        const auto stride = uint32_t(plan_.params.curvature_stride);
         rows(full.height, [&](size_t y) {
             std::uint8_t* out = mask_.data() + full.offset + y * full.width;
             for (uint32_t x = 0; x < full.width; ++x) {
-                out[x] = std::uint8_t(
-                    kernels::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y), t.curvature, t.depth));
+                out[x] = std::uint8_t(robust ? kernels::pyr_metric_robust_fillable(
+                                                   c, full.width, full.height, x, uint32_t(y), stride, t.curvature_base,
+                                                   t.curvature_growth, t.depth, t.depth_growth)
+                                             : kernels::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y),
+                                                                            t.curvature, t.depth));
             }
         });
     }

@@ -60,5 +60,6 @@ namespace pyrseg::cpu::kernels {
 #include "shaders/pyr_mip.h"
 #include "shaders/pyr_normals.h"
 #include "shaders/pyr_quantize.h"
+#include "shaders/pyr_robust.h"
 #include "shaders/pyr_stats.h"
 }  // namespace pyrseg::cpu::kernels

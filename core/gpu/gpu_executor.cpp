@@ -91,6 +91,12 @@ public:
     void begin_pass(const char* pass) override { device_->mark(pass); }
 
     void estimate_normals() override {
+        if (plan_.params.metric == Metric::robust) {
+            dispatch(Kernel::normals_robust, width(), height(),
+                     args({height(), uint32_t(plan_.params.normal_radius), uint32_t(plan_.params.normal_window),
+                           bits(plan_.thresholds.point_scale)}));
+            return;
+        }
         dispatch(Kernel::normals, width(), height(), args({height(), uint32_t(plan_.params.normal_radius)}));
     }
 
@@ -98,6 +104,12 @@ public:
 
     void metric() override {
         const core::Thresholds t = plan_.thresholds;
+        if (plan_.params.metric == Metric::robust) {
+            dispatch(Kernel::metric_robust, width(), height(),
+                     args({height(), plan_.full().offset, uint32_t(plan_.params.curvature_stride),
+                           bits(t.curvature_base), bits(t.curvature_growth), bits(t.depth), bits(t.depth_growth)}));
+            return;
+        }
         dispatch(Kernel::metric, width(), height(),
                  args({height(), plan_.full().offset, bits(t.curvature), bits(t.depth)}));
     }

@@ -1,5 +1,6 @@
 #pragma once
 // Segmentation parameters. Defaults are the algorithm contract's (docs/algorithm.md).
+#include <cstdint>
 #include <optional>
 
 namespace pyrseg {
@@ -9,6 +10,14 @@ inline constexpr double kDefaultDepthThresholdMm = 10.0;    // dt, millimetres
 inline constexpr int kDefaultBridgeLevels = 2;              // b
 inline constexpr int kDefaultUnjoinableGap = 2;             // g
 inline constexpr int kDefaultNormalRadius = 2;              // normals pass neighbour offset, pixels
+inline constexpr int kDefaultNormalWindow = 3;              // robust normals: (2R+1)^2 window of tangents
+inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: normals compared this far apart
+inline constexpr int kMaxNormalWindow = 7;
+inline constexpr int kMaxCurvatureStride = 64;
+
+// Which fillable test (docs/algorithm.md): the paper's (section 2, the contract) for low-noise scanners, or the
+// robust one (sections 2b and 8b) for depth cameras whose noise grows with the square of the depth.
+enum class Metric : std::uint8_t { paper, robust };
 
 struct Params {
     double ct = kDefaultCurvatureThreshold;  // curvature threshold in radians; >= pi disables curvature edges
@@ -21,6 +30,12 @@ struct Params {
     bool label_edges = true;                   // step 6c: valid edge pixels join their smallest labelled neighbour
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
+    Metric metric = Metric::paper;
+    // The robust metric's own parameters; with Metric::paper they must keep these defaults.
+    int normal_window = kDefaultNormalWindow;        // R, 1..7: estimated normals sum tangents over (2R+1)^2 pixels
+    int curvature_stride = kDefaultCurvatureStride;  // s, 1..64: the curvature term compares normals s pixels apart
+    double dt_per_m2 = 0.0;         // millimetres added to dt per square metre of depth (dt + dt_per_m2 * z_m^2)
+    double ct_growth_per_m2 = 0.0;  // 1 - cos(ct) grows by this factor per square metre of depth
 };
 
 }  // namespace pyrseg

@@ -1,0 +1,153 @@
+/* The robust metric (docs/algorithm.md sections 2b and 8b): normals from window sums of fixed-point tangents, and
+ * a fillable test whose curvature term looks at stride s and whose thresholds grow with z^2. Integers wherever
+ * values are summed; the only float operations are correctly rounded ones (scale, clamp, multiply, add, compare).
+ * Needs: PYR_PT(x, y, c) for the normals; PYR_Q_VALID(i), PYR_QN(i, c), PYR_QZ(i) for the metric. */
+#ifndef PYR_ROBUST_H
+#define PYR_ROBUST_H
+#include "pyr_normals.h"
+#include "pyr_types.h"
+#include "pyr_validity.h"
+
+#define PYR_ROBUST_COORD_LIMIT 4194304.0f   /* 2^22 fixed-point steps */
+#define PYR_ROBUST_CURVATURE_PASS 134217728 /* 2^27: the curvature test passes whatever the normals */
+
+/* G(v): rint(clamp(v * 2^e, -2^22, 2^22)); the scale is the exact float 2^e. */
+PYR_FN pyr_i32 pyr_robust_fixed(pyr_f32 v, pyr_f32 scale) {
+    PYR_PRECISE pyr_f32 p = v * scale;
+    p = p < -PYR_ROBUST_COORD_LIMIT ? -PYR_ROBUST_COORD_LIMIT
+                                    : (p > PYR_ROBUST_COORD_LIMIT ? PYR_ROBUST_COORD_LIMIT : p);
+    return PYR_I32(PYR_RINT(p));
+}
+
+PYR_FN pyr_u32 pyr_robust_point_valid(PYR_CTX_PARAM, pyr_u32 x, pyr_u32 y) {
+    return pyr_point_valid(PYR_PT(x, y, 0), PYR_PT(x, y, 1), PYR_PT(x, y, 2));
+}
+
+/* G(P(a)) - G(P(b)), component c. */
+PYR_FN pyr_i32 pyr_robust_tangent(PYR_CTX_PARAM, pyr_u32 xa, pyr_u32 ya, pyr_u32 xb, pyr_u32 yb, pyr_u32 c,
+                                  pyr_f32 scale) {
+    return pyr_robust_fixed(PYR_PT(xa, ya, c), scale) - pyr_robust_fixed(PYR_PT(xb, yb, c), scale);
+}
+
+/* The vector's magnitudes shifted so that the largest lies in [2^14, 2^15), signs kept; m > 0 is that largest. */
+PYR_FN PyrIVec3 pyr_robust_to_15_bits(PyrIVec3 v) {
+    pyr_i32 m = pyr_iabs(v.x);
+    m = pyr_iabs(v.y) > m ? pyr_iabs(v.y) : m;
+    m = pyr_iabs(v.z) > m ? pyr_iabs(v.z) : m;
+    pyr_i32 s = PYR_MSB(PYR_U32(m)) - 14;
+    PyrIVec3 r;
+    r.x = pyr_shift_magnitude(v.x, s);
+    r.y = pyr_shift_magnitude(v.y, s);
+    r.z = pyr_shift_magnitude(v.z, s);
+    return r;
+}
+
+PYR_FN pyr_u32 pyr_robust_is_zero(PyrIVec3 v) {
+    return (v.x == 0 && v.y == 0 && v.z == 0) ? 1u : 0u;
+}
+
+PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r,
+                                    pyr_u32 window, pyr_f32 scale) {
+    PyrIVec3 none;
+    none.x = 0;
+    none.y = 0;
+    none.z = 0;
+    pyr_f32 px = PYR_PT(x, y, 0);
+    pyr_f32 py = PYR_PT(x, y, 1);
+    pyr_f32 pz = PYR_PT(x, y, 2);
+    if (pyr_point_valid(px, py, pz) == 0u) return none;
+    pyr_i32 zi = pyr_robust_fixed(pz, scale);
+    pyr_i32 jump = zi >> 4;
+
+    PyrIVec3 u = none;
+    PyrIVec3 v = none;
+    pyr_u32 y0 = y >= window ? y - window : 0u;
+    pyr_u32 y1 = y + window < h ? y + window : h - 1u;
+    pyr_u32 x0 = x >= window ? x - window : 0u;
+    pyr_u32 x1 = x + window < w ? x + window : w - 1u;
+    for (pyr_u32 jy = y0; jy <= y1; ++jy) {
+        for (pyr_u32 jx = x0; jx <= x1; ++jx) {
+            if (pyr_robust_point_valid(PYR_CTX_ARG, jx, jy) == 0u) continue;
+            if (pyr_iabs(pyr_robust_fixed(PYR_PT(jx, jy, 2), scale) - zi) > jump) continue;
+            if (jx >= r && jx + r < w && pyr_robust_point_valid(PYR_CTX_ARG, jx + r, jy) != 0u &&
+                pyr_robust_point_valid(PYR_CTX_ARG, jx - r, jy) != 0u) {
+                u.x += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 0u, scale);
+                u.y += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 1u, scale);
+                u.z += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 2u, scale);
+            }
+            if (jy >= r && jy + r < h && pyr_robust_point_valid(PYR_CTX_ARG, jx, jy + r) != 0u &&
+                pyr_robust_point_valid(PYR_CTX_ARG, jx, jy - r) != 0u) {
+                v.x += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 0u, scale);
+                v.y += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 1u, scale);
+                v.z += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 2u, scale);
+            }
+        }
+    }
+    if (pyr_robust_is_zero(u) != 0u || pyr_robust_is_zero(v) != 0u) return none;
+    return pyr_unit_normal_from_tangents(pyr_robust_to_15_bits(u), pyr_robust_to_15_bits(v), px, py, pz);
+}
+
+/* min(A + Bc * z^2, 2^27) as an int32, per section 2b; growth == 0 means A alone. */
+PYR_FN pyr_i32 pyr_robust_curvature_limit(pyr_f32 z, pyr_f32 base, pyr_f32 growth) {
+    PYR_PRECISE pyr_f32 zz = z * z;
+    PYR_PRECISE pyr_f32 g = growth * zz;
+    PYR_PRECISE pyr_f32 t = growth == 0.0f ? base : base + g;
+    return t >= PYR_F32(PYR_ROBUST_CURVATURE_PASS) ? PYR_ROBUST_CURVATURE_PASS : PYR_I32(t);
+}
+
+PYR_FN pyr_f32 pyr_robust_depth_limit(pyr_f32 z, pyr_f32 dt, pyr_f32 growth) {
+    PYR_PRECISE pyr_f32 zz = z * z;
+    PYR_PRECISE pyr_f32 g = growth * zz;
+    PYR_PRECISE pyr_f32 d = dt + g;
+    return growth == 0.0f ? dt : d;
+}
+
+PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 stride,
+                                          pyr_f32 curvature_base, pyr_f32 curvature_growth, pyr_f32 dt,
+                                          pyr_f32 depth_growth) {
+    pyr_u32 i = y * w + x;
+    if (PYR_Q_VALID(i) == 0u) return 0u;
+    pyr_i32 qx = PYR_QN(i, 0);
+    pyr_i32 qy = PYR_QN(i, 1);
+    pyr_i32 qz = PYR_QN(i, 2);
+    pyr_f32 z = PYR_QZ(i);
+    pyr_i32 k1 = 0;
+    pyr_i32 ks = 0;
+    pyr_i32 s = 0; /* |s| <= 8 * 3 * 2^26 < 2^31 */
+    pyr_f32 dmin = 0.0f;
+    pyr_f32 dmax = 0.0f;
+    pyr_i32 stride_i = PYR_I32(stride);
+    for (pyr_i32 dy = -1; dy <= 1; ++dy) {
+        for (pyr_i32 dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            pyr_i32 nx = PYR_I32(x) + dx;
+            pyr_i32 ny = PYR_I32(y) + dy;
+            if (nx >= 0 && nx < PYR_I32(w) && ny >= 0 && ny < PYR_I32(h)) {
+                pyr_u32 j = PYR_U32(ny) * w + PYR_U32(nx);
+                if (PYR_Q_VALID(j) != 0u) {
+                    PYR_PRECISE pyr_f32 dd = PYR_FABS(z - PYR_QZ(j));
+                    dmin = (k1 == 0 || dd < dmin) ? dd : dmin;
+                    dmax = (k1 == 0 || dd > dmax) ? dd : dmax;
+                    ++k1;
+                }
+            }
+            pyr_i32 sx = PYR_I32(x) + dx * stride_i;
+            pyr_i32 sy = PYR_I32(y) + dy * stride_i;
+            if (sx >= 0 && sx < PYR_I32(w) && sy >= 0 && sy < PYR_I32(h)) {
+                pyr_u32 j = PYR_U32(sy) * w + PYR_U32(sx);
+                if (PYR_Q_VALID(j) != 0u) {
+                    s += qx * PYR_QN(j, 0) + qy * PYR_QN(j, 1) + qz * PYR_QN(j, 2);
+                    ++ks;
+                }
+            }
+        }
+    }
+    if (k1 == 0 || ks == 0) return 0u;
+    /* ks * (2^26 - L) lies in [-2^29, 2^29] since 0 <= L <= 2^27. */
+    pyr_i32 limit = pyr_robust_curvature_limit(z, curvature_base, curvature_growth);
+    if (s < ks * (PYR_I32(1 << 26) - limit)) return 0u;
+    PYR_PRECISE pyr_f32 d = dmax - dmin;
+    return d <= pyr_robust_depth_limit(z, dt, depth_growth) ? 1u : 0u;
+}
+
+#endif /* PYR_ROBUST_H */
