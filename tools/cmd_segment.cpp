@@ -81,7 +81,16 @@ void write_labels(const fs::path& path, const Result& result) {
 }
 
 // One frame: read, segment (reusing the Segmenter while the size stays the same), write what was asked.
-FrameReport segment_frame(const fs::path& input, const Args& args, const Params& params, const OutputPaths& out,
+// The parameters a Segmenter was made with decide its plan; --sensor auto may change them from frame to frame.
+bool same_params(const Params& a, const Params& b) {
+    return a.ct == b.ct && a.dt == b.dt && a.unit_mm == b.unit_mm && a.bridge_levels == b.bridge_levels &&
+           a.unjoinable_gap == b.unjoinable_gap && a.label_edges == b.label_edges && a.compact == b.compact &&
+           a.normal_radius == b.normal_radius && a.metric == b.metric && a.normal_window == b.normal_window &&
+           a.curvature_stride == b.curvature_stride && a.dt_per_m2 == b.dt_per_m2 &&
+           a.ct_growth_per_m2 == b.ct_growth_per_m2;
+}
+
+FrameReport segment_frame(const fs::path& input, const Args& args, const Params& base_params, const OutputPaths& out,
                           std::unique_ptr<Segmenter>& segmenter) {
     // NAME.png or NAME.ply in the input's own folder would be the input itself.
     for (const std::optional<fs::path>* o : {&out.labels, &out.png, &out.mask, &out.figure, &out.ply, &out.stats}) {
@@ -93,23 +102,39 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     const LoadedInput loaded = load_input(input, args);
     const io::PointCloud& cloud = loaded.cloud;
     const double median_z = median_depth(cloud.points);
-    if (!loaded.millimetres && params.unit_mm == 1.0 && median_z > 0 && median_z < 20.0) {
+    if (!loaded.millimetres && base_params.unit_mm == 1.0 && median_z > 0 && median_z < 20.0) {
         std::fprintf(stderr,
                      "pyrseg: note: %s: median depth is %.3g units; if the cloud is in metres, pass --unit-mm 1000\n",
                      input.string().c_str(), median_z);
-    }
-    if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height) {
-        Outputs outputs;
-        outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
-        outputs.segment_stats = out.stats.has_value();
-        segmenter =
-            std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
     CloudView view;
     view.points = cloud.points.data();
     view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();
     view.width = cloud.width;
     view.height = cloud.height;
+    const std::optional<SensorChoice> sensor = parse_sensor(args);
+    std::string sensor_note;
+    Params params = base_params;
+    if (!sensor || sensor->automatic) {
+        const FrameNoise noise = measure_frame_noise(view, base_params.unit_mm);
+        if (sensor) {
+            params = parse_params(args, noise.suggested);
+            sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
+        } else if (noise.suggested != SensorKind::structured_light) {
+            std::fprintf(stderr,
+                         "pyrseg: hint: %s: %s; the default parameters suit low-noise scanners. Try --sensor %s (or "
+                         "--sensor auto, or the preset of your camera: --help lists them)\n",
+                         input.string().c_str(), noise.reason.c_str(), sensor_kind_name(noise.suggested));
+        }
+    }
+    if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height ||
+        !same_params(segmenter->params(), params)) {
+        Outputs outputs;
+        outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
+        outputs.segment_stats = out.stats.has_value();
+        segmenter =
+            std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
+    }
     const auto start = std::chrono::steady_clock::now();
     const Result result = segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
@@ -124,9 +149,10 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
                                 io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
     }
     char line[512];
-    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s", input.string().c_str(),
-                  loaded.kind.c_str(), result.width, result.height, cloud.normals.empty() ? "estimated" : "from file",
-                  result.segment_count, elapsed.count(), segmenter->backend_name().c_str());
+    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s%s",
+                  input.string().c_str(), loaded.kind.c_str(), result.width, result.height,
+                  cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
+                  segmenter->backend_name().c_str(), sensor_note.c_str());
     return {line, result.segment_count, elapsed.count()};
 }
 

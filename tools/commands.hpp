@@ -1,11 +1,13 @@
 #pragma once
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "pyrseg/io.hpp"
 #include "pyrseg/params.hpp"
+#include "pyrseg/presets.hpp"
 #include "tools/args.hpp"
 
 namespace pyrseg::cli {
@@ -22,7 +24,14 @@ int cmd_bench_report(const std::vector<std::string>& args);
 extern const char* const kParameterHelp;
 extern const std::set<std::string> kParameterValueOptions;
 extern const std::set<std::string> kParameterFlagOptions;
-[[nodiscard]] Params parse_params(const Args& args);
+// --sensor: a preset, or auto (chosen per frame by measure_frame_noise).
+struct SensorChoice {
+    bool automatic = false;
+    SensorKind kind = SensorKind::structured_light;
+};
+[[nodiscard]] std::optional<SensorChoice> parse_sensor(const Args& args);
+// The parameters: the preset (given, else --sensor's unless auto, else the defaults), then the explicit options.
+[[nodiscard]] Params parse_params(const Args& args, std::optional<SensorKind> preset = std::nullopt);
 
 // The inputs `segment` reads: organized PCD, or a depth image with intrinsics (--intrinsics, --calib,
 // --depth-scale), turned into a cloud in millimetres.

@@ -8,6 +8,14 @@ namespace pyrseg::cli {
 
 const char* const kParameterHelp =
     "Segmentation parameters (defaults from the algorithm contract, docs/algorithm.md):\n"
+    "  --sensor NAME         start from the preset for a kind of depth sensor; the options below override it:\n"
+    "                          structured-light  low-noise scanners (PhoXi-like): the defaults\n"
+    "                          kinect-v1         Kinect v1, Xtion, Orbbec Astra (disparity-stepped depth)\n"
+    "                          realsense-d435    RealSense D4xx and other active stereo cameras\n"
+    "                          azure-kinect      Azure Kinect, Kinect v2 and other time-of-flight cameras\n"
+    "                          auto              choose per frame from the frame's own depth noise\n"
+    "                        Without --sensor the defaults apply, and pyrseg says when a frame looks noisier than\n"
+    "                        they suit. docs/quality.md has each preset's values and measurements.\n"
     "  --ct RADIANS          curvature threshold: neighbouring normals more than this angle apart (on average)\n"
     "                        make an edge. Default 0.25; >= 3.1416 disables curvature edges.\n"
     "  --dt MM               depth threshold in millimetres: a spread of neighbour depth differences above this\n"
@@ -27,12 +35,26 @@ const char* const kParameterHelp =
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const std::set<std::string> kParameterValueOptions = {
-    "ct", "dt", "unit-mm", "bridge-levels", "unjoinable-gap", "normal-radius",
-    "metric", "normal-window", "curvature-stride", "dt-per-m2", "ct-growth"};
+    "ct",     "dt",     "unit-mm",       "bridge-levels",    "unjoinable-gap", "normal-radius",
+    "metric", "sensor", "normal-window", "curvature-stride", "dt-per-m2",      "ct-growth"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
 
-Params parse_params(const Args& args) {
+std::optional<SensorChoice> parse_sensor(const Args& args) {
+    const std::optional<std::string> name = args.value("sensor");
+    if (!name) return std::nullopt;
+    if (*name == "auto") return SensorChoice{true, SensorKind::structured_light};
+    if (auto kind = sensor_kind_from_name(*name)) return SensorChoice{false, *kind};
+    std::string known;
+    for (SensorKind k : sensor_kinds()) known += std::string(sensor_kind_name(k)) + ", ";
+    throw Error(ErrorCode::invalid_argument, "--sensor: unknown sensor '" + *name + "'; known: " + known + "auto");
+}
+
+Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     Params p;
+    if (!preset) {
+        if (auto choice = parse_sensor(args); choice && !choice->automatic) preset = choice->kind;
+    }
+    if (preset) p = sensor_preset(*preset);
     if (auto v = args.number("ct")) p.ct = *v;
     if (auto v = args.number("dt")) p.dt = *v;
     if (auto v = args.number("unit-mm")) p.unit_mm = *v;

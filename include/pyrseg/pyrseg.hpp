@@ -4,6 +4,7 @@
 #include "pyrseg/cloud.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/params.hpp"
+#include "pyrseg/presets.hpp"
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/version.hpp"

@@ -1,0 +1,143 @@
+#include "pyrseg/presets.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "pyrseg/error.hpp"
+
+namespace pyrseg {
+namespace {
+
+constexpr std::array kKinds = {SensorKind::structured_light, SensorKind::kinect_v1, SensorKind::realsense_d435,
+                               SensorKind::azure_kinect};
+
+// Above this mean |second difference| / z_m^2 a frame is noisier than a structured-light scanner can be: the
+// synthetic PhoXi-like model measures about 0.15 mm/m^2, the shared consumer scans 0.67 (stereo) to 2.2 (Kinect).
+constexpr double kConsumerSecondDifference = 0.4;
+constexpr std::size_t kMinSamples = 1000;
+
+Params robust(double ct, double ct_growth, double dt, double dt_per_m2, int stride) {
+    Params p;
+    p.metric = Metric::robust;
+    p.normal_radius = 1;
+    p.normal_window = 3;
+    p.curvature_stride = stride;
+    p.ct = ct;
+    p.ct_growth_per_m2 = ct_growth;
+    p.dt = dt;
+    p.dt_per_m2 = dt_per_m2;
+    return p;
+}
+
+}  // namespace
+
+std::span<const SensorKind> sensor_kinds() {
+    return kKinds;
+}
+
+const char* sensor_kind_name(SensorKind kind) {
+    switch (kind) {
+        case SensorKind::structured_light:
+            return "structured-light";
+        case SensorKind::kinect_v1:
+            return "kinect-v1";
+        case SensorKind::realsense_d435:
+            return "realsense-d435";
+        case SensorKind::azure_kinect:
+            return "azure-kinect";
+    }
+    return "unknown";
+}
+
+std::optional<SensorKind> sensor_kind_from_name(std::string_view name) {
+    for (SensorKind k : kKinds) {
+        if (name == sensor_kind_name(k)) return k;
+    }
+    return std::nullopt;
+}
+
+const char* sensor_kind_summary(SensorKind kind) {
+    switch (kind) {
+        case SensorKind::structured_light:
+            return "low-noise structured-light scanners (PhoXi-like): the paper's metric and the contract's defaults";
+        case SensorKind::kinect_v1:
+            return "Kinect v1, Xtion, Orbbec Astra and other structured-light cameras with disparity steps: robust "
+                   "metric";
+        case SensorKind::realsense_d435:
+            return "RealSense D4xx and other active stereo cameras: robust metric";
+        case SensorKind::azure_kinect:
+            return "Azure Kinect, Kinect v2 and other time-of-flight cameras: robust metric, thresholds that grow "
+                   "more slowly with depth";
+    }
+    return "";
+}
+
+Params sensor_preset(SensorKind kind, double unit_mm) {
+    Params p;
+    switch (kind) {
+        case SensorKind::structured_light:
+            break;
+        case SensorKind::kinect_v1:
+            p = robust(0.3, 0.2, 5.0, 10.0, 6);
+            break;
+        case SensorKind::realsense_d435:
+            p = robust(0.3, 0.2, 5.0, 10.0, 6);
+            break;
+        case SensorKind::azure_kinect:
+            p = robust(0.3, 0.1, 5.0, 4.0, 6);
+            break;
+        default:
+            throw Error(ErrorCode::invalid_parameter, "unknown sensor kind");
+    }
+    p.unit_mm = unit_mm;
+    return p;
+}
+
+FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm) {
+    FrameNoise out;
+    if (cloud.points == nullptr || cloud.width < 3 || cloud.height < 1 || !(unit_mm > 0) || !std::isfinite(unit_mm)) {
+        out.reason = "the frame is too small to measure its noise";
+        return out;
+    }
+    const std::size_t row_stride = cloud.row_stride != 0 ? cloud.row_stride : std::size_t(cloud.width);
+    const auto z_at = [&](std::size_t x, std::size_t y) {
+        return double(cloud.points[(y * row_stride + x) * std::size_t(cloud.point_stride) + 2]) * unit_mm;
+    };
+    double sum = 0.0;
+    std::vector<double> depths;
+    for (std::size_t y = 0; y < std::size_t(cloud.height); y += 2) {  // every other row: plenty of samples
+        for (std::size_t x = 1; x + 1 < std::size_t(cloud.width); ++x) {
+            const double a = z_at(x - 1, y), b = z_at(x, y), c = z_at(x + 1, y);
+            if (!(std::isfinite(a) && std::isfinite(b) && std::isfinite(c) && a > 0 && b > 0 && c > 0)) continue;
+            if (std::fabs(a - b) > b / 16 || std::fabs(c - b) > b / 16) continue;  // across an edge
+            const double zm = b / 1000.0;
+            sum += std::fabs(a - 2 * b + c) / (zm * zm);
+            if (out.samples % 64 == 0) depths.push_back(b);
+            ++out.samples;
+        }
+    }
+    char text[256];
+    if (out.samples < kMinSamples) {
+        std::snprintf(text, sizeof text, "only %zu pixels could be measured, too few to judge the sensor", out.samples);
+        out.reason = text;
+        return out;
+    }
+    std::nth_element(depths.begin(), depths.begin() + std::ptrdiff_t(depths.size() / 2), depths.end());
+    out.median_depth_mm = depths[depths.size() / 2];
+    out.second_difference_per_m2 = sum / double(out.samples);
+    const double at_median =
+        out.second_difference_per_m2 * (out.median_depth_mm / 1000.0) * (out.median_depth_mm / 1000.0);
+    const bool noisy = out.second_difference_per_m2 > kConsumerSecondDifference;
+    out.suggested = noisy ? SensorKind::kinect_v1 : SensorKind::structured_light;
+    std::snprintf(text, sizeof text,
+                  "depth noise %.2f mm at the median depth %.2f m (%.2f mm per m^2; above %.1f looks like a consumer "
+                  "depth camera)",
+                  at_median, out.median_depth_mm / 1000.0, out.second_difference_per_m2, kConsumerSecondDifference);
+    out.reason = text;
+    return out;
+}
+
+}  // namespace pyrseg
