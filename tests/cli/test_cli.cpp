@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -307,6 +309,74 @@ TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
         EXPECT_TRUE(x > 300 && x < 500 && y > 200 && y < 340) << "mug pixel far from the mug at " << x << "," << y;
     }
     fs::remove_all(dir);
+}
+
+// Consumer depth scans with the preset of their kind of camera (issue: real sensors): the floor or table is one
+// segment, and every object is a segment of its own where the object is.
+struct ExpectedScene {
+    std::vector<std::pair<int, int>> surface;        // pixels of the floor / table: one segment
+    std::vector<std::array<int, 4>> objects;         // x0, y0, x1, y1: one distinct segment inside each
+    std::vector<std::pair<int, int>> object_pixels;  // a pixel of each object
+};
+
+void expect_scene_segmented(const fs::path& scan, const std::string& options, const ExpectedScene& e) {
+    if (!fs::exists(scan)) GTEST_SKIP() << "sample scan not present: " << scan.string();
+    const fs::path dir = temp_dir();
+    const fs::path labels_path = dir / "labels.npy";
+    const CliRun r = run("segment " + scan.string() + " " + options + " --labels " + labels_path.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
+    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+    std::vector<std::uint32_t> labels(640 * 480);
+    std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
+    const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
+    const std::uint32_t surface = at(e.surface[0].first, e.surface[0].second);
+    ASSERT_NE(surface, 0u);
+    for (const auto& [x, y] : e.surface) EXPECT_EQ(at(x, y), surface) << "surface point (" << x << ", " << y << ")";
+    std::set<std::uint32_t> seen{surface};
+    for (std::size_t k = 0; k < e.objects.size(); ++k) {
+        const auto [px, py] = e.object_pixels[k];
+        const std::uint32_t object = at(px, py);
+        EXPECT_NE(object, 0u) << "object " << k << " unlabelled at (" << px << ", " << py << ")";
+        EXPECT_TRUE(seen.insert(object).second) << "object " << k << " shares segment " << object;
+        const auto [x0, y0, x1, y1] = e.objects[k];
+        std::size_t outside = 0, inside = 0;
+        for (std::size_t i = 0; i < labels.size(); ++i) {
+            if (labels[i] != object) continue;
+            const int x = int(i % 640), y = int(i / 640);
+            (x >= x0 && x <= x1 && y >= y0 && y <= y1 ? inside : outside) += 1;
+        }
+        EXPECT_EQ(outside, 0u) << "object " << k << "'s segment reaches outside the object (" << inside << " inside)";
+        EXPECT_GT(inside, 1000u) << "object " << k;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(Cli, MilkScanWithKinectPresetFloorIsOneSegmentAndEachObjectItsOwn) {
+    // Floor around and between the three objects; the bottle (right), the carton (middle; either face), the jug
+    // (left).
+    expect_scene_segmented(fs::path(PYRSEG_SHARED_DATA_DIR) / "milk_cartoon_all_small_clorox.pcd",
+                           "--unit-mm 1000 --sensor kinect-v1",
+                           {{{320, 400}, {60, 100}, {560, 100}, {350, 300}, {560, 400}, {200, 380}, {380, 60}},
+                            {{395, 90, 505, 270}, {220, 70, 335, 235}, {85, 175, 200, 300}},
+                            {{450, 180}, {300, 150}, {136, 253}}});
+}
+
+TEST(Cli, MugScanWithStereoPresetTableIsOneSegmentAndTheMugItsOwn) {
+    expect_scene_segmented(fs::path(PYRSEG_SHARED_DATA_DIR) / "table_scene_mug_stereo_textured.pcd",
+                           "--unit-mm 1000 --sensor realsense-d435",
+                           {{{200, 420}, {160, 200}, {600, 200}, {600, 450}, {300, 420}, {520, 260}},
+                            {{330, 225, 445, 395}},
+                            {{390, 340}}});
+}
+
+TEST(Cli, CapeDepthImageWithKinectPresetEachWallIsOneSegment) {
+    // A corner: the near wall on the left, the far wall on the right of the diagonal crease.
+    const fs::path data(PYRSEG_SHARED_DATA_DIR);
+    expect_scene_segmented(
+        data / "cape_depth_0.png",
+        "--calib " + (data / "cape_calib_params.xml").string() + ":IR_intrinsic_params --sensor kinect-v1",
+        {{{100, 100}, {100, 400}, {250, 250}, {380, 60}}, {{330, 160, 639, 479}}, {{500, 400}}});
 }
 
 TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
