@@ -87,10 +87,19 @@ Thresholds compute_thresholds(const Params& params) {
         const double unit_m2 = (params.unit_mm / 1000.0) * (params.unit_mm / 1000.0);
         constexpr double kCurvatureOne = 67108864.0;  // 2^26
         const bool always = params.ct >= std::numbers::pi;
-        t.curvature_base = always ? 134217728.0f : static_cast<float>(c0 * kCurvatureOne);  // 2^27: always passes
+        t.curvature_base = always ? 268435456.0f : static_cast<float>(c0 * kCurvatureOne);  // 2^28: always passes
         t.curvature_growth = always ? 0.0f : static_cast<float>(c0 * kCurvatureOne * params.ct_growth_per_m2 * unit_m2);
         t.depth_growth = static_cast<float>(params.dt_per_m2 * 1e-6 * params.unit_mm);
         t.point_scale = std::ldexp(1.0f, stats_point_shift(params.unit_mm));
+        // Finite float constants keep every per-pixel threshold free of NaN (0 * inf) on every device.
+        if (!std::isfinite(t.curvature_growth)) {
+            bad_parameter("ct_growth_per_m2 is too large: its growth overflows float32, got " +
+                          std::to_string(params.ct_growth_per_m2));
+        }
+        if (!std::isfinite(t.depth_growth)) {
+            bad_parameter("dt_per_m2 is too large: its growth overflows float32, got " +
+                          std::to_string(params.dt_per_m2));
+        }
     }
     return t;
 }

@@ -9,7 +9,7 @@
 #include "pyr_validity.h"
 
 #define PYR_ROBUST_COORD_LIMIT 4194304.0f   /* 2^22 fixed-point steps */
-#define PYR_ROBUST_CURVATURE_PASS 134217728 /* 2^27: the curvature test passes whatever the normals */
+#define PYR_ROBUST_CURVATURE_PASS 268435456 /* 2^28: the curvature test passes whatever the normals */
 
 /* G(v): rint(clamp(v * 2^e, -2^22, 2^22)); the scale is the exact float 2^e. */
 PYR_FN pyr_i32 pyr_robust_fixed(pyr_f32 v, pyr_f32 scale) {
@@ -87,7 +87,7 @@ PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32
     return pyr_unit_normal_from_tangents(pyr_robust_to_15_bits(u), pyr_robust_to_15_bits(v), px, py, pz);
 }
 
-/* min(A + Bc * z^2, 2^27) as an int32, per section 2b; growth == 0 means A alone. */
+/* min(A + Bc * z^2, 2^28) as an int32, per section 2b; growth == 0 means A alone. */
 PYR_FN pyr_i32 pyr_robust_curvature_limit(pyr_f32 z, pyr_f32 base, pyr_f32 growth) {
     PYR_PRECISE pyr_f32 zz = z * z;
     PYR_PRECISE pyr_f32 g = growth * zz;
@@ -143,7 +143,7 @@ PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, p
         }
     }
     if (k1 == 0 || ks == 0) return 0u;
-    /* ks * (2^26 - L) lies in [-2^29, 2^29] since 0 <= L <= 2^27. */
+    /* ks * (2^26 - L) lies in [-3 * 2^29, 2^29] since 0 <= L <= 2^28. */
     pyr_i32 limit = pyr_robust_curvature_limit(z, curvature_base, curvature_growth);
     if (s < ks * (PYR_I32(1 << 26) - limit)) return 0u;
     PYR_PRECISE pyr_f32 d = dmax - dmin;

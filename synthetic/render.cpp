@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "rng.hpp"
+#include "sensor.hpp"
 
 namespace pyrseg::synthetic::detail {
 namespace {
@@ -30,7 +31,7 @@ struct Bounded {
     double a0 = -kInf, a1 = kInf, b0 = -kInf, b1 = kInf;  // the same for the projector, in normalized coordinates
 };
 
-Bounded bounds_of(const Solid& s, double f, double cx, double cy) {
+Bounded bounds_of(const Solid& s, double f, double cx, double cy, double baseline) {
     Bounded b;
     if (s.shape == Shape::plane) return b;
     Vec3 corners[8];
@@ -42,7 +43,7 @@ Bounded bounds_of(const Solid& s, double f, double cx, double cy) {
         if (c.z <= 1.0) continue;
         u0 = std::min(u0, c.x / c.z), u1 = std::max(u1, c.x / c.z);
         v0 = std::min(v0, c.y / c.z), v1 = std::max(v1, c.y / c.z);
-        const double a = (c.x - kProjectorBaseline) / c.z;
+        const double a = (c.x - baseline) / c.z;
         a0 = std::min(a0, a), a1 = std::max(a1, a);
     }
     if (b.zmin <= 1.0) {  // reaches behind the image plane: no useful rectangle
@@ -149,15 +150,22 @@ struct Entry {
 
 class Renderer {
 public:
-    Renderer(const std::vector<Solid>& solids, const SceneOptions& options, Scene& scene)
+    // fields is null for the structured-light default, whose path stays as it always was.
+    Renderer(const std::vector<Solid>& solids, const SceneOptions& options, Scene& scene, const SensorModel& model,
+             const SensorFields* fields)
         : solids_(solids),
           options_(options),
           scene_(scene),
           f_(scene.fx),
-          dropouts_(options.shadows && options.hole_fraction > 0) {
+          dropouts_(options.shadows && options.hole_fraction > 0),
+          model_(model),
+          fields_(fields),
+          baseline_(fields != nullptr ? model.baseline_mm : kProjectorBaseline),
+          min_cos_(fields != nullptr ? model.min_cos : kMinDecodableCos),
+          pad_(fields != nullptr ? fields->max_jitter : 0.0) {
         bounds_.reserve(solids.size());
-        for (const Solid& s : solids) bounds_.push_back(bounds_of(s, f_, scene.cx, scene.cy));
-        if (dropouts_) shadows_.emplace(solids, bounds_);
+        for (const Solid& s : solids) bounds_.push_back(bounds_of(s, f_, scene.cx, scene.cy, baseline_));
+        if (dropouts_ && baseline_ > 0) shadows_.emplace(solids, bounds_);
     }
 
     void band(int v_begin, std::vector<std::vector<Entry>>& tiles) const {
@@ -171,14 +179,21 @@ public:
         }
         for (int v = v_begin; v < v_end; ++v) {
             Rng rng(options_.seed, static_cast<std::uint64_t>(Stream::noise_rows) + static_cast<std::uint64_t>(v));
-            for (int u = 0; u < w; ++u) pixel(u, v, tiles[static_cast<std::size_t>(u / kTileWidth)], rng);
+            for (int u = 0; u < w; ++u) {
+                const std::vector<Entry>& list = tiles[static_cast<std::size_t>(u / kTileWidth)];
+                if (fields_ != nullptr) {
+                    sensor_pixel(u, v, list);
+                } else {
+                    pixel(u, v, list, rng);
+                }
+            }
         }
     }
 
 private:
     [[nodiscard]] Vec3 ray(double u, double v) const { return {(u - scene_.cx) / f_, (v - scene_.cy) / f_, 1.0}; }
 
-    // The solids that may be seen in the tile, nearest first.
+    // The solids that may be seen in the tile, nearest first, from rays jittered up to pad_ pixels.
     void list_tile(int u0, int u1, int v0, int v1, std::vector<Entry>& list) const {
         list.clear();
         for (std::size_t i = 0; i < solids_.size(); ++i) {
@@ -189,7 +204,7 @@ private:
                 double zmin = kInf;
                 const Vec3 n = s.frame.axis[2];
                 for (int c = 0; c < 4; ++c) {
-                    const Vec3 d = ray((c & 1) ? u1 - 1 : u0, (c & 2) ? v1 - 1 : v0);
+                    const Vec3 d = ray((c & 1) ? u1 - 1 + pad_ : u0 - pad_, (c & 2) ? v1 - 1 + pad_ : v0 - pad_);
                     const double nd = dot(n, d);
                     zmin = nd < 0 ? std::min(zmin, dot(n, s.center) / nd) : 0.0;
                     if (nd >= 0) break;
@@ -197,7 +212,7 @@ private:
                 list.push_back({zmin * (1 - 1e-9) - 1e-9, i});
                 continue;
             }
-            if (b.u1 < u0 || b.u0 > u1 - 1 || b.v1 < v0 || b.v0 > v1 - 1) continue;
+            if (b.u1 < u0 - pad_ || b.u0 > u1 - 1 + pad_ || b.v1 < v0 - pad_ || b.v0 > v1 - 1 + pad_) continue;
             list.push_back({b.zmin, i});
         }
         std::sort(list.begin(), list.end(), [](const Entry& a, const Entry& b) {
@@ -207,9 +222,9 @@ private:
 
     // Whether the projector cannot light p (normal n) on solid k, or lights it too obliquely.
     [[nodiscard]] bool unlit(Vec3 p, Vec3 n, std::size_t k) const {
-        const Vec3 projector{kProjectorBaseline, 0, 0};
+        const Vec3 projector{baseline_, 0, 0};
         const Vec3 q = p - projector;
-        if (dot(n, q) > -kMinDecodableCos * norm(q)) return true;
+        if (dot(n, q) > -min_cos_ * norm(q)) return true;
         const std::vector<std::size_t>* candidates = shadows_->at(q.x / q.z, q.y / q.z);
         if (candidates == nullptr) return false;
         Hit hit;
@@ -256,11 +271,72 @@ private:
         scene_.object_id[at] = solids_[k].id;
     }
 
+    // The nearest entry of the ray d (kInf when it hits nothing).
+    double cast(Vec3 d, const std::vector<Entry>& list, Hit& nearest, std::size_t& k) const {
+        double best = kInf;
+        Hit hit;
+        for (const Entry& e : list) {
+            if (e.zmin >= best) break;
+            if (ray_entry(solids_[e.index], {0, 0, 0}, d, best, hit)) {
+                best = hit.t;
+                nearest = hit;
+                k = e.index;
+            }
+        }
+        return best;
+    }
+
+    // A consumer sensor's pixel: the exact hit of its jittered ray, or NaN where the sensor's geometry gives no
+    // data; apply_sensor() turns it into a measurement afterwards.
+    void sensor_pixel(int u, int v, const std::vector<Entry>& list) const {
+        const std::size_t at =
+            static_cast<std::size_t>(v) * static_cast<std::size_t>(scene_.width) + static_cast<std::size_t>(u);
+        const Vec3 nominal = ray(u, v);
+        Vec3 d = nominal;
+        if (!fields_->jitter_u.empty()) d = ray(u + fields_->jitter_u[at], v + fields_->jitter_v[at]);
+        Hit nearest;
+        std::size_t k = 0;
+        double best = cast(d, list, nearest, k);
+        // The point is reported on the nominal ray, so its surface must face that ray too: where the jittered ray
+        // slipped past a silhouette onto a side the nominal ray sees edge-on, the nominal ray decides.
+        if (!(best < kInf && dot(nearest.normal, nominal) < -1e-3 * norm(nominal)) && pad_ > 0) {
+            d = nominal;
+            best = cast(d, list, nearest, k);
+        }
+        float* point = scene_.points.data() + 3 * at;
+        float* normal = scene_.normals.data() + 3 * at;
+        bool valid = best < kInf;
+        const Vec3 p = d * best;
+        if (valid && dropouts_) {
+            valid = dot(nearest.normal, d) <= -min_cos_ * norm(d) && (baseline_ <= 0 || !unlit(p, nearest.normal, k));
+            if (valid && model_.stereo_band) {
+                // The second imager, baseline_ along x with the same intrinsics, must see the point to match it.
+                const double u2 = f_ * (p.x - baseline_) / p.z + scene_.cx;
+                valid = u2 >= -0.5 && u2 <= scene_.width - 0.5;
+            }
+        }
+        if (!valid) {
+            point[0] = point[1] = point[2] = kNanF;
+            normal[0] = normal[1] = normal[2] = kNanF;
+            scene_.object_id[at] = kNoDataId;
+            return;
+        }
+        point[0] = static_cast<float>(p.x), point[1] = static_cast<float>(p.y), point[2] = static_cast<float>(p.z);
+        normal[0] = static_cast<float>(nearest.normal.x), normal[1] = static_cast<float>(nearest.normal.y);
+        normal[2] = static_cast<float>(nearest.normal.z);
+        scene_.object_id[at] = solids_[k].id;
+    }
+
     const std::vector<Solid>& solids_;
     const SceneOptions& options_;
     Scene& scene_;
     double f_;
     bool dropouts_;
+    const SensorModel& model_;
+    const SensorFields* fields_;
+    double baseline_;  // projector or second imager along x (mm); 0: none
+    double min_cos_;   // grazing-angle limit for the camera and the projector
+    double pad_;       // how far (pixels) a jittered ray may stray from its pixel
     std::vector<Bounded> bounds_;
     std::optional<ShadowGrid> shadows_;
 };
@@ -299,7 +375,11 @@ void render(const std::vector<Solid>& solids, const SceneOptions& options, Scene
     scene.normals.resize(3 * pixels);
     scene.object_id.resize(pixels);
 
-    const Renderer renderer(solids, options, scene);
+    const SensorModel model = sensor_model(options.sensor);
+    const bool consumer = options.sensor != Sensor::structured_light;
+    const SensorFields fields =
+        consumer ? make_sensor_fields(model, options, scene.width, scene.height) : SensorFields{};
+    const Renderer renderer(solids, options, scene, model, consumer ? &fields : nullptr);
     const int bands = (scene.height + kBandHeight - 1) / kBandHeight;
     std::atomic<int> next{0};
     auto work = [&] {
@@ -312,6 +392,7 @@ void render(const std::vector<Solid>& solids, const SceneOptions& options, Scene
     for (int i = 1; i < threads; ++i) pool.emplace_back(work);
     work();
     for (std::thread& t : pool) t.join();
+    if (consumer) apply_sensor(model, fields, options, scene);
 
     const double half_w = scene.width / (2 * scene.fx), half_h = scene.height / (2 * scene.fy);
     punch_blobs(make_blobs(options, half_w, half_h), scene);

@@ -14,8 +14,9 @@ inline std::uint64_t splitmix64(std::uint64_t& state) {
 }
 
 // Independent streams of one seed (layout, holes, the noise of each row), so that changing one part of the
-// options or the image size leaves the others as they were.
-enum class Stream : std::uint64_t { layout = 1, holes = 2, noise_rows = 0x100 };
+// options or the image size leaves the others as they were. Sensor models draw row j of their field k from
+// sensor_rows + (k << 16) + j, clear of noise_rows + v for every v below the largest image side.
+enum class Stream : std::uint64_t { layout = 1, holes = 2, noise_rows = 0x100, sensor_rows = 0x100000 };
 
 class Rng {
 public:

@@ -308,6 +308,33 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     }
     md += "\n";
 
+    // What the robust metric costs: the same frames with the kinect-v1 preset, pass by pass.
+    md +=
+        "## The robust metric's cost\n\nThe same frames, normals estimated, with the paper's metric (pipeline/) and "
+        "with the robust metric of the kinect-v1 preset (pipeline_robust/: window normals R = 3, curvature stride 6). "
+        "Ratio: robust ÷ paper (above 1: the robust metric is slower).\n\n";
+    md += header({"frame", "backend", "paper", "robust", "robust ÷ paper", "normals: paper", "normals: robust",
+                  "metric: paper", "metric: robust"});
+    for (const Size& s : sizes) {
+        for (const std::string& b : backends) {
+            const Entry* paper = find(entries, "pipeline/" + b + "/" + s.name + "/estimated_normals");
+            const Entry* robust = find(entries, "pipeline_robust/" + b + "/" + s.name + "/estimated_normals");
+            if (robust == nullptr) continue;
+            const auto counter = [](const Entry* e, const char* pass) {
+                if (e == nullptr) return std::string("—");
+                const auto it = e->counters.find(pass);
+                if (it == e->counters.end()) return std::string("—");
+                char text[32];
+                std::snprintf(text, sizeof text, "%.2f ms", it->second);
+                return std::string(text);
+            };
+            md += table_row({s.name, b, ms_cell(paper), ms_cell(robust), ratio_cell(ratio(robust, paper)),
+                             counter(paper, "normals_ms"), counter(robust, "normals_ms"), counter(paper, "metric_ms"),
+                             counter(robust, "metric_ms")});
+        }
+    }
+    md += "\n";
+
     // The fills' worst cases.
     md +=
         "## The fills' worst cases\n\nOne winding region of 8-pixel corridors. Every backend fills by union-find, "

@@ -1,12 +1,17 @@
 #pragma once
-// Seeded synthetic bin-picking scenes as a structured-light camera (PhoXi-like, about 1.2 m above the floor,
-// looking down) sees them, with exact surface normals and per-pixel ground truth, for tests, benchmarks and the demo.
+// Seeded synthetic bin-picking scenes as a depth camera (by default a PhoXi-like structured-light scanner, about
+// 1.2 m above the floor, looking down) sees them, with exact surface normals and per-pixel ground truth, for tests,
+// benchmarks and the demo. Consumer depth cameras (Kinect v1, RealSense D435, Azure Kinect) are modelled too; see
+// docs/sensors.md.
 //
 // The scene lives in millimetres and the field of view is fixed, so every resolution shows the same scene; the
-// layout depends only on the seed and on object_count, touching and bin, never on the size, noise or holes.
+// layout depends only on the seed and on object_count, touching and bin, never on the size, noise, holes, sensor or
+// camera distance.
 // Output is deterministic for a given seed on a given platform, whatever the thread count.
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 namespace pyrseg::synthetic {
@@ -21,17 +26,27 @@ inline constexpr std::uint32_t kFirstObjectId = 7;
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr int kMaxObjectCount = 1000;
 
+// The depth camera whose noise and missing data the frame shows.
+enum class Sensor : std::uint8_t { structured_light, kinect_v1, realsense_d435, azure_kinect };
+
 struct SceneOptions {
     int width = 640;
     int height = 480;
     std::uint64_t seed = 1;
     int object_count = 12;        // boxes, cylinders and spheres in the bin, 0..max_object_count
-    double noise_mm = 0.1;        // sigma of gaussian depth noise along the viewing ray (0: none)
+    double noise_mm = 0.1;        // sigma of gaussian depth noise along the viewing ray (0: none); structured_light
+                                  // only: the other sensors follow their own noise model (SensorModel)
     double hole_fraction = 0.01;  // approximate fraction of pixels in missing-data blobs, 0..1 (0: no missing data)
     bool touching = true;         // pack objects so that several touch each other and the bin walls
     bool bin = true;              // a bin (bottom + walls) on the floor; false: objects on a plain floor
+    // The depth camera whose noise and missing data the frame shows (docs/sensors.md).
+    Sensor sensor = Sensor::structured_light;
+    // From the camera to the floor point it looks at, 300..6000 mm. Only the camera moves (along its axis); the
+    // layout stays as it is.
+    double camera_distance_mm = 1200;
     // Structured-light dropouts on top of the blobs: where the projector (150 mm beside the camera) cannot light
-    // the surface, and surfaces seen or lit at grazing angles. Only when hole_fraction > 0, so that
+    // the surface, and surfaces seen or lit at grazing angles; for the other sensors all their missing data
+    // (shadows, grazing angles, depth edges, out of range, the stereo band). Only when hole_fraction > 0, so that
     // hole_fraction = 0 always gives a complete frame.
     bool shadows = true;
     int threads = 0;  // 0: one per hardware thread; the output does not depend on it
@@ -65,8 +80,50 @@ struct Scene {
 };
 
 // Throws std::invalid_argument for width or height outside 1..max_image_side, object_count outside
-// 0..max_object_count, noise_mm negative or not finite, hole_fraction outside 0..1, or threads negative.
+// 0..max_object_count, noise_mm negative or not finite, hole_fraction outside 0..1, camera_distance_mm outside
+// 300..6000, an unknown sensor, or threads negative.
 Scene generate(const SceneOptions& options);
+
+// "structured-light", "kinect-v1", "realsense-d435", "azure-kinect"; nullptr for a value outside the enum.
+const char* sensor_name(Sensor sensor);
+// The sensor of that name (as sensor_name writes it); nullopt for any other string.
+std::optional<Sensor> sensor_from_name(std::string_view name);
+
+// The random depth error (sigma, mm) before quantization at depth z (mm) is
+//   sqrt(polynomial(z)^2 + (z^2 / (f b) * disparity_sigma_px)^2),
+//   polynomial(z) = constant_mm + linear * z + quadratic_per_mm * (z - quadratic_origin_mm)^2,
+// with f the frame's focal length (pixels) and b the baseline. Pixel quantities are pixels of the generated frame,
+// as if the sensor had that resolution with the generator's fixed field of view. See docs/sensors.md for sources.
+struct AxialNoise {
+    double constant_mm = 0;
+    double linear = 0;            // mm per mm of depth
+    double quadratic_per_mm = 0;  // mm per mm^2
+    double quadratic_origin_mm = 0;
+    double disparity_sigma_px = 0;  // matching noise in disparity; needs baseline_mm > 0
+};
+
+struct SensorModel {
+    Sensor sensor = Sensor::structured_light;
+    // Projector or second imager along the camera's +x (mm); points it cannot see have no data. Triangulating
+    // sensors measure disparity d = f b / z. 0: the illuminator sits at the camera (time of flight).
+    double baseline_mm = 0;
+    bool time_of_flight = false;       // measures depth directly: no disparity, flying pixels at edges
+    double disparity_step_px = 0;      // disparity quantization (subpixel step); 0: none
+    AxialNoise axial;                  // random depth error
+    double correlation_radius_px = 0;  // noise and jitter are box-filtered over (2r + 1)^2 pixels; 0: white
+    double lateral_sigma_px = 0;       // jitter of the ray each pixel samples (pixels)
+    double depth_step_mm = 0;          // output rounding (1: whole millimetres as uint16 sensors); 0: none
+    double min_depth_mm = 0;           // no data nearer ...
+    double max_depth_mm = 0;           // ... or farther than this (0: no limit)
+    double min_cos = 0;                // no data where the camera (or projector) sees the surface at a cosine
+                                       // below this (grazing angles)
+    double edge_dropout = 0;           // probability that a pixel at a depth discontinuity has no data
+    double flying_pixel = 0;           // probability that a kept pixel at a discontinuity mixes both depths
+    bool stereo_band = false;          // no data where the second imager (same field of view) does not see
+};
+
+// The parameters of a sensor. structured_light describes the PhoXi-like default (its noise is noise_mm).
+SensorModel sensor_model(Sensor sensor);
 
 // Fillable masks whose one region winds across the whole frame, the worst cases of fills that carry labels a step
 // at a time: corridors 8 pixels wide between 8-pixel walls (so that they survive to level N - 2), 1 = fillable.

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "pyrseg/presets.hpp"
+
 namespace pyrseg::test {
 namespace {
 
@@ -79,7 +81,63 @@ std::vector<ConformanceCase> build_cases() {
     return cases;
 }
 
+constexpr int kRobustCaseCount = 48;
+
+ConformanceCase make_robust_case(int index, int width, int height, CaseRng& rng) {
+    ConformanceCase c;
+    c.scene.width = width;
+    c.scene.height = height;
+    c.scene.seed = std::uint64_t(5000 + index);
+    c.scene.object_count = rng.range(0, 16);
+    c.scene.sensor = rng.pick({synthetic::Sensor::structured_light, synthetic::Sensor::kinect_v1,
+                               synthetic::Sensor::realsense_d435, synthetic::Sensor::azure_kinect});
+    c.scene.camera_distance_mm = rng.pick({600.0, 1200.0, 1200.0, 2500.0});
+    c.scene.hole_fraction = rng.pick({0.0, 0.01, 0.05});
+    c.scene.touching = rng.chance(75);
+    c.scene.bin = rng.chance(70);
+    c.given_normals = rng.chance(20);
+    // A preset as users pick it, or the robust metric's parameters over their whole ranges.
+    const int preset = rng.range(0, 5);
+    if (preset < int(sensor_kinds().size())) {
+        c.params = sensor_preset(sensor_kinds()[std::size_t(preset)]);
+    } else {
+        c.params.metric = Metric::robust;
+        c.params.ct = rng.pick({0.05, 0.2, 0.3, 0.6, 3.5});
+        c.params.dt = rng.pick({0.0, 2.0, 5.0, 20.0, std::numeric_limits<double>::infinity()});
+        c.params.normal_radius = rng.pick({1, 1, 2, 5});
+        c.params.normal_window = rng.range(1, kMaxNormalWindow);
+        c.params.curvature_stride = rng.pick({1, 2, 4, 6, 13, kMaxCurvatureStride});
+        c.params.dt_per_m2 = rng.pick({0.0, 0.0, 3.0, 10.0, 1e6});
+        c.params.ct_growth_per_m2 = rng.pick({0.0, 0.0, 0.2, 1.0, 1e9});
+        if (rng.chance(20)) c.params.unit_mm = rng.pick({0.5, 3.0});
+    }
+    if (rng.chance(20)) c.params.bridge_levels = rng.range(1, 3);
+    c.params.label_edges = rng.chance(80);
+    c.name = "robust" + std::to_string(index) + "_" + std::to_string(width) + "x" + std::to_string(height) + "_" +
+             synthetic::sensor_name(c.scene.sensor) + (c.given_normals ? "_given_normals" : "_estimated_normals");
+    for (char& ch : c.name) ch = ch == '-' ? '_' : ch;
+    return c;
+}
+
+std::vector<ConformanceCase> build_robust_cases() {
+    std::vector<ConformanceCase> cases;
+    CaseRng rng(20261130);
+    const int fixed[][2] = {{1, 1}, {3, 9}, {9, 3}, {15, 15}, {640, 480}, {2064, 1544}, {33, 17}, {64, 1}};
+    for (const auto& size : fixed) cases.push_back(make_robust_case(int(cases.size()), size[0], size[1], rng));
+    while (int(cases.size()) < kRobustCaseCount) {
+        const int w = rng.chance(15) ? rng.range(1, 16) : rng.range(9, 200);
+        const int h = rng.chance(15) ? rng.range(1, 16) : rng.range(9, 150);
+        cases.push_back(make_robust_case(int(cases.size()), w, h, rng));
+    }
+    return cases;
+}
+
 }  // namespace
+
+const std::vector<ConformanceCase>& robust_conformance_cases() {
+    static const std::vector<ConformanceCase> cases = build_robust_cases();
+    return cases;
+}
 
 const std::vector<ConformanceCase>& conformance_cases() {
     static const std::vector<ConformanceCase> cases = build_cases();

@@ -83,6 +83,25 @@ INSTANTIATE_TEST_SUITE_P(Backends, SyntheticScenes,
                                     conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
                          });
 
+class RobustScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(RobustScenes, MatchesReference) {
+    const auto& [backend, index] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const ConformanceCase& c = robust_conformance_cases()[std::size_t(index)];
+    const synthetic::Scene scene = synthetic::generate(c.scene);
+    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr, scene.width,
+                       scene.height, c.params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RobustScenes,
+                         ::testing::Combine(::testing::ValuesIn(available_backend_names()),
+                                            ::testing::Range(0, int(robust_conformance_cases().size()))),
+                         [](const ::testing::TestParamInfo<RobustScenes::ParamType>& param_info) {
+                             return std::get<0>(param_info.param) + "_" +
+                                    robust_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
+                         });
+
 // Depths in the subnormal range: validity (z > 0) and the metric's float depth differences must follow IEEE on
 // every backend, whatever a device's denormal mode (contract section 2; docs/algorithm.md section 9).
 class TinyDepths : public ::testing::TestWithParam<std::string> {};

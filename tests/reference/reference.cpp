@@ -55,6 +55,42 @@ int level_count(int width, int height) {
     return 1 + n;
 }
 
+// Section 2b's four parameters: in range with the robust metric, at their defaults with the paper one.
+std::string check_metric_params(const Params& p) {
+    if (p.metric == Metric::paper) {
+        const Params defaults;
+        if (p.normal_window != defaults.normal_window)
+            return "normal_window must keep its default (3) with metric paper";
+        if (p.curvature_stride != defaults.curvature_stride) {
+            return "curvature_stride must keep its default (4) with metric paper";
+        }
+        // Compared as doubles on purpose: -0.0 equals the default 0 and NaN does not.
+        if (!(p.dt_per_m2 == defaults.dt_per_m2)) return "dt_per_m2 must keep its default (0) with metric paper";
+        if (!(p.ct_growth_per_m2 == defaults.ct_growth_per_m2)) {
+            return "ct_growth_per_m2 must keep its default (0) with metric paper";
+        }
+        return {};
+    }
+    if (p.metric != Metric::robust) return "metric must be paper or robust";
+    if (p.normal_window < 1 || p.normal_window > 7) return "normal_window must be in 1..7";
+    if (p.curvature_stride < 1 || p.curvature_stride > 64) return "curvature_stride must be in 1..64";
+    if (!std::isfinite(p.dt_per_m2) || p.dt_per_m2 < 0.0) return "dt_per_m2 must be finite and >= 0";
+    if (!std::isfinite(p.ct_growth_per_m2) || p.ct_growth_per_m2 < 0.0)
+        return "ct_growth_per_m2 must be finite and >= 0";
+    if (p.metric == Metric::robust) {
+        // Section 2b: constants that are not finite as float32 are rejected.
+        const double z2 = (p.unit_mm / 1000.0) * (p.unit_mm / 1000.0);
+        const double c0 = p.ct >= std::numbers::pi ? 0.0 : 1.0 - std::cos(p.ct);
+        if (!std::isfinite(static_cast<float>(c0 * 67108864.0 * p.ct_growth_per_m2 * z2))) {
+            return "ct_growth_per_m2 is too large: its growth overflows float32";
+        }
+        if (!std::isfinite(static_cast<float>(p.dt_per_m2 * 1e-6 * p.unit_mm))) {
+            return "dt_per_m2 is too large: its growth overflows float32";
+        }
+    }
+    return {};
+}
+
 std::string check_params(int width, int height, const Params& p) {
     if (width < 1 || height < 1) return "width and height must be >= 1";
     if (!std::isfinite(p.ct) || p.ct < 0.0) return "ct must be finite and >= 0";
@@ -62,6 +98,7 @@ std::string check_params(int width, int height, const Params& p) {
     if (!std::isfinite(p.unit_mm) || p.unit_mm <= 0.0) return "unit_mm must be finite and > 0";
     if (p.bridge_levels < 1) return "bridge_levels must be >= 1";
     if (p.unjoinable_gap < 1) return "unjoinable_gap must be >= 1";
+    if (std::string why = check_metric_params(p); !why.empty()) return why;
     const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
     if (pixels > kMaxU32) return "image too large: W*H does not fit in 32 bits";
     return {};
@@ -143,39 +180,10 @@ Vec3f sub(const float* a, const float* b) {
     return Vec3f{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
 
-// The normal of one pixel as the integer vector q (|q_c| <= 8192), or (0, 0, 0) when it is undefined.
-Vec3i pixel_normal(const float* points, std::int64_t width, std::int64_t height, std::int64_t x, std::int64_t y,
-                   std::int64_t r) {
+// Steps 2 (from "C = U x V") to 5 of section 8 on two integer tangents: the normal as the integer vector q
+// (|q_c| <= 8192), or (0, 0, 0) when the cross product is zero. p is the pixel's point, for the orientation.
+Vec3i normal_of_tangents(const Vec3i& fu, const Vec3i& fv, const float* p) {
     const Vec3i none{0, 0, 0};
-    auto at = [&](std::int64_t px, std::int64_t py) { return points + 3 * (py * width + px); };
-    const float* p = at(x, y);
-    if (!point_valid(p)) return none;
-
-    // Tangent from the neighbours on either side: both -> central difference, one -> one-sided, none -> undefined.
-    auto tangent = [&](const float* after, const float* before, Vec3f& t) {
-        if (after != nullptr && before != nullptr) {
-            t = sub(after, before);
-        } else if (after != nullptr) {
-            t = sub(after, p);
-        } else if (before != nullptr) {
-            t = sub(p, before);
-        } else {
-            return false;
-        }
-        return true;
-    };
-    auto usable = [&](std::int64_t px, std::int64_t py) -> const float* {
-        if (px < 0 || py < 0 || px >= width || py >= height) return nullptr;
-        const float* q = at(px, py);
-        return point_valid(q) ? q : nullptr;
-    };
-    Vec3f u{};
-    Vec3f v{};
-    if (!tangent(usable(x + r, y), usable(x - r, y), u)) return none;
-    if (!tangent(usable(x, y + r), usable(x, y - r), v)) return none;
-
-    const Vec3i fu = fixed_point(u);
-    const Vec3i fv = fixed_point(v);
     const Vec3i c{fu[1] * fv[2] - fu[2] * fv[1], fu[2] * fv[0] - fu[0] * fv[2], fu[0] * fv[1] - fu[1] * fv[0]};
     if (c[0] == 0 && c[1] == 0 && c[2] == 0) return none;
 
@@ -209,6 +217,155 @@ Vec3i pixel_normal(const float* points, std::int64_t width, std::int64_t height,
     return q;
 }
 
+// The normal of one pixel as the integer vector q (|q_c| <= 8192), or (0, 0, 0) when it is undefined.
+Vec3i pixel_normal(const float* points, std::int64_t width, std::int64_t height, std::int64_t x, std::int64_t y,
+                   std::int64_t r) {
+    const Vec3i none{0, 0, 0};
+    auto at = [&](std::int64_t px, std::int64_t py) { return points + 3 * (py * width + px); };
+    const float* p = at(x, y);
+    if (!point_valid(p)) return none;
+
+    // Tangent from the neighbours on either side: both -> central difference, one -> one-sided, none -> undefined.
+    auto tangent = [&](const float* after, const float* before, Vec3f& t) {
+        if (after != nullptr && before != nullptr) {
+            t = sub(after, before);
+        } else if (after != nullptr) {
+            t = sub(after, p);
+        } else if (before != nullptr) {
+            t = sub(p, before);
+        } else {
+            return false;
+        }
+        return true;
+    };
+    auto usable = [&](std::int64_t px, std::int64_t py) -> const float* {
+        if (px < 0 || py < 0 || px >= width || py >= height) return nullptr;
+        const float* q = at(px, py);
+        return point_valid(q) ? q : nullptr;
+    };
+    Vec3f u{};
+    Vec3f v{};
+    if (!tangent(usable(x + r, y), usable(x - r, y), u)) return none;
+    if (!tangent(usable(x, y + r), usable(x, y - r), v)) return none;
+
+    return normal_of_tangents(fixed_point(u), fixed_point(v), p);
+}
+
+// Sections 10 and 8b. The fixed point's exponent: the smallest e (within -126..127) with 2^e >= 16 * unit_mm.
+int point_shift(double unit_mm) {
+    int e = -126;
+    while (e < 127 && std::ldexp(1.0, e) < 16.0 * unit_mm) ++e;
+    return e;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Robust normals (docs/algorithm.md section 8b).
+
+// G(v) = rint(clamp(v * 2^e, -2^22, 2^22)), round half to even. v * 2^e is a float32 product (exact unless it
+// overflows, which the clamp then saturates, or lands among the subnormals); std::nearbyint rounds half to even in
+// the default rounding mode.
+std::int64_t fixed_coordinate(float v, float scale) {
+    const float scaled = v * scale;
+    const float limit = 4194304.0f;  // 2^22
+    return static_cast<std::int64_t>(std::nearbyint(std::clamp(scaled, -limit, limit)));
+}
+
+// Brings a non-zero integer vector to 15 significant bits: the largest magnitude ends up in [2^14, 2^15), every
+// magnitude shifted by the same amount (right: truncating), signs kept.
+Vec3i to_15_bits(const Vec3i& v) {
+    std::int64_t largest = 0;
+    for (std::int64_t comp : v) largest = std::max(largest, comp < 0 ? -comp : comp);
+    const int s = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(largest))) - 1 - 14;
+    Vec3i out{};
+    for (std::size_t c = 0; c < 3; ++c) {
+        std::int64_t mag = v[c] < 0 ? -v[c] : v[c];
+        if (s > 0) {
+            mag >>= s;
+        } else if (s < 0) {
+            mag <<= -s;
+        }
+        out[c] = v[c] < 0 ? -mag : mag;
+    }
+    return out;
+}
+
+// Every pixel's robust normal as the integer vector q, (0, 0, 0) where undefined.
+std::vector<Vec3i> robust_normals_q(const float* points, std::int64_t width, std::int64_t height, std::int64_t r,
+                                    std::int64_t window, double unit_mm) {
+    const auto count = static_cast<std::size_t>(width * height);
+    const float scale = std::ldexp(1.0f, point_shift(unit_mm));
+    std::vector<std::uint8_t> pv(count, 0);
+    std::vector<Vec3i> g(count, Vec3i{0, 0, 0});
+    for (std::size_t i = 0; i < count; ++i) {
+        const float* p = points + 3 * i;
+        if (!point_valid(p)) continue;
+        pv[i] = 1;
+        for (std::size_t c = 0; c < 3; ++c) g[i][c] = fixed_coordinate(p[c], scale);
+    }
+    const auto idx = [&](std::int64_t x, std::int64_t y) { return static_cast<std::size_t>(y * width + x); };
+
+    // Tangents of every pixel; no one-sided fallback. The pixel itself need not be point-valid for its tangent to
+    // exist, but only point-valid pixels are ever in a window.
+    std::vector<std::uint8_t> has_h(count, 0);
+    std::vector<std::uint8_t> has_v(count, 0);
+    std::vector<Vec3i> th(count, Vec3i{0, 0, 0});
+    std::vector<Vec3i> tv(count, Vec3i{0, 0, 0});
+    for (std::int64_t y = 0; y < height; ++y) {
+        for (std::int64_t x = 0; x < width; ++x) {
+            const std::size_t j = idx(x, y);
+            if (x - r >= 0 && x + r < width && pv[idx(x - r, y)] != 0 && pv[idx(x + r, y)] != 0) {
+                has_h[j] = 1;
+                for (std::size_t c = 0; c < 3; ++c) th[j][c] = g[idx(x + r, y)][c] - g[idx(x - r, y)][c];
+            }
+            if (y - r >= 0 && y + r < height && pv[idx(x, y - r)] != 0 && pv[idx(x, y + r)] != 0) {
+                has_v[j] = 1;
+                for (std::size_t c = 0; c < 3; ++c) tv[j][c] = g[idx(x, y + r)][c] - g[idx(x, y - r)][c];
+            }
+        }
+    }
+
+    std::vector<Vec3i> q(count, Vec3i{0, 0, 0});
+    for (std::int64_t y = 0; y < height; ++y) {
+        for (std::int64_t x = 0; x < width; ++x) {
+            const std::size_t i = idx(x, y);
+            if (pv[i] == 0) continue;
+            const std::int64_t zi = g[i][2];
+            const std::int64_t jmax = zi >> 4;  // J; zi >= 0 here, so the shift is a plain floor division by 16
+            Vec3i u{0, 0, 0};
+            Vec3i v{0, 0, 0};
+            for (std::int64_t dy = -window; dy <= window; ++dy) {
+                for (std::int64_t dx = -window; dx <= window; ++dx) {
+                    const std::int64_t nx = x + dx;
+                    const std::int64_t ny = y + dy;
+                    if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+                    const std::size_t j = idx(nx, ny);
+                    if (pv[j] == 0) continue;
+                    const std::int64_t dz = g[j][2] - zi;
+                    if ((dz < 0 ? -dz : dz) > jmax) continue;
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        if (has_h[j] != 0) u[c] += th[j][c];
+                        if (has_v[j] != 0) v[c] += tv[j][c];
+                    }
+                }
+            }
+            const bool u_zero = u[0] == 0 && u[1] == 0 && u[2] == 0;
+            const bool v_zero = v[0] == 0 && v[1] == 0 && v[2] == 0;
+            if (u_zero || v_zero) continue;
+            q[i] = normal_of_tangents(to_15_bits(u), to_15_bits(v), points + 3 * i);
+        }
+    }
+    return q;
+}
+
+std::vector<float> normals_from_q(const std::vector<Vec3i>& q) {
+    std::vector<float> normals(3 * q.size(), 0.0f);
+    for (std::size_t i = 0; i < q.size(); ++i) {
+        // q / 2^13 is exact: |q| <= 2^13 fits the float significand and the scale is a power of two.
+        for (std::size_t c = 0; c < 3; ++c) normals[3 * i + c] = static_cast<float>(q[i][c]) / 8192.0f;
+    }
+    return normals;
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Metric pass (contract section 2).
 
@@ -222,49 +379,166 @@ std::int64_t quantize(float n) {
     return static_cast<std::int64_t>(std::nearbyint(std::clamp(n, -1.0f, 1.0f) * 8192.0f));
 }
 
+using QuantizedNormals = std::vector<std::array<std::int64_t, 3>>;
+
+// Section 2's quantization of every valid pixel's normal (zero elsewhere, never read).
+QuantizedNormals quantize_normals(const float* normals, const std::vector<std::uint8_t>& valid) {
+    QuantizedNormals qn(valid.size(), {0, 0, 0});
+    for (std::size_t i = 0; i < valid.size(); ++i) {
+        if (valid[i] == 0) continue;
+        for (std::size_t c = 0; c < 3; ++c) qn[i][c] = quantize(normals[3 * i + c]);
+    }
+    return qn;
+}
+
+struct CurvatureSum {
+    std::int64_t k = 0;  // how many of the 8 pixels at the stride exist and are valid
+    std::int64_t s = 0;  // the sum of the integer dot products qn_i . qn_j over them
+};
+
+// Over the pixels (x + stride*dx, y + stride*dy), (dx, dy) != (0, 0) in {-1, 0, 1}^2, that exist and are valid.
+CurvatureSum curvature_sum(const QuantizedNormals& qn, const std::vector<std::uint8_t>& valid, std::int64_t width,
+                           std::int64_t height, std::int64_t x, std::int64_t y, std::int64_t stride) {
+    const auto i = static_cast<std::size_t>(y * width + x);
+    CurvatureSum out;
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            const std::int64_t nx = x + stride * dx;
+            const std::int64_t ny = y + stride * dy;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            const auto j = static_cast<std::size_t>(ny * width + nx);
+            if (valid[j] == 0) continue;
+            out.s += qn[i][0] * qn[j][0] + qn[i][1] * qn[j][1] + qn[i][2] * qn[j][2];
+            ++out.k;
+        }
+    }
+    return out;
+}
+
+struct DepthSpread {
+    std::int64_t k = 0;  // valid 8-neighbours (stride 1)
+    float d = 0.0f;      // max_j dd_j - min_j dd_j in float32 (0 when k = 0, never used then)
+};
+
+// Section 2's depth term: dd_j = |z_i - z_j| over the valid 8-neighbours, d = max - min, all in float32.
+DepthSpread depth_spread(const float* points, const std::vector<std::uint8_t>& valid, std::int64_t width,
+                         std::int64_t height, std::int64_t x, std::int64_t y) {
+    const auto i = static_cast<std::size_t>(y * width + x);
+    const float zi = points[3 * i + 2];
+    std::int64_t k = 0;
+    float dd_min = 0.0f;
+    float dd_max = 0.0f;
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            const std::int64_t nx = x + dx;
+            const std::int64_t ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            const auto j = static_cast<std::size_t>(ny * width + nx);
+            if (valid[j] == 0) continue;
+            const float diff = zi - points[3 * j + 2];
+            const float dd = std::fabs(diff);
+            if (k == 0) {
+                dd_min = dd;
+                dd_max = dd;
+            } else {
+                dd_min = std::min(dd_min, dd);
+                dd_max = std::max(dd_max, dd);
+            }
+            ++k;
+        }
+    }
+    DepthSpread out;
+    out.k = k;
+    out.d = dd_max - dd_min;
+    return out;
+}
+
 std::vector<std::uint8_t> metric(const float* points, const float* normals, const std::vector<std::uint8_t>& valid,
                                  std::int64_t width, std::int64_t height, const Params& p) {
     const std::int64_t tc = curvature_threshold(p.ct);
     const auto dt_units = static_cast<float>(p.dt / p.unit_mm);
     const std::size_t count = valid.size();
-    std::vector<std::array<std::int64_t, 3>> qn(count, {0, 0, 0});
-    for (std::size_t i = 0; i < count; ++i) {
-        if (valid[i] == 0) continue;
-        for (std::size_t c = 0; c < 3; ++c) qn[i][c] = quantize(normals[3 * i + c]);
-    }
+    const QuantizedNormals qn = quantize_normals(normals, valid);
     std::vector<std::uint8_t> fillable(count, 0);
     for (std::int64_t y = 0; y < height; ++y) {
         for (std::int64_t x = 0; x < width; ++x) {
             const auto i = static_cast<std::size_t>(y * width + x);
             if (valid[i] == 0) continue;
-            const float zi = points[3 * i + 2];
-            std::int64_t k = 0;
-            std::int64_t s = 0;
-            float dd_min = 0.0f;
-            float dd_max = 0.0f;
-            for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                for (std::int64_t dx = -1; dx <= 1; ++dx) {
-                    if (dx == 0 && dy == 0) continue;
-                    const std::int64_t nx = x + dx;
-                    const std::int64_t ny = y + dy;
-                    if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-                    const auto j = static_cast<std::size_t>(ny * width + nx);
-                    if (valid[j] == 0) continue;
-                    s += qn[i][0] * qn[j][0] + qn[i][1] * qn[j][1] + qn[i][2] * qn[j][2];
-                    const float diff = zi - points[3 * j + 2];
-                    const float dd = std::fabs(diff);
-                    if (k == 0) {
-                        dd_min = dd;
-                        dd_max = dd;
-                    } else {
-                        dd_min = std::min(dd_min, dd);
-                        dd_max = std::max(dd_max, dd);
-                    }
-                    ++k;
-                }
-            }
-            const float d = dd_max - dd_min;
-            fillable[i] = (k >= 1 && s >= k * tc && d <= dt_units) ? 1 : 0;
+            const CurvatureSum curv = curvature_sum(qn, valid, width, height, x, y, 1);
+            const DepthSpread depth = depth_spread(points, valid, width, height, x, y);
+            // Over the same 8 neighbours, so curv.k == depth.k.
+            fillable[i] = (depth.k >= 1 && curv.s >= curv.k * tc && depth.d <= dt_units) ? 1 : 0;
+        }
+    }
+    return fillable;
+}
+
+// The robust metric's host constants (section 2b), computed in double and converted to float32 once.
+struct RobustConstants {
+    float a = 0.0f;
+    float bc = 0.0f;
+    float dt_units = 0.0f;
+    float bd = 0.0f;
+};
+
+RobustConstants robust_constants(const Params& p) {
+    RobustConstants k;
+    const double z2 = (p.unit_mm / 1000.0) * (p.unit_mm / 1000.0);  // Z2 = (unit_mm / 1000)^2
+    if (p.ct >= std::numbers::pi) {
+        k.a = 268435456.0f;  // 2^28
+        k.bc = 0.0f;
+    } else {
+        const double c0 = 1.0 - std::cos(p.ct);
+        k.a = static_cast<float>(c0 * 67108864.0);
+        k.bc = static_cast<float>(c0 * 67108864.0 * p.ct_growth_per_m2 * z2);
+    }
+    k.dt_units = static_cast<float>(p.dt / p.unit_mm);
+    k.bd = static_cast<float>(p.dt_per_m2 * 1e-6 * p.unit_mm);
+    return k;
+}
+
+// Curvature limit L of a pixel at depth z, an integer in 0..2^28. Each float operation is its own statement, so no
+// contraction is possible even without -ffp-contract=off.
+std::int64_t curvature_limit(const RobustConstants& k, float z) {
+    const float two28 = 268435456.0f;
+    float t = k.a;
+    if (k.bc != 0.0f) {
+        const float zz = z * z;
+        const float grow = k.bc * zz;
+        t = k.a + grow;
+    }
+    if (t >= two28) return std::int64_t{1} << 28;
+    return static_cast<std::int64_t>(std::floor(t));
+}
+
+float depth_limit(const RobustConstants& k, float z) {
+    if (k.bd == 0.0f) return k.dt_units;
+    const float zz = z * z;
+    const float grow = k.bd * zz;
+    const float d = k.dt_units + grow;
+    return d;
+}
+
+std::vector<std::uint8_t> robust_metric(const float* points, const float* normals,
+                                        const std::vector<std::uint8_t>& valid, std::int64_t width, std::int64_t height,
+                                        const Params& p) {
+    const RobustConstants k = robust_constants(p);
+    const QuantizedNormals qn = quantize_normals(normals, valid);
+    const std::int64_t two26 = std::int64_t{1} << 26;
+    std::vector<std::uint8_t> fillable(valid.size(), 0);
+    for (std::int64_t y = 0; y < height; ++y) {
+        for (std::int64_t x = 0; x < width; ++x) {
+            const auto i = static_cast<std::size_t>(y * width + x);
+            if (valid[i] == 0) continue;
+            const float z = points[3 * i + 2];
+            const std::int64_t l = curvature_limit(k, z);
+            const CurvatureSum curv = curvature_sum(qn, valid, width, height, x, y, p.curvature_stride);
+            const bool curvature_ok = curv.k >= 1 && curv.s >= curv.k * (two26 - l);
+            const DepthSpread depth = depth_spread(points, valid, width, height, x, y);
+            const bool depth_ok = depth.k >= 1 && depth.d <= depth_limit(k, z);
+            fillable[i] = (curvature_ok && depth_ok) ? 1 : 0;
         }
     }
     return fillable;
@@ -482,13 +756,6 @@ void finish(std::vector<std::uint32_t> raw, const Params& p, Output& out) {
     out.raw_labels = std::move(raw);
 }
 
-// Section 10. The fixed point's exponent: the smallest e (within -126..127) with 2^e >= 16 * unit_mm.
-int point_shift(double unit_mm) {
-    int e = -126;
-    while (e < 127 && std::ldexp(1.0, e) < 16.0 * unit_mm) ++e;
-    return e;
-}
-
 // Section 10: per segment, in order of raw label (the compacted order), over the labelled pixels. points and
 // normals are null for a mask.
 std::vector<Segment> segment_statistics(const Output& out, const float* points, const float* normals, int width,
@@ -564,6 +831,13 @@ std::vector<float> estimate_normals(const float* points, int width, int height, 
     return normals;
 }
 
+std::vector<float> estimate_robust_normals(const float* points, int width, int height, int radius, int window,
+                                           double unit_mm) {
+    if (width < 1 || height < 1 || radius < 1 || window < 1 || window > 7) return {};
+    if (!std::isfinite(unit_mm) || unit_mm <= 0.0) return {};
+    return normals_from_q(robust_normals_q(points, width, height, radius, window, unit_mm));
+}
+
 Output segment(const float* points, const float* normals, int width, int height, const Params& params) {
     if (std::string why = check_params(width, height, params); !why.empty()) return failure(std::move(why));
     if (normals == nullptr && params.normal_radius < 1) return failure("normal_radius must be >= 1");
@@ -571,13 +845,22 @@ Output segment(const float* points, const float* normals, int width, int height,
     if (std::string why = make_plan(width, height, params, plan); !why.empty()) return failure(std::move(why));
 
     const auto count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    std::vector<float> used = normals != nullptr ? std::vector<float>(normals, normals + 3 * count)
-                                                 : estimate_normals(points, width, height, params.normal_radius);
+    const bool robust = params.metric == Metric::robust;
+    std::vector<float> used;
+    if (normals != nullptr) {
+        used.assign(normals, normals + 3 * count);
+    } else if (robust) {
+        used = normals_from_q(
+            robust_normals_q(points, width, height, params.normal_radius, params.normal_window, params.unit_mm));
+    } else {
+        used = estimate_normals(points, width, height, params.normal_radius);
+    }
     std::vector<std::uint8_t> valid(count, 0);
     for (std::size_t i = 0; i < count; ++i) {
         valid[i] = (point_valid(points + 3 * i) && normal_valid(used.data() + 3 * i)) ? 1 : 0;
     }
-    std::vector<std::uint8_t> fillable = metric(points, used.data(), valid, width, height, params);
+    std::vector<std::uint8_t> fillable = robust ? robust_metric(points, used.data(), valid, width, height, params)
+                                                : metric(points, used.data(), valid, width, height, params);
     Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan);
     out.segments = segment_statistics(out, points, used.data(), width, params);
     out.normals = std::move(used);

@@ -1,14 +1,21 @@
 #pragma once
 // The independent oracle for pyrseg: a plain, slow-but-linear implementation of the algorithm contract
-// (shared/spec/algorithm-contract.md) and of docs/algorithm.md section 8 (the normals pass), written from that text
-// only. The conformance suite compares every backend with it bit for bit.
+// (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals)
+// and 8 (the normals pass), written from that text only. The conformance suite compares every backend with it bit for
+// bit.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace pyrseg_ref {
 
+// Which metric builds the fillable mask B: `paper` is the contract's (docs/algorithm.md section 2, normals of section
+// 8), `robust` is section 2b (normals of section 8b when the caller gives none).
+enum class Metric { paper, robust };
+
 struct Params {
+    using Metric = pyrseg_ref::Metric;  // so Params::Metric::robust reads too
+
     double ct = 0.25;  // radians
     double dt = 10.0;  // millimetres
     double unit_mm = 1.0;
@@ -18,6 +25,13 @@ struct Params {
     bool label_edges = true;
     bool compact = true;
     int normal_radius = 1;
+    // Section 2b. With Metric::paper the four numbers below must keep their defaults (else ok = false); with
+    // Metric::robust they are checked against their ranges whether or not normals are given.
+    Metric metric = Metric::paper;
+    int normal_window = 3;          // R, 1..7: the (2R+1) x (2R+1) window of section 8b
+    int curvature_stride = 4;       // s, 1..64: the curvature term compares with the 8 pixels at stride s
+    double dt_per_m2 = 0.0;         // millimetres added to dt per square metre of depth; finite, >= 0
+    double ct_growth_per_m2 = 0.0;  // growth of the curvature limit per square metre of depth; finite, >= 0
 };
 
 // One segment's statistics (docs/algorithm.md section 10), in compacted order: exact integer sums.
@@ -41,7 +55,8 @@ struct Output {
     std::vector<Segment> segments;          // segment_count entries, by increasing raw label
 };
 
-// points: packed xyz float32, 3*W*H, row-major. normals: packed, or nullptr to estimate them (docs section 8).
+// points: packed xyz float32, 3*W*H, row-major. normals: packed, or nullptr to estimate them (docs section 8, or
+// section 8b with Metric::robust). Output::normals holds the normals the metric used.
 Output segment(const float* points, const float* normals, int width, int height, const Params& params);
 
 // Steps 3..7 only, from a given mask: fillable[i] is B; valid[i] (nullptr = every pixel valid) is used by edge
@@ -52,5 +67,11 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
 // The normals pass alone (docs/algorithm.md section 8): 3*W*H floats, (0,0,0) where undefined.
 // Returns an empty vector when width, height or radius is < 1.
 std::vector<float> estimate_normals(const float* points, int width, int height, int radius);
+
+// The robust normals alone (docs/algorithm.md section 8b): 3*W*H floats, (0,0,0) where undefined. radius is r,
+// window is R, unit_mm fixes the exponent e of the fixed-point points. Returns an empty vector when width, height or
+// radius is < 1, window is outside 1..7, or unit_mm is not finite and > 0.
+std::vector<float> estimate_robust_normals(const float* points, int width, int height, int radius, int window,
+                                           double unit_mm);
 
 }  // namespace pyrseg_ref

@@ -1043,4 +1043,422 @@ TEST(ReferenceNormals, SmallCrossProductIsShiftedLeft) {
     EXPECT_EQ(normal_at(n, 2, 0, 0), q13(-5793, 5793, 0));
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// Robust normals (docs/algorithm.md section 8b). unit_mm = 1 unless said: e = 4 (2^4 >= 16), so G(v) = 16 v for the
+// integer millimetre coordinates used here, Zi = 16 z and J = z (|dz| <= z/16 keeps a pixel in the window). For
+// grid_points x = column and y = row, so G(x + r) - G(x - r) = 32 r. Each case writes its sums U and V by hand; the
+// rest is the 15-bit normalisation of U and V and steps 2..5 of section 8 (C, D, len, q, orientation).
+
+std::vector<float> robust_normals(const std::vector<float>& pts, int w, int h, int r, int window,
+                                  double unit_mm = 1.0) {
+    return pyrseg_ref::estimate_robust_normals(pts.data(), w, h, r, window, unit_mm);
+}
+
+Params robust_params() {
+    Params p;
+    p.metric = pyrseg_ref::Metric::robust;
+    return p;
+}
+
+TEST(ReferenceRobustNormals, PlaneTiltedAboutOneAxisEveryPixel) {
+    // z = 1000 + x, r = 1, R = 1. Every window pixel with a horizontal tangent adds (32, 0, 32), with a vertical one
+    // (0, 32, 0); a 9x9 centre has 9 of each: U = (288, 0, 288) -> U' = (18432, 0, 18432), V' = (0, 18432, 0).
+    // C = (-18432^2, 0, 18432^2) -> D = (-20736, 0, 20736), len = 29325, q = (-5793, 0, 5793), q . F(P) > 0 -> flipped.
+    // A border pixel has fewer tangents, but U stays a multiple of (1, 0, 1) and V of (0, 1, 0): the same normal.
+    const std::vector<float> pts = grid_points(9, 9, [](int x, int) { return 1000.0f + static_cast<float>(x); });
+    const std::vector<float> n = robust_normals(pts, 9, 9, 1, 1);
+    ASSERT_EQ(n.size(), 243u);
+    for (int y = 0; y < 9; ++y) {
+        for (int x = 0; x < 9; ++x) EXPECT_EQ(normal_at(n, 9, x, y), q13(5793, 0, -5793)) << x << "," << y;
+    }
+
+    // z = 1000 + 2y: U = (288, 0, 0) -> (18432, 0, 0), V = (0, 288, 576) -> (0, 9216, 18432). C = (0, -18432^2,
+    // 18432 * 9216) -> D = (0, -20736, 10368), len = 23183, q = (0, -7327, 3664) -> flipped.
+    const std::vector<float> pts_y =
+        grid_points(9, 9, [](int, int y) { return 1000.0f + 2.0f * static_cast<float>(y); });
+    const std::vector<float> ny = robust_normals(pts_y, 9, 9, 1, 1);
+    for (int y = 0; y < 9; ++y) {
+        for (int x = 0; x < 9; ++x) EXPECT_EQ(normal_at(ny, 9, x, y), q13(0, 7327, -3664)) << x << "," << y;
+    }
+}
+
+TEST(ReferenceRobustNormals, WindowOverImageBorders) {
+    // r = 2, R = 1 on z = 1000 + x: a horizontal tangent needs 2 <= x <= 6, a vertical one 2 <= y <= 6 (no one-sided
+    // fallback). Columns 0 and 8 (windows x 0..1 and 7..8) and rows 0 and 8 reach none -> no normal; every other
+    // pixel reaches one and gets the plane's normal, corners (1,1) and (7,7) included.
+    const std::vector<float> pts = grid_points(9, 9, [](int x, int) { return 1000.0f + static_cast<float>(x); });
+    const std::vector<float> n = robust_normals(pts, 9, 9, 2, 1);
+    for (int y = 0; y < 9; ++y) {
+        for (int x = 0; x < 9; ++x) {
+            const bool none = x == 0 || x == 8 || y == 0 || y == 8;
+            EXPECT_EQ(normal_at(n, 9, x, y), none ? q13(0, 0, 0) : q13(5793, 0, -5793)) << x << "," << y;
+        }
+    }
+
+    // z = 1000 + x^2 on 5x5, r = 1. Horizontal tangents at x = 1, 2, 3: (32, 0, 64), (32, 0, 128), (32, 0, 192).
+    // R = 7 covers the whole image from every pixel (|dz| <= 16 <= z/16): U = 5 rows * (96, 0, 384) = (480, 0, 1920),
+    // V = 15 * (0, 32, 0) = (0, 480, 0) -> U' = (7680, 0, 30720), V' = (0, 30720, 0), C = (-943718400, 0, 235929600)
+    // -> D = (-28800, 0, 7200), len = 29686, q = (-7948, 0, 1987) -> flipped, the same at every pixel.
+    const std::vector<float> curved = grid_points(5, 5, [](int x, int) { return 1000.0f + static_cast<float>(x * x); });
+    const std::vector<float> whole = robust_normals(curved, 5, 5, 1, 7);
+    for (int y = 0; y < 5; ++y) {
+        for (int x = 0; x < 5; ++x) EXPECT_EQ(normal_at(whole, 5, x, y), q13(7948, 0, -1987)) << x << "," << y;
+    }
+    // R = 1 at the corner (0,0): window (0..1) x (0..1); horizontal tangents at (1,0), (1,1): U = (64, 0, 128);
+    // vertical ones at (0,1), (1,1): V = (0, 64, 0) -> U' = (8192, 0, 16384), V' = (0, 16384, 0) ->
+    // D = (-16384, 0, 8192), len = 18317, q = (-7327, 0, 3664) -> flipped.
+    const std::vector<float> small = robust_normals(curved, 5, 5, 1, 1);
+    EXPECT_EQ(normal_at(small, 5, 0, 0), q13(7327, 0, -3664));
+
+    // Arguments outside the ranges give an empty result.
+    EXPECT_TRUE(robust_normals(curved, 5, 5, 0, 1).empty());
+    EXPECT_TRUE(robust_normals(curved, 5, 5, 1, 0).empty());
+    EXPECT_TRUE(robust_normals(curved, 5, 5, 1, 8).empty());
+    EXPECT_TRUE(robust_normals(curved, 5, 5, 1, 1, 0.0).empty());
+    EXPECT_TRUE(pyrseg_ref::estimate_robust_normals(curved.data(), 0, 5, 1, 1, 1.0).empty());
+}
+
+TEST(ReferenceRobustNormals, WindowMembershipIsInclusiveAtJ) {
+    // 9x9 frontal z = 1000 with one outlier at (5,4); pixel (4,4), r = 1, R = 1: Zi = 16000, J = 16000 >> 4 = 1000.
+    // The tangents crossing the outlier (of (4,4) horizontally: +16 dz; of (5,3) and (5,5) vertically: +-16 dz, which
+    // cancel) count either way; the outlier's own tangents (32, 0, 0) and (0, 32, 0) only when |G(z) - Zi| <= J.
+    // z = 1062.5 -> G = 17000, |G - Zi| = 1000 = J: in. U = 9 * (32, 0, 0) + (0, 0, 1000) = (288, 0, 1000),
+    // V = (0, 288, 0) -> U' = (9216, 0, 32000), V' = (0, 18432, 0), D = (-18000, 0, 5184), len = 18731 ->
+    // q = (7872, 0, -2267) after the flip.
+    // z = 1062.5625 -> G = 17001: out. U = (256, 0, 1001), V = (0, 256, 0) -> U' = (8192, 0, 32032),
+    // V' = (0, 16384, 0), D = (-32032, 0, 8192), len = 33062 -> q = (7937, 0, -2030) after the flip.
+    auto centre = [](float outlier) {
+        std::vector<float> pts = grid_points(9, 9, [](int, int) { return 1000.0f; });
+        pts[3 * (4 * 9 + 5) + 2] = outlier;
+        return normal_at(robust_normals(pts, 9, 9, 1, 1), 9, 4, 4);
+    };
+    EXPECT_EQ(centre(1062.5f), q13(7872, 0, -2267));
+    EXPECT_EQ(centre(1062.5625f), q13(7937, 0, -2030));
+}
+
+TEST(ReferenceRobustNormals, DepthStepKeepsTheOtherSideOutOfTheWindow) {
+    // 16x9: z = 1000 for x <= 7 (frontal) and z = 2000 + 8y for x >= 8 (tilted about the x axis); r = 1, R = 1.
+    // Far from the step each side has its own plane's normal:
+    //   (2,4) and (5,4) (window x 4..6, its tangents reach x 3..7): U = (288, 0, 0), V = (0, 288, 0) -> (0, 0, -8192);
+    //   (12,4): Zi = 32512, J = 2032, t_v = (0, 32, 256): U = (288, 0, 0), V = (0, 288, 2304) -> U' = (18432, 0, 0),
+    //   V' = (0, 2304, 18432), D = (0, -20736, 2592), len = 20897 -> (0, 8129, -1016) after the flip.
+    // (7,4), next to the step: column 8 is out of its window (|G(z) - 16000| >= 16000 > J = 1000), so the right
+    // plane's tilt about x never enters V and q_y = 0 (with column 8 in, V would gain 3 * (0, 32, 256)). Column 7's
+    // own horizontal tangents do cross the step (the text tests only the window pixels' depths):
+    //   U = 6 * (32, 0, 0) + 16 * (0, 0, 1024 + 1032 + 1040) = (192, 0, 49536), V = 6 * (0, 32, 0) = (0, 192, 0)
+    //   -> U' = (96, 0, 24768), V' = (0, 24576, 0), D = (-18576, 0, 72), len = 18576, q = (-8192, 0, 32);
+    //   F(P) = (224, 128, 32000): q . F(P) = -8192 * 224 + 32 * 32000 < 0, not flipped.
+    const std::vector<float> pts =
+        grid_points(16, 9, [](int x, int y) { return x <= 7 ? 1000.0f : 2000.0f + 8.0f * static_cast<float>(y); });
+    const std::vector<float> n = robust_normals(pts, 16, 9, 1, 1);
+    EXPECT_EQ(normal_at(n, 16, 2, 4), q13(0, 0, -8192));
+    EXPECT_EQ(normal_at(n, 16, 5, 4), q13(0, 0, -8192));
+    EXPECT_EQ(normal_at(n, 16, 12, 4), q13(0, 8129, -1016));
+    EXPECT_EQ(normal_at(n, 16, 7, 4), q13(-8192, 0, 32));
+}
+
+TEST(ReferenceRobustNormals, FixedPointRoundsHalfToEven) {
+    // 5x3, x_i = 2.5 i / 16 mm, y = row, z = 1000 + i/16. G(x_i) = rint(2.5 i) = 0, 2, 5, 8, 10 (half to even; half
+    // away from zero or truncation would give 3 or 7). Pixel (2,1), r = 1, R = 1: horizontal tangents at x = 1, 2, 3
+    // per row: (5, 0, 2), (6, 0, 2), (5, 0, 2); vertical ones only on row 1: (0, 32, 0). U = 3 * (16, 0, 6) =
+    // (48, 0, 18), V = (0, 96, 0) -> U' = (24576, 0, 9216), V' = (0, 24576, 0), D = (-6912, 0, 18432), len = 19685
+    // -> q = (-2876, 0, 7671) -> flipped. (With U = (45, 0, 18) it would be (3042, 0, -7606).)
+    std::vector<float> pts;
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 5; ++x) {
+            pts.push_back(2.5f * static_cast<float>(x) / 16.0f);
+            pts.push_back(static_cast<float>(y));
+            pts.push_back(1000.0f + static_cast<float>(x) / 16.0f);
+        }
+    }
+    EXPECT_EQ(normal_at(robust_normals(pts, 5, 3, 1, 1), 5, 2, 1), q13(2876, 0, -7671));
+}
+
+TEST(ReferenceRobustNormals, FixedPointSaturatesAtTwoToThe22) {
+    // Millimetres (e = 4): z = 300000 + x -> 16 z > 2^22, every G(z) = 2^22, the tangents lose their z: frontal.
+    // z = 260000 + x -> G(z) = 4160000 + 16 x < 2^22: the tilted plane's (5793, 0, -5793).
+    auto centre = [](float z0, float step, double unit_mm) {
+        std::vector<float> pts;
+        for (int y = 0; y < 9; ++y) {
+            for (int x = 0; x < 9; ++x) {
+                pts.push_back(static_cast<float>(x) * step);
+                pts.push_back(static_cast<float>(y) * step);
+                pts.push_back(z0 + static_cast<float>(x) * step);
+            }
+        }
+        return normal_at(robust_normals(pts, 9, 9, 1, 1, unit_mm), 9, 4, 4);
+    };
+    EXPECT_EQ(centre(300000.0f, 1.0f, 1.0), q13(0, 0, -8192));
+    EXPECT_EQ(centre(260000.0f, 1.0f, 1.0), q13(5793, 0, -5793));
+    // Metres: e = 14 (2^13 < 16000 <= 2^14), steps of 1/1024 m -> 16 in G. 260 m -> 4259840 > 2^22: saturated;
+    // 250 m -> 4096000 + 16 x: not.
+    EXPECT_EQ(centre(260.0f, 1.0f / 1024.0f, 1000.0), q13(0, 0, -8192));
+    EXPECT_EQ(centre(250.0f, 1.0f / 1024.0f, 1000.0), q13(5793, 0, -5793));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Robust metric (docs/algorithm.md section 2b). ct = 0.25 (the default): c0 * 2^26 = 2086252.12..., so A is that
+// float and L = 2086252 while Bc = 0.
+
+// Pixels in a row (W x 1) with given normals, robust metric with stride 1 unless p says otherwise.
+std::vector<std::uint8_t> robust_row(const std::vector<float>& z, const std::vector<std::vector<float>>& normals,
+                                     Params p) {
+    p.metric = pyrseg_ref::Metric::robust;
+    const int w = static_cast<int>(z.size());
+    const std::vector<float> pts = grid_points(w, 1, [&](int x, int) { return z[static_cast<std::size_t>(x)]; });
+    std::vector<float> nrm;
+    for (const std::vector<float>& n : normals) nrm.insert(nrm.end(), n.begin(), n.end());
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), w, 1, p);
+    EXPECT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.normals, nrm);  // given normals are what the metric uses
+    return out.fillable;
+}
+
+Params stride1() {
+    Params p = robust_params();
+    p.curvature_stride = 1;
+    return p;
+}
+
+const std::vector<float> kFront = {0.0f, 0.0f, -1.0f};
+const std::vector<float> kBack = {0.0f, 0.0f, 1.0f};
+
+TEST(ReferenceRobustMetric, TiltedPlaneEndToEnd) {
+    // 16x16, z = 1000 + x, robust defaults (r = 1 here, R = 3, s = 4): every normal is (5793, 0, -5793) (see the
+    // normals tests), so S = ks * 67117698 >= ks * (2^26 - L); d = 1 - 0 <= 10 everywhere. All fillable -> raw 1.
+    const std::vector<float> pts = grid_points(16, 16, [](int x, int) { return 1000.0f + static_cast<float>(x); });
+    const Params p = robust_params();
+    Output out = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+    ASSERT_TRUE(out.ok) << out.error;
+    std::vector<float> expected_normals;
+    for (int i = 0; i < 256; ++i) {
+        const std::vector<float> n = q13(5793, 0, -5793);
+        expected_normals.insert(expected_normals.end(), n.begin(), n.end());
+    }
+    EXPECT_EQ(out.normals, expected_normals);
+    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>(256, 1)));
+    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(256, 1)));
+    // segment() estimated them with section 8b and the parameters' r, R and unit_mm.
+    EXPECT_EQ(out.normals, pyrseg_ref::estimate_robust_normals(pts.data(), 16, 16, 1, 3, 1.0));
+}
+
+TEST(ReferenceRobustMetric, CreaseSeenAtStrideFourNotAtStrideOne) {
+    // 32x12, z = 1000 + |x - 16| (two 45-degree planes meeting at x = 16), r = 1, R = 3, ct = 0.25, dt = 10.
+    // Normals: x <= 12: (-5793, 0, -5793); x >= 20: (5793, 0, -5793) (windows on one plane only).
+    //   (16,y): per window row the tangents are 3 * (32, 0, -32) + (32, 0, 0) + 3 * (32, 0, 32) = (224, 0, 0):
+    //   frontal (0, 0, -8192).
+    //   (15,y): per row 4 * (32, 0, -32) + (32, 0, 0) + 2 * (32, 0, 32) = (224, 0, -64); U = (1568, 0, -448),
+    //   V = (0, 1568, 0) -> U' = (25088, 0, -7168), V' = (0, 25088, 0), D = (5488, 0, 19208), len = 19976
+    //   -> (-2251, 0, -7877); (17,y) mirrored: (2251, 0, -7877).
+    // Stride 4 at (16,6): 3 left, 3 right, 2 crease normals: S = 6 * 8192 * 5793 + 2 * 2^26 = 418955264 <
+    // 8 * (2^26 - 2086252) = 520180896 -> not fillable. Stride 1: S = 6 * 8192 * 7877 + 2 * 2^26 = 521388032 >=
+    // 520180896 -> fillable. d = 1 - 0 <= 10 either way. (4,6) sees only left-plane normals: fillable with both.
+    const std::vector<float> pts =
+        grid_points(32, 12, [](int x, int) { return 1000.0f + static_cast<float>(x > 16 ? x - 16 : 16 - x); });
+    Params p = robust_params();
+    p.normal_window = 3;
+    Output s4 = pyrseg_ref::segment(pts.data(), nullptr, 32, 12, p);
+    ASSERT_TRUE(s4.ok) << s4.error;
+    EXPECT_EQ(normal_at(s4.normals, 32, 16, 6), q13(0, 0, -8192));
+    EXPECT_EQ(normal_at(s4.normals, 32, 15, 6), q13(-2251, 0, -7877));
+    EXPECT_EQ(normal_at(s4.normals, 32, 17, 6), q13(2251, 0, -7877));
+    EXPECT_EQ(normal_at(s4.normals, 32, 12, 6), q13(-5793, 0, -5793));
+    EXPECT_EQ(normal_at(s4.normals, 32, 20, 6), q13(5793, 0, -5793));
+    EXPECT_EQ(s4.fillable[6 * 32 + 16], 0);
+    EXPECT_EQ(s4.fillable[6 * 32 + 4], 1);
+
+    p.curvature_stride = 1;
+    Output s1 = pyrseg_ref::segment(pts.data(), nullptr, 32, 12, p);
+    ASSERT_TRUE(s1.ok) << s1.error;
+    EXPECT_EQ(s1.normals, s4.normals);  // the stride does not touch the normals
+    EXPECT_EQ(s1.fillable[6 * 32 + 16], 1);
+    EXPECT_EQ(s1.fillable[6 * 32 + 4], 1);
+}
+
+TEST(ReferenceRobustMetric, StrideLooksOnlyAtPixelsAtTheStride) {
+    // 9x1 at z = 1000, pixel 3 faces away (0, 0, 1): S = -2^26 with a frontal pixel, far below 2^26 - L.
+    // Stride 4: pixel 3 sees pixel 7, pixel 7 sees pixel 3 (both fail); every other pixel sees only frontal ones.
+    // Stride 1: pixels 2, 3, 4 see pixel 3 (or are it): S = 2^26 - 2^26 = 0 < 2 * (2^26 - L).
+    std::vector<std::vector<float>> nrm(9, kFront);
+    nrm[3] = kBack;
+    const std::vector<float> z(9, 1000.0f);
+    Params p = robust_params();
+    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{1, 1, 1, 0, 1, 1, 1, 0, 1}));
+    p.curvature_stride = 1;
+    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{1, 1, 0, 0, 0, 1, 1, 1, 1}));
+
+    // 3x3 flat frontal: stride 2 reaches the corners (3 pixels at stride) and edge midpoints (1), not the centre
+    // (ks = 0 -> not fillable); stride 3 reaches nothing.
+    const std::vector<float> pts = grid_points(3, 3, [](int, int) { return 1000.0f; });
+    const std::vector<float> flat = constant_normals(9, 0.0f, 0.0f, -1.0f);
+    p.curvature_stride = 2;
+    Output two = pyrseg_ref::segment(pts.data(), flat.data(), 3, 3, p);
+    ASSERT_TRUE(two.ok) << two.error;
+    EXPECT_EQ(two.fillable, (std::vector<std::uint8_t>{1, 1, 1, 1, 0, 1, 1, 1, 1}));
+    p.curvature_stride = 3;
+    Output three = pyrseg_ref::segment(pts.data(), flat.data(), 3, 3, p);
+    EXPECT_EQ(three.fillable, (std::vector<std::uint8_t>(9, 0)));
+}
+
+TEST(ReferenceRobustMetric, CurvatureLimitIsFloorOfTAndInclusive) {
+    // Two pixels (stride 1, ks = 1): pass iff S >= 2^26 - L.
+    // ct = acos(1 - 8191.75 / 2^26): A = (float)(c0 * 2^26) = 8191.75 -> L = 8191; normals (0,0,-1) and
+    // (0,0,-8191/8192): S = 8192 * 8191 = 67100672 < 67100673 -> edge. With 8192.25: L = 8192, S = 2^26 - L: passes.
+    Params p = stride1();
+    const std::vector<float> almost = {0.0f, 0.0f, -8191.0f / 8192.0f};
+    p.ct = std::acos(1.0 - 8191.75 / 67108864.0);
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, almost}, p), (std::vector<std::uint8_t>{0, 0}));
+    p.ct = std::acos(1.0 - 8192.25 / 67108864.0);
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, almost}, p), (std::vector<std::uint8_t>{1, 1}));
+
+    // ct = pi/2: c0 = 1 - 6.1e-17 rounds to 2^26 as a float -> L = 2^26, the test is S >= 0.
+    p.ct = std::numbers::pi / 2.0;
+    const std::vector<float> side = {1.0f, 0.0f, 0.0f};
+    const std::vector<float> side_back = {1.0f, 0.0f, 1.0f / 8192.0f};
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, side}, p), (std::vector<std::uint8_t>{1, 1}));       // S = 0
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, side_back}, p), (std::vector<std::uint8_t>{0, 0}));  // S = -8192
+
+    // The default stride 4 finds no pixel in a 2x1 image: ks = 0 -> never fillable.
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kFront}, robust_params()), (std::vector<std::uint8_t>{0, 0}));
+}
+
+TEST(ReferenceRobustMetric, CurvatureAtAndAbovePi) {
+    // ct >= pi: A = 2^28, Bc = 0 -> L = 2^28, the test is S >= -3 * ks * 2^26: always. Opposite unit normals
+    // (0,0,-1), (0,0,1): S = -2^26 -> passes. Just below pi c0 = 2 as a double, so A = 2^27 -> L = 2^27, which
+    // passes them with equality. ct = 3.1:
+    // A = (float)((1 - cos 3.1) * 2^26) < 2^27 -> S = -2^26 < 2^26 - L -> edge.
+    Params p = stride1();
+    const std::vector<std::uint8_t> both = {1, 1};
+    const std::vector<std::uint8_t> none = {0, 0};
+    p.ct = std::numbers::pi;
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    p.ct = 100.0;
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    p.ct = std::nextafter(std::numbers::pi, 0.0);
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    p.ct = 3.1;
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), none);
+
+    // (0.70710677, 0, -0.70710677) quantizes to (5793, 0, -5793), |qn|^2 = 67117698 > 2^26, so the opposite pair has
+    // S = -67117698 < -2^26: only L = 2^28 (ct >= pi) passes it whatever the normals; just below pi it is an edge.
+    const std::vector<float> diag = {0.70710677f, 0.0f, -0.70710677f};
+    const std::vector<float> diag_back = {-0.70710677f, 0.0f, 0.70710677f};
+    p.ct = std::numbers::pi;
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {diag, diag_back}, p), both);
+    p.ct = std::nextafter(std::numbers::pi, 0.0);
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {diag, diag_back}, p), none);
+}
+
+TEST(ReferenceRobustMetric, DepthLimitGrowsWithDepthSquared) {
+    // dt = 10 mm, dt_per_m2 = 1: Bd = (float)1e-6. z = 2000: z * z = 4e6, Bd * 4e6 rounds to 4, D = 14 exactly.
+    // The middle pixel sees dd = 0 and the step -> d = step; the ends d = 0.
+    Params p = stride1();
+    p.dt_per_m2 = 1.0;
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.0f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 1, 1}));  // d = 14 = D
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.001f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 0, 1}));  // d = 14.000977 > D
+    // At 1 m the growth is only 1 mm: D = 11.
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1012.0f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 0, 1}));
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1011.0f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 1, 1}));
+    // z * z = +inf (z = 1e20): D = 10 + inf = +inf, any finite d passes.
+    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, {kFront, kFront, kFront}, p), (std::vector<std::uint8_t>{1, 1, 1}));
+    // Without the growth D = dt_units = 10.
+    p.dt_per_m2 = 0.0;
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, {kFront, kFront, kFront}, p),
+              (std::vector<std::uint8_t>{1, 0, 1}));
+    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, {kFront, kFront, kFront}, p), (std::vector<std::uint8_t>{1, 0, 1}));
+
+    // Metres: dt_units = (float)0.01, Bd = (float)1e-3; z = 2: D = 0.01 + 0.004 ~ 0.014 >= 2.012f - 2 ~ 0.012.
+    Params m = stride1();
+    m.unit_mm = 1000.0;
+    m.dt_per_m2 = 1.0;
+    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, {kFront, kFront, kFront}, m), (std::vector<std::uint8_t>{1, 1, 1}));
+    m.dt_per_m2 = 0.0;
+    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, {kFront, kFront, kFront}, m), (std::vector<std::uint8_t>{1, 0, 1}));
+}
+
+TEST(ReferenceRobustMetric, CurvatureGrowthMakesANoisyFarSurfaceFillable) {
+    // Normals alternating (+-1024, 0, -8128) / 8192 along a row: each pixel's neighbours have the other sign,
+    // qn . qn' = 8128^2 - 1024^2 = 65015808, so a pixel passes iff L >= 2^26 - 65015808 = 2093056.
+    // No growth: L = 2086252 -> edges. ct_growth_per_m2 = 0.01: Bc = (float)(c0 * 2^26 * 0.01 * 1e-6) =
+    // 0.0208625197...; z = 3000: t = A + Bc * 9e6 = 2274014.75 -> L = 2274014: fillable. The same surface at z = 500:
+    // t = 2091467.75 -> L = 2091467 < 2093056: still edges.
+    const std::vector<float> plus = {1024.0f / 8192.0f, 0.0f, -8128.0f / 8192.0f};
+    const std::vector<float> minus = {-1024.0f / 8192.0f, 0.0f, -8128.0f / 8192.0f};
+    const std::vector<std::vector<float>> noisy = {plus, minus, plus};
+    Params p = stride1();
+    EXPECT_EQ(robust_row({3000.0f, 3000.0f, 3000.0f}, noisy, p), (std::vector<std::uint8_t>{0, 0, 0}));
+    p.ct_growth_per_m2 = 0.01;
+    EXPECT_EQ(robust_row({3000.0f, 3000.0f, 3000.0f}, noisy, p), (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(robust_row({500.0f, 500.0f, 500.0f}, noisy, p), (std::vector<std::uint8_t>{0, 0, 0}));
+    // z * z = +inf: t = +inf -> L = 2^27, even opposite normals pass.
+    EXPECT_EQ(robust_row({1e20f, 1e20f}, {kFront, kBack}, p), (std::vector<std::uint8_t>{1, 1}));
+    p.ct_growth_per_m2 = 0.0;
+    EXPECT_EQ(robust_row({1e20f, 1e20f}, {kFront, kBack}, p), (std::vector<std::uint8_t>{0, 0}));
+}
+
+TEST(ReferenceRobustMetric, ParameterErrors) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // Rejected by every entry point, with a message naming the parameter.
+    auto rejected_for = [&](const Params& p, const std::string& name) {
+        Output a = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+        Output b = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+        Output c = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+        for (const Output* o : {&a, &b, &c}) {
+            if (o->ok || o->error.find(name) == std::string::npos) return false;
+        }
+        return true;
+    };
+    auto accepted = [&](const Params& p) {
+        return pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok &&
+               pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p).ok &&
+               pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p).ok;
+    };
+    auto with = [](Params p, auto change) {
+        change(p);
+        return p;
+    };
+    const Params paper;
+    const Params robust = robust_params();
+    EXPECT_TRUE(accepted(paper));
+    EXPECT_TRUE(accepted(robust));
+
+    // Paper: the four must keep their defaults.
+    EXPECT_TRUE(rejected_for(with(paper, [](Params& p) { p.normal_window = 2; }), "normal_window"));
+    EXPECT_TRUE(rejected_for(with(paper, [](Params& p) { p.curvature_stride = 1; }), "curvature_stride"));
+    EXPECT_TRUE(rejected_for(with(paper, [](Params& p) { p.dt_per_m2 = 1.0; }), "dt_per_m2"));
+    EXPECT_TRUE(rejected_for(with(paper, [](Params& p) { p.ct_growth_per_m2 = 0.5; }), "ct_growth_per_m2"));
+
+    // Robust: ranges.
+    EXPECT_TRUE(rejected_for(with(robust, [](Params& p) { p.normal_window = 0; }), "normal_window"));
+    EXPECT_TRUE(rejected_for(with(robust, [](Params& p) { p.normal_window = 8; }), "normal_window"));
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.normal_window = 1; })));
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.normal_window = 7; })));
+    EXPECT_TRUE(rejected_for(with(robust, [](Params& p) { p.curvature_stride = 0; }), "curvature_stride"));
+    EXPECT_TRUE(rejected_for(with(robust, [](Params& p) { p.curvature_stride = 65; }), "curvature_stride"));
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.curvature_stride = 1; })));
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.curvature_stride = 64; })));
+    for (double bad : {-1.0, nan, inf, -inf}) {
+        EXPECT_TRUE(rejected_for(with(robust, [&](Params& p) { p.dt_per_m2 = bad; }), "dt_per_m2")) << bad;
+        EXPECT_TRUE(rejected_for(with(robust, [&](Params& p) { p.ct_growth_per_m2 = bad; }), "ct_growth_per_m2"))
+            << bad;
+    }
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.dt_per_m2 = 1e6; })));
+    EXPECT_TRUE(accepted(with(robust, [](Params& p) { p.ct_growth_per_m2 = 1e6; })));
+    // The section 2 checks still apply, and normal_radius still matters only when normals are estimated.
+    EXPECT_FALSE(accepted(with(robust, [](Params& p) { p.ct = -1.0; })));
+    const Params r0 = with(robust, [](Params& p) { p.normal_radius = 0; });
+    EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, r0).ok);
+    EXPECT_FALSE(pyrseg_ref::segment(pts.data(), nullptr, 16, 16, r0).ok);
+}
+
 }  // namespace

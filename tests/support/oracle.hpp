@@ -28,6 +28,11 @@ inline pyrseg_ref::Params to_reference(const Params& p) {
     r.label_edges = p.label_edges;
     r.compact = p.compact;
     r.normal_radius = p.normal_radius;
+    r.metric = p.metric == Metric::robust ? pyrseg_ref::Metric::robust : pyrseg_ref::Metric::paper;
+    r.normal_window = p.normal_window;
+    r.curvature_stride = p.curvature_stride;
+    r.dt_per_m2 = p.dt_per_m2;
+    r.ct_growth_per_m2 = p.ct_growth_per_m2;
     return r;
 }
 
