@@ -46,6 +46,42 @@ PYR_FN pyr_u32 pyr_robust_is_zero(PyrIVec3 v) {
     return (v.x == 0 && v.y == 0 && v.z == 0) ? 1u : 0u;
 }
 
+/* The tangents of pixel (x, y) and its fixed-point depth (section 8b). */
+PYR_FN PyrRobustTexel pyr_robust_texel(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r,
+                                       pyr_f32 scale) {
+    PyrRobustTexel t;
+    t.gz = -1;
+    t.tangents = 0u;
+    t.th.x = 0;
+    t.th.y = 0;
+    t.th.z = 0;
+    t.tv = t.th;
+    if (pyr_robust_point_valid(PYR_CTX_ARG, x, y) == 0u) return t;
+    t.gz = pyr_robust_fixed(PYR_PT(x, y, 2), scale);
+    if (x >= r && x + r < w && pyr_robust_point_valid(PYR_CTX_ARG, x + r, y) != 0u &&
+        pyr_robust_point_valid(PYR_CTX_ARG, x - r, y) != 0u) {
+        t.tangents |= 1u;
+        t.th.x = pyr_robust_tangent(PYR_CTX_ARG, x + r, y, x - r, y, 0u, scale);
+        t.th.y = pyr_robust_tangent(PYR_CTX_ARG, x + r, y, x - r, y, 1u, scale);
+        t.th.z = pyr_robust_tangent(PYR_CTX_ARG, x + r, y, x - r, y, 2u, scale);
+    }
+    if (y >= r && y + r < h && pyr_robust_point_valid(PYR_CTX_ARG, x, y + r) != 0u &&
+        pyr_robust_point_valid(PYR_CTX_ARG, x, y - r) != 0u) {
+        t.tangents |= 2u;
+        t.tv.x = pyr_robust_tangent(PYR_CTX_ARG, x, y + r, x, y - r, 0u, scale);
+        t.tv.y = pyr_robust_tangent(PYR_CTX_ARG, x, y + r, x, y - r, 1u, scale);
+        t.tv.z = pyr_robust_tangent(PYR_CTX_ARG, x, y + r, x, y - r, 2u, scale);
+    }
+    return t;
+}
+
+/* Where a window reads its texels. GPUs compute each where it is needed (neighbouring invocations share the point
+ * loads in cache); the CPU defines this to read texels it computed once per frame. It expands inside
+ * pyr_robust_normal_q, whose parameters (w, h, r, scale) it names. */
+#ifndef PYR_ROBUST_TEXEL
+#define PYR_ROBUST_TEXEL(jx, jy) pyr_robust_texel(PYR_CTX_ARG, w, h, jx, jy, r, scale)
+#endif
+
 PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r,
                                     pyr_u32 window, pyr_f32 scale) {
     PyrIVec3 none;
@@ -67,19 +103,17 @@ PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32
     pyr_u32 x1 = x + window < w ? x + window : w - 1u;
     for (pyr_u32 jy = y0; jy <= y1; ++jy) {
         for (pyr_u32 jx = x0; jx <= x1; ++jx) {
-            if (pyr_robust_point_valid(PYR_CTX_ARG, jx, jy) == 0u) continue;
-            if (pyr_iabs(pyr_robust_fixed(PYR_PT(jx, jy, 2), scale) - zi) > jump) continue;
-            if (jx >= r && jx + r < w && pyr_robust_point_valid(PYR_CTX_ARG, jx + r, jy) != 0u &&
-                pyr_robust_point_valid(PYR_CTX_ARG, jx - r, jy) != 0u) {
-                u.x += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 0u, scale);
-                u.y += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 1u, scale);
-                u.z += pyr_robust_tangent(PYR_CTX_ARG, jx + r, jy, jx - r, jy, 2u, scale);
+            PyrRobustTexel t = PYR_ROBUST_TEXEL(jx, jy);
+            if (t.gz < 0 || pyr_iabs(t.gz - zi) > jump) continue;
+            if ((t.tangents & 1u) != 0u) {
+                u.x += t.th.x;
+                u.y += t.th.y;
+                u.z += t.th.z;
             }
-            if (jy >= r && jy + r < h && pyr_robust_point_valid(PYR_CTX_ARG, jx, jy + r) != 0u &&
-                pyr_robust_point_valid(PYR_CTX_ARG, jx, jy - r) != 0u) {
-                v.x += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 0u, scale);
-                v.y += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 1u, scale);
-                v.z += pyr_robust_tangent(PYR_CTX_ARG, jx, jy + r, jx, jy - r, 2u, scale);
+            if ((t.tangents & 2u) != 0u) {
+                v.x += t.tv.x;
+                v.y += t.tv.y;
+                v.z += t.tv.z;
             }
         }
     }

@@ -28,6 +28,16 @@ struct PyrIVec3 {
     pyr_i32 z;
 };
 
+/* One pixel's share of the robust normals' windows (docs/algorithm.md section 8b): its fixed-point depth G(z) (-1
+ * when the point is not point-valid) and its tangents, bit 0 of `tangents` when t_h exists, bit 1 when t_v does. */
+PYR_TYPEDEF(PyrRobustTexel)
+struct PyrRobustTexel {
+    pyr_i32 gz;
+    pyr_u32 tangents;
+    PyrIVec3 th;
+    PyrIVec3 tv;
+};
+
 /* A quantized pixel: validity and qn (contract section 2). */
 PYR_TYPEDEF(PyrQuant)
 struct PyrQuant {

@@ -87,12 +87,23 @@ public:
     void estimate_normals() override {
         const size_t w = size_t(plan_.width);
         if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
-        const PassContext c = context();
         const auto radius = uint32_t(plan_.params.normal_radius);
         const auto window = uint32_t(plan_.params.normal_window);
         const float scale = plan_.thresholds.point_scale;
         const bool robust = plan_.params.metric == Metric::robust;
         const auto h = uint32_t(plan_.height);
+        PassContext c = context();
+        if (robust) {
+            // Each pixel's tangents once, rather than once for every window that holds the pixel.
+            if (robust_texels_.empty()) robust_texels_.resize(plan_.pixel_count());  // once per Segmenter
+            rows(size_t(plan_.height), [&](size_t y) {
+                for (size_t x = 0; x < w; ++x) {
+                    robust_texels_[y * w + x] =
+                        kernels::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius, scale);
+                }
+            });
+            c.robust_texels = robust_texels_.data();
+        }
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
                 const PyrIVec3 q = robust ? kernels::pyr_robust_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y),
@@ -415,7 +426,8 @@ private:
     const core::Plan& plan_;
     ThreadPool pool_;
     CloudView cloud_{};
-    std::vector<float> normals_;  // estimated, packed
+    std::vector<float> normals_;                 // estimated, packed
+    std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
     std::vector<QuantPixel> quant_;
     std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
     std::vector<std::uint8_t> mask_;        // all levels
@@ -442,10 +454,11 @@ size_t physical_memory_bytes() {
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
     return pixels * (sizeof(QuantPixel) + 1 + 3 * sizeof(float)) +  // quantized pixels, mask validity, normals
-           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
-           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
-           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                         // union-find
-           plan.stats_words() * sizeof(uint32_t);                                   // statistics
+           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +        // masks, labels
+           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                              // compaction table
+           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                               // union-find
+           plan.stats_words() * sizeof(uint32_t) +                                        // statistics
+           (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0);  // robust normals' texels
 }
 
 }  // namespace

@@ -25,7 +25,8 @@ struct PassContext {
     std::uint8_t* mask = nullptr;              // all levels
     std::uint32_t* labels = nullptr;           // all levels
     const std::uint32_t* lut = nullptr;
-    std::uint32_t* stats = nullptr;  // the statistics words, PYR_STATS_WORDS per slot
+    std::uint32_t* stats = nullptr;                 // the statistics words, PYR_STATS_WORDS per slot
+    const PyrRobustTexel* robust_texels = nullptr;  // the robust normals' texels of the frame, W*H
 };
 
 inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
@@ -43,6 +44,10 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_Q_VALID(i) static_cast<std::uint32_t>(ctx.quant[i].valid)
 #define PYR_QN(i, c) static_cast<std::int32_t>(ctx.quant[i].q[c])
 #define PYR_QZ(i) (ctx.quant[i].z)
+// The robust normals read the texels estimate_normals computed once per frame (w: the image width, named by the
+// function it expands in, as are r and scale, which the GPUs' definition uses and this one need not).
+#define PYR_ROBUST_TEXEL(jx, jy) \
+    ((void)h, (void)r, (void)scale, ctx.robust_texels[static_cast<std::size_t>(jy) * (w) + (jx)])
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
