@@ -53,6 +53,10 @@ void check_metric_parameters(const Params& p) {
         bad_parameter("curvature_stride must be in 1.." + std::to_string(kMaxCurvatureStride) + ", got " +
                       std::to_string(p.curvature_stride));
     }
+    if (p.edge_rounds < 1 || p.edge_rounds > kMaxEdgeRounds) {
+        bad_parameter("edge_rounds must be in 1.." + std::to_string(kMaxEdgeRounds) + ", got " +
+                      std::to_string(p.edge_rounds));
+    }
     if (p.metric == Metric::paper &&
         (p.normal_window != kDefaultNormalWindow || p.curvature_stride != kDefaultCurvatureStride ||
          p.dt_per_m2 != 0.0 || p.ct_growth_per_m2 != 0.0)) {

@@ -19,16 +19,23 @@ constexpr std::array kKinds = {SensorKind::structured_light, SensorKind::kinect_
 constexpr double kConsumerSecondDifference = 0.4;
 constexpr std::size_t kMinSamples = 1000;
 
-Params robust(double ct, double ct_growth, double dt, double dt_per_m2, int stride) {
+// The robust metric with normal radius 1: the window (R) does the smoothing.
+struct Robust {
+    double ct, ct_growth_per_m2, dt, dt_per_m2;
+    int window, stride, edge_rounds;
+};
+
+Params robust(const Robust& r) {
     Params p;
     p.metric = Metric::robust;
     p.normal_radius = 1;
-    p.normal_window = 3;
-    p.curvature_stride = stride;
-    p.ct = ct;
-    p.ct_growth_per_m2 = ct_growth;
-    p.dt = dt;
-    p.dt_per_m2 = dt_per_m2;
+    p.normal_window = r.window;
+    p.curvature_stride = r.stride;
+    p.ct = r.ct;
+    p.ct_growth_per_m2 = r.ct_growth_per_m2;
+    p.dt = r.dt;
+    p.dt_per_m2 = r.dt_per_m2;
+    p.edge_rounds = r.edge_rounds;
     return p;
 }
 
@@ -80,14 +87,16 @@ Params sensor_preset(SensorKind kind, double unit_mm) {
     switch (kind) {
         case SensorKind::structured_light:
             break;
+        // Chosen with `pyrseg eval` on the synthetic sensor models (docs/quality.md, "Choosing the presets") and
+        // checked on the shared real scans (tests/cli): ct, ct growth, dt, dt growth, R, s, edge rounds.
         case SensorKind::kinect_v1:
-            p = robust(0.3, 0.2, 5.0, 10.0, 6);
+            p = robust({0.6, 0.1, 5.0, 10.0, 3, 6, 8});
             break;
         case SensorKind::realsense_d435:
-            p = robust(0.3, 0.2, 5.0, 10.0, 6);
+            p = robust({0.6, 0.3, 5.0, 10.0, 4, 6, 10});
             break;
         case SensorKind::azure_kinect:
-            p = robust(0.3, 0.1, 5.0, 4.0, 6);
+            p = robust({0.4, 0.1, 5.0, 4.0, 3, 4, 8});
             break;
         default:
             throw Error(ErrorCode::invalid_parameter, "unknown sensor kind");

@@ -8,6 +8,7 @@
 
 #include "pyrseg/cloud.hpp"
 #include "pyrseg/result.hpp"
+#include "shaders/pyr_types.h"
 
 namespace pyrseg::core {
 
@@ -62,10 +63,11 @@ inline void unstage_results(const unsigned char* staged, std::size_t pixels, boo
             for (std::size_t i = 0; i < pixels; ++i) {
                 std::uint32_t v = 0;
                 std::memcpy(&v, mask + 4 * i, 4);
-                out.fillable_mask[i] = static_cast<std::uint8_t>(v);
+                out.fillable_mask[i] = static_cast<std::uint8_t>(v & PYR_MASK_FILLABLE);
             }
         } else {
-            std::memcpy(out.fillable_mask.data(), mask, pixels);
+            // Bit 0 is B; edge labelling's rounds live in the bits above it.
+            for (std::size_t i = 0; i < pixels; ++i) out.fillable_mask[i] = mask[i] & PYR_MASK_FILLABLE;
         }
     }
     out.normals.clear();

@@ -309,16 +309,21 @@ PYR_KERNEL_GROUPS(final_lines) {
 }
 #endif
 
-/* edges (2D, w x h): h, offset of level N. In place: only valid, non-fillable, unlabelled pixels change, and no
- * pixel reads those. */
+/* edges (2D, w x h): h, offset of level N, round (1..63), rounds (E). In place: only valid, non-fillable,
+ * unlabelled pixels change, and no pixel of this round reads those. With more than one round, a pixel labelled here
+ * records the round in its mask, for the rounds after it. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_EDGES)
 PYR_KERNEL_2D(edges) {
     pyr_u32 x = PYR_X;
     pyr_u32 y = PYR_Y;
     if (x >= PYR_W || y >= PYR_ARG(0)) return;
     pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
-    pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y);
-    if (l != pyr_buf_labels[i]) pyr_buf_labels[i] = l;
+    pyr_u32 round = PYR_ARG(2);
+    pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, round);
+    if (l != pyr_buf_labels[i]) {
+        pyr_buf_labels[i] = l;
+        if (round < PYR_ARG(3)) PYR_STORE_MASK(i, PYR_MASK(i) | (round << PYR_MASK_EDGE_SHIFT));
+    }
 }
 #endif
 

@@ -136,50 +136,59 @@ PYR_FN pyr_f32 pyr_robust_depth_limit(pyr_f32 z, pyr_f32 dt, pyr_f32 growth) {
     return growth == 0.0f ? dt : d;
 }
 
+/* Whether the pixel at (x + dx, y + dy) exists and is valid; its index in j. */
+PYR_FN pyr_u32 pyr_robust_valid_at(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_i32 x, pyr_i32 y) {
+    if (x < 0 || x >= PYR_I32(w) || y < 0 || y >= PYR_I32(h)) return 0u;
+    return PYR_Q_VALID(PYR_U32(y) * w + PYR_U32(x));
+}
+
+PYR_FN pyr_i32 pyr_robust_dot(PYR_CTX_PARAM, pyr_u32 a, pyr_u32 b) {
+    return PYR_QN(a, 0) * PYR_QN(b, 0) + PYR_QN(a, 1) * PYR_QN(b, 1) + PYR_QN(a, 2) * PYR_QN(b, 2);
+}
+
 PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 stride,
                                           pyr_f32 curvature_base, pyr_f32 curvature_growth, pyr_f32 dt,
                                           pyr_f32 depth_growth) {
     pyr_u32 i = y * w + x;
     if (PYR_Q_VALID(i) == 0u) return 0u;
-    pyr_i32 qx = PYR_QN(i, 0);
-    pyr_i32 qy = PYR_QN(i, 1);
-    pyr_i32 qz = PYR_QN(i, 2);
     pyr_f32 z = PYR_QZ(i);
+    /* Depth: the 8 neighbours at stride 1, as section 2. */
     pyr_i32 k1 = 0;
-    pyr_i32 ks = 0;
-    pyr_i32 s = 0; /* |s| <= 8 * 3 * 2^26 < 2^31 */
     pyr_f32 dmin = 0.0f;
     pyr_f32 dmax = 0.0f;
-    pyr_i32 stride_i = PYR_I32(stride);
     for (pyr_i32 dy = -1; dy <= 1; ++dy) {
         for (pyr_i32 dx = -1; dx <= 1; ++dx) {
             if (dx == 0 && dy == 0) continue;
             pyr_i32 nx = PYR_I32(x) + dx;
             pyr_i32 ny = PYR_I32(y) + dy;
-            if (nx >= 0 && nx < PYR_I32(w) && ny >= 0 && ny < PYR_I32(h)) {
-                pyr_u32 j = PYR_U32(ny) * w + PYR_U32(nx);
-                if (PYR_Q_VALID(j) != 0u) {
-                    PYR_PRECISE pyr_f32 dd = PYR_FABS(z - PYR_QZ(j));
-                    dmin = (k1 == 0 || dd < dmin) ? dd : dmin;
-                    dmax = (k1 == 0 || dd > dmax) ? dd : dmax;
-                    ++k1;
-                }
-            }
-            pyr_i32 sx = PYR_I32(x) + dx * stride_i;
-            pyr_i32 sy = PYR_I32(y) + dy * stride_i;
-            if (sx >= 0 && sx < PYR_I32(w) && sy >= 0 && sy < PYR_I32(h)) {
-                pyr_u32 j = PYR_U32(sy) * w + PYR_U32(sx);
-                if (PYR_Q_VALID(j) != 0u) {
-                    s += qx * PYR_QN(j, 0) + qy * PYR_QN(j, 1) + qz * PYR_QN(j, 2);
-                    ++ks;
-                }
-            }
+            if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, nx, ny) == 0u) continue;
+            PYR_PRECISE pyr_f32 dd = PYR_FABS(z - PYR_QZ(PYR_U32(ny) * w + PYR_U32(nx)));
+            dmin = (k1 == 0 || dd < dmin) ? dd : dmin;
+            dmax = (k1 == 0 || dd > dmax) ? dd : dmax;
+            ++k1;
         }
     }
-    if (k1 == 0 || ks == 0) return 0u;
-    /* ks * (2^26 - L) lies in [-3 * 2^29, 2^29] since 0 <= L <= 2^28. */
+    /* Curvature: the normals s pixels before and after the pixel along the 4 axes (horizontal, vertical, both
+     * diagonals), each pair whose two pixels exist and are valid. |s| <= 4 * 3 * 2^26 < 2^31. */
+    pyr_i32 kp = 0;
+    pyr_i32 s = 0;
+    pyr_i32 st = PYR_I32(stride);
+    for (pyr_i32 axis = 0; axis < 4; ++axis) {
+        pyr_i32 dx = axis == 1 ? 0 : 1;
+        pyr_i32 dy = axis == 0 ? 0 : (axis == 3 ? -1 : 1);
+        pyr_i32 ax = PYR_I32(x) + dx * st;
+        pyr_i32 ay = PYR_I32(y) + dy * st;
+        pyr_i32 bx = PYR_I32(x) - dx * st;
+        pyr_i32 by = PYR_I32(y) - dy * st;
+        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, ax, ay) == 0u) continue;
+        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, bx, by) == 0u) continue;
+        s += pyr_robust_dot(PYR_CTX_ARG, PYR_U32(ay) * w + PYR_U32(ax), PYR_U32(by) * w + PYR_U32(bx));
+        ++kp;
+    }
+    if (k1 == 0 || kp == 0) return 0u;
+    /* kp * (2^26 - L) lies in [-3 * 2^28, 2^28] since 0 <= L <= 2^28. */
     pyr_i32 limit = pyr_robust_curvature_limit(z, curvature_base, curvature_growth);
-    if (s < ks * (PYR_I32(1 << 26) - limit)) return 0u;
+    if (s < kp * (PYR_I32(1 << 26) - limit)) return 0u;
     PYR_PRECISE pyr_f32 d = dmax - dmin;
     return d <= pyr_robust_depth_limit(z, dt, depth_growth) ? 1u : 0u;
 }

@@ -64,6 +64,8 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 /* Mask bits of a texel. Only the fill at level N-1 (step 4) sets the anchor bit. */
 #define PYR_MASK_FILLABLE 1u
 #define PYR_MASK_ANCHORED 2u
+/* Level N only: the round of step 6c that labelled an edge pixel, 1..63, in bits 2..7 (0: none). */
+#define PYR_MASK_EDGE_SHIFT 2u
 
 /* Compaction's scan numbers the label table in chunks of this many entries, one invocation per chunk
  * (shaders/pyr_scan.h; core/plan.hpp sizes the table and the chunk sums once for every backend). */

@@ -27,11 +27,14 @@ constexpr const char* kDemoUsage =
     "structured-light noise and holes), segments it from its points alone (normals estimated) with every\n"
     "available backend, checks that all backends give the same labels byte for byte, prints a timing table,\n"
     "and writes pictures. The shared sample scans (*.pcd in --data, default ../shared/data) are segmented too\n"
-    "when present.\n"
+    "when present, each with the preset of the kind of sensor its depth noise looks like (as --sensor auto).\n"
+    "--sensor NAME (see the parameters) renders the synthetic scene as that sensor model sees it instead\n"
+    "(docs/sensors.md) and segments it, and the scans, with that sensor's preset.\n"
     "  --out DIR     where the pictures go (default pyrseg-demo)\n"
     "  --size WxH    scene size (default 2064x1544, a Photoneo PhoXi frame)\n"
     "  --seed N      scene seed (default 1)\n"
-    "  --noise MM    sensor noise of the scene, sigma along the viewing ray (default 0.1 mm, PhoXi-like)\n"
+    "  --noise MM    structured-light noise of the scene, sigma along the viewing ray (default 0.1 mm,\n"
+    "                PhoXi-like; the other sensor models have their own)\n"
     "  --runs N      timed runs per backend after one warm-up (default 5)\n"
     "  --data DIR    folder of sample .pcd scans (default ../shared/data)\n"
     "\n";
@@ -155,11 +158,18 @@ int cmd_demo(const std::vector<std::string>& argv) {
     const fs::path out_dir = args.value("out").value_or("pyrseg-demo");
     fs::create_directories(out_dir);
     const Params params = parse_params(args);
+    // --sensor NAME also renders the synthetic scene as that sensor model sees it (docs/sensors.md).
+    const std::optional<SensorChoice> sensor = parse_sensor(args);
+    if (sensor && !sensor->automatic) {
+        const auto model = synthetic::sensor_from_name(sensor_kind_name(sensor->kind));
+        if (model) scene_options.sensor = *model;
+    }
 
     auto start = std::chrono::steady_clock::now();
     const synthetic::Scene scene = synthetic::generate(scene_options);
-    std::printf("synthetic scene %d x %d (seed %llu) generated in %.0f ms\n", scene.width, scene.height,
-                static_cast<unsigned long long>(scene_options.seed), ms_since(start));
+    std::printf("synthetic scene %d x %d (seed %llu, %s) generated in %.0f ms\n", scene.width, scene.height,
+                static_cast<unsigned long long>(scene_options.seed), synthetic::sensor_name(scene_options.sensor),
+                ms_since(start));
     std::vector<fs::path> written;
     CloudView view;
     view.points = scene.points.data();
@@ -182,12 +192,22 @@ int cmd_demo(const std::vector<std::string>& argv) {
             Params scan_params = params;
             // The shared scans are in metres; a cloud whose median depth is under 20 units is taken as metres.
             if (!args.value("unit-mm") && median_depth(cloud.points) < 20.0) scan_params.unit_mm = 1000.0;
-            std::printf("\n%s (unit %g mm)\n", scan.filename().string().c_str(), scan_params.unit_mm);
             CloudView scan_view;
             scan_view.points = cloud.points.data();
             scan_view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();
             scan_view.width = cloud.width;
             scan_view.height = cloud.height;
+            // Each scan gets the preset of the kind of sensor its noise looks like, unless --sensor names one.
+            std::string chosen = "parameters as given";
+            if (!sensor || sensor->automatic) {
+                const FrameNoise noise = measure_frame_noise(scan_view, scan_params.unit_mm);
+                const double unit_mm = scan_params.unit_mm;
+                scan_params = parse_params(args, noise.suggested);
+                scan_params.unit_mm = unit_mm;
+                chosen = std::string("sensor auto: ") + sensor_kind_name(noise.suggested) + ", " + noise.reason;
+            }
+            std::printf("\n%s (unit %g mm; %s)\n", scan.filename().string().c_str(), scan_params.unit_mm,
+                        chosen.c_str());
             agree = segment_everywhere(scan.stem().string(), scan_view, scan_params, runs, out_dir, written) && agree;
         }
     } else {

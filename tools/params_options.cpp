@@ -31,12 +31,15 @@ const char* const kParameterHelp =
     "  --curvature-stride S  robust: normals compared S pixels apart (1..64, default 4).\n"
     "  --dt-per-m2 MM        robust: millimetres added to --dt per square metre of depth (default 0).\n"
     "  --ct-growth G         robust: 1 - cos(ct) grows by G per square metre of depth (default 0).\n"
+    "  --edge-rounds E       label edge pixels up to E steps from a segment (1..63, default 1: the contract's one\n"
+    "                        layer); the robust presets use more, to share out their wider edge bands.\n"
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const std::set<std::string> kParameterValueOptions = {
-    "ct",     "dt",     "unit-mm",       "bridge-levels",    "unjoinable-gap", "normal-radius",
-    "metric", "sensor", "normal-window", "curvature-stride", "dt-per-m2",      "ct-growth"};
+    "ct",         "dt",     "unit-mm",       "bridge-levels",    "unjoinable-gap", "normal-radius",
+    "metric",     "sensor", "normal-window", "curvature-stride", "dt-per-m2",      "ct-growth",
+    "edge-rounds"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
 
 std::optional<SensorChoice> parse_sensor(const Args& args) {
@@ -74,6 +77,7 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.integer("curvature-stride")) p.curvature_stride = *v;
     if (auto v = args.number("dt-per-m2")) p.dt_per_m2 = *v;
     if (auto v = args.number("ct-growth")) p.ct_growth_per_m2 = *v;
+    if (auto v = args.integer("edge-rounds")) p.edge_rounds = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

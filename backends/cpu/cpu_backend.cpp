@@ -198,16 +198,40 @@ public:
         const PassContext c = context();
         const PyrLevel full = plan_.full();
         std::fill(lut_.begin(), lut_.end(), 0u);
-        rows(full.height, [&](size_t y) {
-            for (uint32_t x = 0; x < full.width; ++x) {
-                const uint32_t i = full.offset + uint32_t(y) * full.width + x;
-                // Only edge pixels change, and no other pixel reads them: writing only changes keeps rows
-                // free of races on the fillable labels they read.
-                const uint32_t l = kernels::pyr_edge_label(c, full, x, uint32_t(y));
-                if (l != labels_[i]) labels_[i] = l;
-            }
-            mark_row(y);
-        });
+        const auto rounds = uint32_t(plan_.params.edge_rounds);
+        if (rounds == 1) {
+            rows(full.height, [&](size_t y) {
+                for (uint32_t x = 0; x < full.width; ++x) {
+                    const uint32_t i = full.offset + uint32_t(y) * full.width + x;
+                    // Only edge pixels change, and no other pixel reads them: writing only changes keeps rows
+                    // free of races on the fillable labels they read.
+                    const uint32_t l = kernels::pyr_edge_label(c, full, x, uint32_t(y), 1u);
+                    if (l != labels_[i]) labels_[i] = l;
+                }
+                mark_row(y);
+            });
+            return;
+        }
+        // Several rounds: each one reads its neighbours' masks, which the round's own writes change, so it first
+        // computes every new label and then writes them (with the round in the mask).
+        if (edge_next_.empty()) edge_next_.resize(plan_.pixel_count());  // once per Segmenter
+        for (uint32_t round = 1; round <= rounds; ++round) {
+            rows(full.height, [&](size_t y) {
+                for (uint32_t x = 0; x < full.width; ++x) {
+                    edge_next_[y * full.width + x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
+                }
+            });
+            rows(full.height, [&](size_t y) {
+                for (uint32_t x = 0; x < full.width; ++x) {
+                    const uint32_t i = full.offset + uint32_t(y) * full.width + x;
+                    const uint32_t l = edge_next_[y * full.width + x];
+                    if (l == labels_[i]) continue;
+                    labels_[i] = l;
+                    if (round < rounds) mask_[i] = std::uint8_t(mask_[i] | (round << PYR_MASK_EDGE_SHIFT));
+                }
+                if (round == rounds) mark_row(y);
+            });
+        }
     }
 
     void compact(bool apply, bool after_edges) override {
@@ -262,7 +286,10 @@ public:
         }
         if (outputs.fillable_mask) {
             const std::uint8_t* m = mask_.data() + plan_.full().offset;
-            out.fillable_mask.assign(m, m + pixels);
+            out.fillable_mask.resize(pixels);
+            // Bit 0 is B; edge labelling's rounds live in the bits above it.
+            std::transform(m, m + pixels, out.fillable_mask.begin(),
+                           [](std::uint8_t v) { return std::uint8_t(v & PYR_MASK_FILLABLE); });
         } else {
             out.fillable_mask.clear();
         }
@@ -428,6 +455,7 @@ private:
     CloudView cloud_{};
     std::vector<float> normals_;                 // estimated, packed
     std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
+    std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)
     std::vector<QuantPixel> quant_;
     std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
     std::vector<std::uint8_t> mask_;        // all levels
@@ -454,11 +482,12 @@ size_t physical_memory_bytes() {
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
     return pixels * (sizeof(QuantPixel) + 1 + 3 * sizeof(float)) +  // quantized pixels, mask validity, normals
-           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +        // masks, labels
-           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                              // compaction table
-           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                               // union-find
-           plan.stats_words() * sizeof(uint32_t) +                                        // statistics
-           (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0);  // robust normals' texels
+           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +         // masks, labels
+           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                               // compaction table
+           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                                // union-find
+           plan.stats_words() * sizeof(uint32_t) +                                         // statistics
+           (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0) +  // robust normals' texels
+           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0);             // edge rounds' labels
 }
 
 }  // namespace

@@ -152,7 +152,12 @@ public:
                  args({l.width, l.height, l.offset, p.width, p.height, p.offset, 0u}));
     }
 
-    void label_edges() override { dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset})); }
+    void label_edges() override {
+        const auto rounds = uint32_t(plan_.params.edge_rounds);
+        for (uint32_t round = 1; round <= rounds; ++round) {
+            dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset, round, rounds}));
+        }
+    }
 
     void compact(bool apply, bool /*after_edges*/) override {
         const uint32_t count = plan_.lut_size();

@@ -14,6 +14,7 @@ inline constexpr int kDefaultNormalWindow = 3;              // robust normals: (
 inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: normals compared this far apart
 inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
+inline constexpr int kMaxEdgeRounds = 63;
 
 // Which fillable test (docs/algorithm.md): the paper's (section 2, the contract) for low-noise scanners, or the
 // robust one (sections 2b and 8b) for depth cameras whose noise grows with the square of the depth.
@@ -27,7 +28,11 @@ struct Params {
     // not fit the image is rejected instead.
     std::optional<int> bridge_levels;
     std::optional<int> unjoinable_gap;
-    bool label_edges = true;                   // step 6c: valid edge pixels join their smallest labelled neighbour
+    bool label_edges = true;  // step 6c: valid edge pixels join their smallest labelled neighbour
+    // Rounds of step 6c, 1..63 (docs/algorithm.md section 5): 1 is the contract's one layer of edge pixels; each
+    // further round labels the next layer of an edge band from the layer before, so that wide bands (the robust
+    // metric's) are shared out among the segments on either side.
+    int edge_rounds = 1;
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
     Metric metric = Metric::paper;

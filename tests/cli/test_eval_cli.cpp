@@ -1,5 +1,6 @@
-// `pyrseg eval`, run as a user runs it: the quick sweep writes its table and plots, and on it the pyramid merges
-// no more ground-truth objects than plain connected components once bridges are added (the paper's claim).
+// `pyrseg eval`, run as a user runs it: the quick sweeps (sensor models x distances, and the noise sweep) write their
+// tables and plots, and on them the pyramid merges no more ground-truth objects than plain connected components once
+// bridges are added (the paper's claim).
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -37,7 +38,9 @@ std::vector<std::string> cells_of(const std::string& row) {
 TEST(CliEval, HelpExplainsEveryMetric) {
     const CliRun r = run("eval --help");
     EXPECT_EQ(r.status, 0) << r.output;
-    for (const char* word : {"Usage", "merged", "split", "ARI", "labelled", "segments", "--quick", "--bridges"}) {
+    for (const char* word : {"Usage", "merged", "split", "ARI", "labelled", "segments", "--quick", "--bridges",
+                             "--sensors", "--distances", "--params", "--tune-seeds", "preset", "structured-light",
+                             "kinect-v1", "realsense-d435", "azure-kinect", "grid search", "TUNING seeds"}) {
         EXPECT_NE(r.output.find(word), std::string::npos) << word << "\n" << r.output;
     }
     EXPECT_NE(run("--help").output.find("eval"), std::string::npos);
@@ -54,10 +57,34 @@ TEST(CliEval, BadListsAreUsageErrors) {
     EXPECT_NE(r.output.find("WxH"), std::string::npos) << r.output;
 }
 
+TEST(CliEval, UnknownSensorAndBadSensorOptionsAreUsageErrors) {
+    CliRun r = run("eval --quick --sensors kinect-v1,kinect-v9");
+    EXPECT_EQ(r.status, 2) << r.output;
+    // Names the culprit and lists the models there are.
+    EXPECT_NE(r.output.find("unknown sensor model 'kinect-v9'"), std::string::npos) << r.output;
+    for (const char* known : {"structured-light", "kinect-v1", "realsense-d435", "azure-kinect"}) {
+        EXPECT_NE(r.output.find(known), std::string::npos) << known << "\n" << r.output;
+    }
+    r = run("eval --quick --sensors ''");
+    EXPECT_EQ(r.status, 2) << r.output;
+    r = run("eval --quick --distances 100");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("300..6000"), std::string::npos) << r.output;
+    r = run("eval --quick --params tuned");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("preset or default"), std::string::npos) << r.output;
+    r = run("eval --quick --sensors kinect-v1 --noise 0,1");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("one noise level"), std::string::npos) << r.output;
+    r = run("eval --quick --tune-seeds 0");
+    EXPECT_EQ(r.status, 2) << r.output;
+}
+
+// The noise sweep, which --noise without --sensors and --distances still runs.
 TEST(CliEval, QuickSweepWritesTableAndPlotsAndThePyramidMergesLess) {
     const fs::path dir = fs::temp_directory_path() / ("pyrseg_eval_test_" + std::to_string(::getpid()));
     fs::remove_all(dir);
-    const CliRun r = run("eval --quick --out-dir " + dir.string());
+    const CliRun r = run("eval --quick --noise 0,0.5 --out-dir " + dir.string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("bridge 4 px"), std::string::npos) << r.output;
 
@@ -117,6 +144,147 @@ TEST(CliEval, QuickSweepWritesTableAndPlotsAndThePyramidMergesLess) {
             }
         }
     }
+    fs::remove_all(dir);
+}
+
+// The markdown tables of a report: each table's header cells, and its rows' cells, under the heading above it.
+struct Table {
+    std::string heading;
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    [[nodiscard]] std::size_t column(const std::string& name) const {
+        for (std::size_t c = 0; c < header.size(); ++c) {
+            if (header[c] == name) return c;
+        }
+        ADD_FAILURE() << "no column " << name << " under " << heading;
+        return 0;
+    }
+};
+
+std::vector<Table> tables_of(const fs::path& report) {
+    std::ifstream in(report);
+    EXPECT_TRUE(in) << report;
+    std::vector<Table> tables;
+    std::string heading;
+    bool in_table = false;
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("#", 0) == 0) heading = line;
+        if (line.rfind("|", 0) != 0) {
+            in_table = false;
+            continue;
+        }
+        if (!in_table) {
+            tables.push_back({heading, cells_of(line), {}});
+            in_table = true;
+        } else if (line.rfind("|---", 0) != 0) {
+            tables.back().rows.push_back(cells_of(line));
+        }
+    }
+    return tables;
+}
+
+void expect_png(const fs::path& file) {
+    ASSERT_TRUE(fs::exists(file)) << file;
+    const pyrseg::io::Image image = pyrseg::io::read_png(file);
+    EXPECT_GT(image.width, 300) << file;
+    EXPECT_GT(image.height, 200) << file;
+    EXPECT_EQ(image.channels, 3) << file;
+}
+
+// The default sweep, quick: two sensor models at one distance, bridges 0, 1 and 2, PCL tuned per model.
+TEST(CliEval, QuickSensorSweepWritesTablesSummaryAndPlots) {
+    const fs::path dir = fs::temp_directory_path() / ("pyrseg_eval_sensors_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const CliRun r = run("eval --quick --out-dir " + dir.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    // Progress: a line per sensor model and distance.
+    EXPECT_NE(r.output.find("structured-light at 1200 mm"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("kinect-v1 at 1200 mm"), std::string::npos) << r.output;
+
+    const std::vector<std::string> sensors = {"structured-light", "kinect-v1"};
+    for (const std::string& sensor : sensors) {
+        for (const char* plot : {"merge_rate_", "split_rate_", "ari_"}) {
+            expect_png(dir / (plot + sensor + "_320x240.png"));
+        }
+    }
+    expect_png(dir / "ari_summary_320x240.png");
+    EXPECT_FALSE(fs::exists(dir / "merge_rate_320x240.png"));  // the noise sweep's plot
+
+    const std::vector<Table> tables = tables_of(dir / "quality.md");
+    const Table* summary = nullptr;
+    const Table* pcl_settings = nullptr;
+    std::vector<const Table*> per_sensor;
+    for (const Table& t : tables) {
+        if (t.header.empty()) continue;
+        if (t.header[0] == "sensor" && t.header.size() > 1 && t.header[1] == "ARI: pyramid") summary = &t;
+        if (t.header[0] == "sensor" && t.header.size() > 1 && t.header[1] == "PCL setting chosen") pcl_settings = &t;
+        if (t.header[0] == "distance (mm)") per_sensor.push_back(&t);
+    }
+    ASSERT_NE(summary, nullptr) << "no summary table";
+    ASSERT_EQ(summary->rows.size(), sensors.size());
+    const bool with_pcl = pcl_settings != nullptr;
+    for (std::size_t i = 0; i < sensors.size(); ++i) {
+        const std::vector<std::string>& row = summary->rows[i];
+        ASSERT_EQ(row.size(), summary->header.size()) << i;
+        EXPECT_EQ(row[0], sensors[i]);
+        for (const char* check : {"pyramid ARI >= PCL", "pyramid merged <= CC/5", "labelled >= 90%"}) {
+            const std::string& v = row[summary->column(check)];
+            EXPECT_TRUE(v == "yes" || v == "**no**" || v == "n/a") << check << ": " << v;
+        }
+        EXPECT_NE(row[summary->column("merged w1: pyramid")], "n/a");
+        EXPECT_NE(row[summary->column("merged w2: CC")], "n/a");
+        EXPECT_GT(std::stod(row[summary->column("ARI: pyramid")]), 0.0) << sensors[i];
+        if (with_pcl) {
+            EXPECT_GT(std::stod(row[summary->column("ARI: PCL")]), 0.0) << sensors[i];
+        } else {
+            EXPECT_EQ(row[summary->column("pyramid ARI >= PCL")], "n/a");
+        }
+    }
+    if (with_pcl) {
+        ASSERT_EQ(pcl_settings->rows.size(), sensors.size());
+        for (std::size_t i = 0; i < sensors.size(); ++i) {
+            EXPECT_EQ(pcl_settings->rows[i][0], sensors[i]);
+            EXPECT_NE(pcl_settings->rows[i][1].find("smoothing"), std::string::npos) << pcl_settings->rows[i][1];
+        }
+    }
+    // One table per sensor model: distance 1200 x bridges 0, 1, 2.
+    ASSERT_EQ(per_sensor.size(), sensors.size());
+    for (std::size_t i = 0; i < sensors.size(); ++i) {
+        const Table& t = *per_sensor[i];
+        EXPECT_EQ(t.heading, "### " + sensors[i]);
+        ASSERT_TRUE(t.header.size() == 14u || t.header.size() == 18u) << t.header.size();
+        ASSERT_EQ(t.rows.size(), 3u) << sensors[i];
+        for (std::size_t b = 0; b < 3; ++b) {
+            const std::vector<std::string>& row = t.rows[b];
+            ASSERT_EQ(row.size(), t.header.size());
+            EXPECT_EQ(row[0], "1200");
+            EXPECT_EQ(row[1], std::to_string(b));
+            EXPECT_GT(std::stoi(row[t.column("objects")]), 10);
+            if (b > 0) {
+                EXPECT_LE(std::stoi(row[t.column("merged: pyramid")]), std::stoi(row[t.column("merged: CC")]))
+                    << sensors[i] << ", bridge " << b << " px";
+            }
+        }
+    }
+    std::ifstream in(dir / "quality.md");
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_NE(text.str().find("the preset (robust metric"), std::string::npos);  // kinect-v1's preset
+    fs::remove_all(dir);
+}
+
+TEST(CliEval, DefaultParamsAreScoredOnConsumerModelsToo) {
+    const fs::path dir = fs::temp_directory_path() / ("pyrseg_eval_defaults_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const CliRun r = run("eval --quick --params default --sensors kinect-v1 --out-dir " + dir.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "quality.md");
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_NE(text.str().find("the defaults for every sensor model"), std::string::npos) << text.str();
+    EXPECT_NE(text.str().find("the defaults (paper metric"), std::string::npos) << text.str();
+    EXPECT_EQ(text.str().find("robust metric"), std::string::npos) << text.str();
+    expect_png(dir / "merge_rate_kinect-v1_320x240.png");
     fs::remove_all(dir);
 }
 

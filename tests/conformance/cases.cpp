@@ -113,6 +113,7 @@ ConformanceCase make_robust_case(int index, int width, int height, CaseRng& rng)
     }
     if (rng.chance(20)) c.params.bridge_levels = rng.range(1, 3);
     c.params.label_edges = rng.chance(80);
+    if (rng.chance(50)) c.params.edge_rounds = rng.pick({2, 3, 8, kMaxEdgeRounds});
     c.name = "robust" + std::to_string(index) + "_" + std::to_string(width) + "x" + std::to_string(height) + "_" +
              synthetic::sensor_name(c.scene.sensor) + (c.given_normals ? "_given_normals" : "_estimated_normals");
     for (char& ch : c.name) ch = ch == '-' ? '_' : ch;

@@ -23,6 +23,7 @@
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_robust.h"
 #include "pyr_scan.h"
 #include "pyr_stats.h"
 
@@ -36,11 +37,13 @@ __kernel void all_passes(PYR_CTX_PARAM, __global int* out) {
     PyrIVec3 q = pyr_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 1u);
     PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
     uint r = pyr_metric_fillable(PYR_CTX_ARG, 64u, 64u, x, y, 100, 1.0f);
+    r += pyr_metric_robust_fillable(PYR_CTX_ARG, 64u, 64u, x, y, 4u, 100.0f, 0.5f, 1.0f, 0.25f);
+    r += PYR_U32(pyr_robust_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 1u, 3u, 16.0f).z);
     r += pyr_mip_texel(PYR_CTX_ARG, lv, x, y);
     r += pyr_label_init_texel(PYR_CTX_ARG, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
-    r += pyr_edge_label(PYR_CTX_ARG, lv, x, y);
+    r += pyr_edge_label(PYR_CTX_ARG, lv, x, y, 2u);
     r += pyr_compact_label(PYR_CTX_ARG, 3u);
     r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
     r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);

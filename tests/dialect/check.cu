@@ -29,6 +29,7 @@ struct Ctx {
 #include "pyr_mip.h"
 #include "pyr_normals.h"
 #include "pyr_quantize.h"
+#include "pyr_robust.h"
 #include "pyr_scan.h"
 #include "pyr_stats.h"
 
@@ -39,11 +40,13 @@ __global__ void all_passes(Ctx ctx, int* out) {
     const PyrIVec3 q = pyr_normal_q(ctx, 64u, 64u, x, y, 1u);
     const PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
     unsigned r = pyr_metric_fillable(ctx, 64u, 64u, x, y, 100, 1.0f);
+    r += pyr_metric_robust_fillable(ctx, 64u, 64u, x, y, 4u, 100.0f, 0.5f, 1.0f, 0.25f);
+    r += PYR_U32(pyr_robust_normal_q(ctx, 64u, 64u, x, y, 1u, 3u, 16.0f).z);
     r += pyr_mip_texel(ctx, lv, x, y);
     r += pyr_label_init_texel(ctx, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(ctx, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
-    r += pyr_edge_label(ctx, lv, x, y);
+    r += pyr_edge_label(ctx, lv, x, y, 2u);
     r += pyr_compact_label(ctx, 3u);
     r += pyr_sweep_row(ctx, lv, y, 0u) + pyr_sweep_column(ctx, lv, x, 1u);
     r += pyr_count_marks(ctx, 0u, 64u);

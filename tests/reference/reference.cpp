@@ -57,6 +57,7 @@ int level_count(int width, int height) {
 
 // Section 2b's four parameters: in range with the robust metric, at their defaults with the paper one.
 std::string check_metric_params(const Params& p) {
+    if (p.edge_rounds < 1 || p.edge_rounds > 63) return "edge_rounds must be in 1..63";
     if (p.metric == Metric::paper) {
         const Params defaults;
         if (p.normal_window != defaults.normal_window)
@@ -392,7 +393,7 @@ QuantizedNormals quantize_normals(const float* normals, const std::vector<std::u
 }
 
 struct CurvatureSum {
-    std::int64_t k = 0;  // how many of the 8 pixels at the stride exist and are valid
+    std::int64_t k = 0;  // how many of the pixels (or pairs) taking part exist and are valid
     std::int64_t s = 0;  // the sum of the integer dot products qn_i . qn_j over them
 };
 
@@ -412,6 +413,27 @@ CurvatureSum curvature_sum(const QuantizedNormals& qn, const std::vector<std::ui
             out.s += qn[i][0] * qn[j][0] + qn[i][1] * qn[j][1] + qn[i][2] * qn[j][2];
             ++out.k;
         }
+    }
+    return out;
+}
+
+// Section 2b: over the 4 axes, the pairs of pixels s before and after (x, y) that both exist and are valid; the sum
+// of the dot products of each pair's two normals (the pixel's own normal takes no part).
+CurvatureSum pair_curvature_sum(const QuantizedNormals& qn, const std::vector<std::uint8_t>& valid, std::int64_t width,
+                                std::int64_t height, std::int64_t x, std::int64_t y, std::int64_t stride) {
+    CurvatureSum out;
+    const std::int64_t axes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+    const auto valid_at = [&](std::int64_t px, std::int64_t py) {
+        return px >= 0 && py >= 0 && px < width && py < height && valid[static_cast<std::size_t>(py * width + px)] != 0;
+    };
+    for (const auto& axis : axes) {
+        const std::int64_t ax = x + stride * axis[0], ay = y + stride * axis[1];
+        const std::int64_t bx = x - stride * axis[0], by = y - stride * axis[1];
+        if (!valid_at(ax, ay) || !valid_at(bx, by)) continue;
+        const auto a = static_cast<std::size_t>(ay * width + ax);
+        const auto b = static_cast<std::size_t>(by * width + bx);
+        out.s += qn[a][0] * qn[b][0] + qn[a][1] * qn[b][1] + qn[a][2] * qn[b][2];
+        ++out.k;
     }
     return out;
 }
@@ -534,7 +556,7 @@ std::vector<std::uint8_t> robust_metric(const float* points, const float* normal
             if (valid[i] == 0) continue;
             const float z = points[3 * i + 2];
             const std::int64_t l = curvature_limit(k, z);
-            const CurvatureSum curv = curvature_sum(qn, valid, width, height, x, y, p.curvature_stride);
+            const CurvatureSum curv = pair_curvature_sum(qn, valid, width, height, x, y, p.curvature_stride);
             const bool curvature_ok = curv.k >= 1 && curv.s >= curv.k * (two26 - l);
             const DepthSpread depth = depth_spread(points, valid, width, height, x, y);
             const bool depth_ok = depth.k >= 1 && depth.d <= depth_limit(k, z);
@@ -598,7 +620,8 @@ std::vector<std::uint32_t> fallback_labels(const std::vector<std::uint8_t>& fill
 }
 
 std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& fillable,
-                                          const std::vector<std::uint8_t>& valid, const Plan& plan, bool label_edges) {
+                                          const std::vector<std::uint8_t>& valid, const Plan& plan, bool label_edges,
+                                          int edge_rounds) {
     const auto n = static_cast<std::size_t>(plan.n);
     const auto m = static_cast<std::size_t>(plan.m);
     const auto dim = [&](std::size_t k) { return plan.dims[k]; };
@@ -719,17 +742,25 @@ std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& filla
         for (std::int64_t y = 1; y < d.h; ++y) take(idx(x, y), idx(x, y - 1));
         for (std::int64_t y = d.h - 2; y >= 0; --y) take(idx(x, y), idx(x, y + 1));
     }
-    // 6c: reads the state after 6b only, so edge labels never spread to further edge pixels.
+    // 6c, rounds 1..E: round k reads the state after round k-1 only. A neighbour counts when it is labelled and
+    // fillable, or was labelled by an earlier round (round 1: fillable ones only, the contract's step).
     if (label_edges) {
-        const std::vector<std::uint32_t> after_b = lab;
-        for (std::size_t t = 0; t < lab.size(); ++t) {
-            if (valid[t] == 0 || fill[n][t] != 0 || after_b[t] != 0) continue;
-            std::uint32_t best = 0;
-            for_each_4_neighbour(t, d.w, d.h, [&](std::size_t nb) {
-                const std::uint32_t l = after_b[nb];
-                if (fill[n][nb] != 0 && l != 0 && (best == 0 || l < best)) best = l;
-            });
-            lab[t] = best;
+        std::vector<int> labelled_in(lab.size(), 0);  // the round that labelled an edge pixel, 0: none
+        for (int round = 1; round <= edge_rounds; ++round) {
+            const std::vector<std::uint32_t> before = lab;
+            for (std::size_t t = 0; t < lab.size(); ++t) {
+                if (valid[t] == 0 || fill[n][t] != 0 || before[t] != 0) continue;
+                std::uint32_t best = 0;
+                for_each_4_neighbour(t, d.w, d.h, [&](std::size_t nb) {
+                    const std::uint32_t l = before[nb];
+                    const bool counts = fill[n][nb] != 0 || (labelled_in[nb] != 0 && labelled_in[nb] < round);
+                    if (counts && l != 0 && (best == 0 || l < best)) best = l;
+                });
+                if (best != 0) {
+                    lab[t] = best;
+                    labelled_in[t] = round;
+                }
+            }
         }
     }
     return lab;
@@ -805,8 +836,9 @@ Output failure(std::string why) {
 Output label_from_mask(std::vector<std::uint8_t> fillable, const std::vector<std::uint8_t>& valid, int width,
                        int height, const Params& p, const Plan& plan) {
     Output out;
-    std::vector<std::uint32_t> raw =
-        plan.fallback ? fallback_labels(fillable, width, height) : pyramid_labels(fillable, valid, plan, p.label_edges);
+    std::vector<std::uint32_t> raw = plan.fallback
+                                         ? fallback_labels(fillable, width, height)
+                                         : pyramid_labels(fillable, valid, plan, p.label_edges, p.edge_rounds);
     out.fillable = std::move(fillable);
     finish(std::move(raw), p, out);
     return out;

@@ -23,13 +23,14 @@ struct Params {
     int unjoinable_gap = 2;    // g
     bool bg_explicit = false;  // true: b/g that do not fit the image are an error (ok=false) instead of the fallback
     bool label_edges = true;
+    int edge_rounds = 1;  // rounds of step 6c, 1..63 (docs/algorithm.md section 5)
     bool compact = true;
     int normal_radius = 1;
     // Section 2b. With Metric::paper the four numbers below must keep their defaults (else ok = false); with
     // Metric::robust they are checked against their ranges whether or not normals are given.
     Metric metric = Metric::paper;
     int normal_window = 3;          // R, 1..7: the (2R+1) x (2R+1) window of section 8b
-    int curvature_stride = 4;       // s, 1..64: the curvature term compares with the 8 pixels at stride s
+    int curvature_stride = 4;       // s, 1..64: the curvature term compares the pairs of pixels s before and after
     double dt_per_m2 = 0.0;         // millimetres added to dt per square metre of depth; finite, >= 0
     double ct_growth_per_m2 = 0.0;  // growth of the curvature limit per square metre of depth; finite, >= 0
 };

@@ -612,6 +612,160 @@ TEST(ReferenceStep6, EdgeLabellingTakesSmallestNeighbourAndSkipsInvalid) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// Edge rounds (docs/algorithm.md section 5 step 6c, `edge_rounds` E): round 1 is the contract's step; in round k >= 2
+// a valid, non-fillable, unlabelled pixel takes the smallest label among its 4-neighbours that are labelled and
+// fillable or were labelled in rounds 1..k-1 (a Jacobi step). Pictures: '#' fillable, '-' valid and not fillable,
+// 'x' invalid.
+
+std::vector<std::uint8_t> valid_of(const std::vector<std::string>& rows) {
+    std::vector<std::uint8_t> out;
+    for (const std::string& row : rows) {
+        for (char c : row) out.push_back(c == 'x' ? 0 : 1);
+    }
+    return out;
+}
+
+Output run_edges(const std::vector<std::string>& rows, int edge_rounds, bool label_edges = true) {
+    Params p;  // 16x16 with the default b = g = 2: N = 5, M = 3, U = 1 (old is <= offset_2 = 1: nothing here)
+    p.edge_rounds = edge_rounds;
+    p.label_edges = label_edges;
+    const std::vector<std::uint8_t> valid = valid_of(rows);
+    return run_mask(rows, p, &valid);
+}
+
+// The 4x4 block (0..3, 0..3) is level-3 texel (0,0): new label offset_3 + 0 + 1 = 5 + 1 = 6 (level 2 needs 8x8).
+// Row 1 goes on with valid non-fillable pixels x = 4..11, an invalid one at x = 12 and valid ones again at 13..15.
+// Row 3 goes on with valid x = 4, 5, a fillable pixel at x = 6 that no fill reaches (its left neighbour is not
+// fillable, its level-4 parent (3,1) has invalid children in row 2) and valid ones at 7..15. Everything else outside
+// the block is invalid, so the labels can only run along rows 1 and 3.
+const std::vector<std::string> kCorridors = {
+    "####xxxxxxxxxxxx",  //
+    "####--------x---",  //
+    "####xxxxxxxxxxxx",  //
+    "####--#---------",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+    "xxxxxxxxxxxxxxxx",  //
+};
+
+// The expected raw labels of kCorridors: the block (6), the first `row1` pixels of row 1 after it and the first
+// `row3` pixels of row 3 after it.
+std::vector<std::uint32_t> corridor_labels(int row1, int row3) {
+    std::vector<std::uint32_t> out(256, 0);
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 4; ++x) out[static_cast<std::size_t>(y * 16 + x)] = 6;
+    }
+    for (int x = 4; x < 4 + row1; ++x) out[static_cast<std::size_t>(16 + x)] = 6;
+    for (int x = 4; x < 4 + row3; ++x) out[static_cast<std::size_t>(48 + x)] = 6;
+    return out;
+}
+
+TEST(ReferenceEdgeRounds, EachRoundReachesOneStepFurther) {
+    // Round k labels pixel x = 3 + k of row 1 (its left neighbour was labelled in round k - 1, or is fillable for
+    // k = 1), so E rounds label exactly x = 4..3+E. The invalid (12,1) is never labelled and cuts 13..15 off: even
+    // 63 rounds reach only 4..11. In row 3, (4,3) and (5,3) take 6 in rounds 1 and 2; (6,3) is fillable, so no round
+    // labels it, and unlabelled it passes nothing on: (7..15, 3) stay 0.
+    for (const int e : {1, 2, 5}) {
+        Output out = run_edges(kCorridors, e);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_LABELS(out.raw_labels, corridor_labels(e, e < 2 ? e : 2), 16) << "E = " << e;
+        EXPECT_EQ(out.segment_count, 1u);
+        EXPECT_EQ(out.fillable, mask_of(kCorridors));  // the rounds never touch the mask
+    }
+    Output all = run_edges(kCorridors, 63);
+    ASSERT_TRUE(all.ok) << all.error;
+    EXPECT_LABELS(all.raw_labels, corridor_labels(8, 2), 16);
+    std::vector<std::uint32_t> compacted = corridor_labels(8, 2);
+    for (std::uint32_t& l : compacted) l = l != 0 ? 1u : 0u;  // 6 -> 1
+    EXPECT_LABELS(all.labels, compacted, 16);
+    // label_edges off: no round at all, whatever E.
+    Output off = run_edges(kCorridors, 5, false);
+    ASSERT_TRUE(off.ok) << off.error;
+    EXPECT_LABELS(off.raw_labels, corridor_labels(0, 0), 16);
+}
+
+TEST(ReferenceEdgeRounds, TwoSegmentsShareABandByFirstArrivalThenSmallestLabel) {
+    // C: the block (0..3, 8..11) is level-3 texel (0,2): offset_3 + 8 + 0 + 1 = 14. A: the 8x8 block (8..15, 8..15)
+    // makes level-2 texel (1,1) fillable: offset_2 + 2 + 1 + 1 = 5, which its level-3 (and finer) children copy. So
+    // the right-hand segment has the smaller label.
+    // Row 9: the fillable (4,9) takes 14 in step 6a (left to right); the band between is x = 5, 6, 7.
+    //   Round 1: (5,9) <- 14, (7,9) <- 5. Round 2: (6,9) sees 14 on its left and 5 on its right, both from round 1:
+    //   the smaller, 5 (the one on the right, so not the first one visited).
+    // Row 11: the band is x = 4..7. Round 1: (4,11) <- 14, (7,11) <- 5. Round 2: (5,11) <- 14 (its right neighbour
+    //   is still unlabelled after round 1), (6,11) <- 5. Round 3 would bring 5 to (5,11), but a labelled pixel never
+    //   changes: it keeps 14, for any E >= 2.
+    // Row 10 between the blocks, rows 0..7 and the rest of rows 12..15 are invalid.
+    const std::vector<std::string> rows = {
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "xxxxxxxxxxxxxxxx",  //
+        "####xxxx########",  //
+        "#####---########",  //
+        "####xxxx########",  //
+        "####----########",  //
+        "xxxxxxxx########",  //
+        "xxxxxxxx########",  //
+        "xxxxxxxx########",  //
+        "xxxxxxxx########",  //
+    };
+    const std::vector<std::string> blank(8, "................");
+    std::vector<std::string> one = blank;
+    for (const char* row : {"cccc....aaaaaaaa", "cccccc.aaaaaaaaa", "cccc....aaaaaaaa", "ccccc..aaaaaaaaa",
+                            "........aaaaaaaa", "........aaaaaaaa", "........aaaaaaaa", "........aaaaaaaa"}) {
+        one.emplace_back(row);
+    }
+    std::vector<std::string> more = blank;
+    for (const char* row : {"cccc....aaaaaaaa", "ccccccaaaaaaaaaa", "cccc....aaaaaaaa", "ccccccaaaaaaaaaa",
+                            "........aaaaaaaa", "........aaaaaaaa", "........aaaaaaaa", "........aaaaaaaa"}) {
+        more.emplace_back(row);
+    }
+    Output out1 = run_edges(rows, 1);
+    ASSERT_TRUE(out1.ok) << out1.error;
+    EXPECT_LABELS(out1.raw_labels, labels_of(one, {{'a', 5}, {'c', 14}}), 16);
+    for (const int e : {2, 3, 63}) {
+        Output out = run_edges(rows, e);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_LABELS(out.raw_labels, labels_of(more, {{'a', 5}, {'c', 14}}), 16) << "E = " << e;
+        EXPECT_LABELS(out.labels, labels_of(more, {{'a', 1}, {'c', 2}}), 16) << "E = " << e;
+        EXPECT_EQ(out.segment_count, 2u);
+    }
+}
+
+TEST(ReferenceEdgeRounds, RangeIsOneToSixtyThree) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    for (const int e : {0, 64, -1}) {
+        Params p;
+        p.edge_rounds = e;
+        Output a = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+        EXPECT_FALSE(a.ok) << e;
+        EXPECT_NE(a.error.find("edge_rounds"), std::string::npos) << a.error;
+        EXPECT_FALSE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok) << e;
+    }
+    for (const int e : {1, 63}) {
+        Params p;
+        p.edge_rounds = e;
+        EXPECT_TRUE(pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p).ok) << e;
+        EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok) << e;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Parameters.
 
 TEST(ReferenceParams, Rejection) {
@@ -1197,10 +1351,14 @@ TEST(ReferenceRobustNormals, FixedPointSaturatesAtTwoToThe22) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// Robust metric (docs/algorithm.md section 2b). ct = 0.25 (the default): c0 * 2^26 = 2086252.12..., so A is that
-// float and L = 2086252 while Bc = 0.
+// Robust metric (docs/algorithm.md section 2b). ct = 0.25 (the default): c0 * 2^26 = 2086252.06..., A = 2086252.125
+// as a float, so L = 2086252 while Bc = 0, 2^26 - L = 65022612 and 4 * (2^26 - L) = 260090448.
+// The curvature term of a pixel (x, y) looks only at the pairs a = (x + s*dx, y + s*dy), b = (x - s*dx, y - s*dy) on
+// the axes (1, 0), (0, 1), (1, 1), (1, -1) whose two pixels exist and are valid (kp of them) and passes iff kp >= 1
+// and S = sum qn_a . qn_b >= kp * (2^26 - L). So in a W x 1 row only the horizontal pair can exist, and only for
+// s <= x <= W - 1 - s: at stride 1 the two end pixels have kp = 0 and are never fillable.
 
-// Pixels in a row (W x 1) with given normals, robust metric with stride 1 unless p says otherwise.
+// Pixels in a row (W x 1) with given normals, robust metric (stride as p says).
 std::vector<std::uint8_t> robust_row(const std::vector<float>& z, const std::vector<std::vector<float>>& normals,
                                      Params p) {
     p.metric = pyrseg_ref::Metric::robust;
@@ -1214,6 +1372,17 @@ std::vector<std::uint8_t> robust_row(const std::vector<float>& z, const std::vec
     return out.fillable;
 }
 
+// A w x h image at z = 1000 with the given normals (row-major, one per pixel), robust metric: the fillable mask.
+std::vector<std::uint8_t> robust_grid(int w, int h, const std::vector<std::vector<float>>& normals, Params p) {
+    p.metric = pyrseg_ref::Metric::robust;
+    const std::vector<float> pts = grid_points(w, h, [](int, int) { return 1000.0f; });
+    std::vector<float> nrm;
+    for (const std::vector<float>& n : normals) nrm.insert(nrm.end(), n.begin(), n.end());
+    Output out = pyrseg_ref::segment(pts.data(), nrm.data(), w, h, p);
+    EXPECT_TRUE(out.ok) << out.error;
+    return out.fillable;
+}
+
 Params stride1() {
     Params p = robust_params();
     p.curvature_stride = 1;
@@ -1222,12 +1391,26 @@ Params stride1() {
 
 const std::vector<float> kFront = {0.0f, 0.0f, -1.0f};
 const std::vector<float> kBack = {0.0f, 0.0f, 1.0f};
+const std::vector<float> kNone = {0.0f, 0.0f, 0.0f};  // makes the pixel invalid
+
+// Distance of a coordinate (0..15) from the band 4..11.
+int band_distance(int v) {
+    return v < 4 ? 4 - v : (v > 11 ? v - 11 : 0);
+}
 
 TEST(ReferenceRobustMetric, TiltedPlaneEndToEnd) {
     // 16x16, z = 1000 + x, robust defaults (r = 1 here, R = 3, s = 4): every normal is (5793, 0, -5793) (see the
-    // normals tests), so S = ks * 67117698 >= ks * (2^26 - L); d = 1 - 0 <= 10 everywhere. All fillable -> raw 1.
+    // normals tests), so every pair has qn_a . qn_b = 2 * 5793^2 = 67117698 > 2^26 - L; d = 1 - 0 or 0 <= 10
+    // everywhere. A pixel has a horizontal pair iff 4 <= x <= 11, a vertical one iff 4 <= y <= 11, and the diagonal
+    // ones only when it has both: fillable iff x or y is in 4..11 (a plus); the four 4x4 corners have kp = 0.
+    // Pyramid (N = 5, M = 3, U = 1): level 4 (8x8) is fillable iff tx or ty is in 2..5, level 3 (4x4) iff tx or ty
+    // is in 1..2 (a plus of 12 texels), level 2 has a corner texel under each of its texels: nothing. So every level-3
+    // texel gets a new label, and the fill at level 3 gives the plus the smallest, that of texel (1,0):
+    // offset_3 + 0 * 4 + 1 + 1 = 5 + 2 = 7 (not old: old is <= offset_2 = 1). Levels 4 and 5 copy it.
+    // Edge labelling (one round by default) gives 7 to the corner pixels next to the plus (x = 3 or 12, or y = 3 or
+    // 12); the other 3x3 of each corner stay 0.
     const std::vector<float> pts = grid_points(16, 16, [](int x, int) { return 1000.0f + static_cast<float>(x); });
-    const Params p = robust_params();
+    Params p = robust_params();
     Output out = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
     ASSERT_TRUE(out.ok) << out.error;
     std::vector<float> expected_normals;
@@ -1236,27 +1419,74 @@ TEST(ReferenceRobustMetric, TiltedPlaneEndToEnd) {
         expected_normals.insert(expected_normals.end(), n.begin(), n.end());
     }
     EXPECT_EQ(out.normals, expected_normals);
-    EXPECT_EQ(out.fillable, (std::vector<std::uint8_t>(256, 1)));
-    EXPECT_EQ(out.raw_labels, (std::vector<std::uint32_t>(256, 1)));
     // segment() estimated them with section 8b and the parameters' r, R and unit_mm.
     EXPECT_EQ(out.normals, pyrseg_ref::estimate_robust_normals(pts.data(), 16, 16, 1, 3, 1.0));
+    std::vector<std::uint8_t> plus(256, 0);
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 16; ++x) {
+            plus[static_cast<std::size_t>(y * 16 + x)] = (band_distance(x) == 0 || band_distance(y) == 0) ? 1 : 0;
+        }
+    }
+    EXPECT_EQ(out.fillable, plus);
+    const std::vector<std::string> one_round = {
+        "...7777777777...",  //
+        "...7777777777...",  //
+        "...7777777777...",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "7777777777777777",  //
+        "...7777777777...",  //
+        "...7777777777...",  //
+        "...7777777777...",  //
+    };
+    EXPECT_LABELS(out.raw_labels, labels_of(one_round, {{'7', 7}}), 16);
+    EXPECT_EQ(out.segment_count, 1u);
+
+    // With E edge rounds a corner pixel is labelled iff it is at most E steps from the plus, i.e. iff
+    // min(band_distance(x), band_distance(y)) <= E (round k labels the pixels at that distance k). E = 3 leaves the
+    // four image corners; E = 4 labels everything.
+    p.edge_rounds = 3;
+    Output three = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+    ASSERT_TRUE(three.ok) << three.error;
+    std::vector<std::uint32_t> expected_three(256, 7);
+    for (const std::size_t corner : {0u, 15u, 240u, 255u}) expected_three[corner] = 0;
+    EXPECT_LABELS(three.raw_labels, expected_three, 16);
+    EXPECT_EQ(three.fillable, plus);  // the rounds do not touch the mask
+    p.edge_rounds = 4;
+    Output four = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+    ASSERT_TRUE(four.ok) << four.error;
+    EXPECT_LABELS(four.raw_labels, std::vector<std::uint32_t>(256, 7), 16);
 }
 
 TEST(ReferenceRobustMetric, CreaseSeenAtStrideFourNotAtStrideOne) {
-    // 32x12, z = 1000 + |x - 16| (two 45-degree planes meeting at x = 16), r = 1, R = 3, ct = 0.25, dt = 10.
-    // Normals: x <= 12: (-5793, 0, -5793); x >= 20: (5793, 0, -5793) (windows on one plane only).
+    // 32x12, z = 1000 + |x - 16| (two 45-degree planes meeting at x = 16), r = 1, R = 3, dt = 10, ct = 0.6:
+    // c0 * 2^26 = 11721528.46..., A = 11721528 as a float -> L = 11721528, 4 * (2^26 - L) = 221549344.
+    // Normals (the same in every row: U stays a multiple of one row's tangent sum, V of (0, 1, 0)):
+    //   x <= 12: (-5793, 0, -5793); x >= 20: (5793, 0, -5793) (windows on one plane only).
     //   (16,y): per window row the tangents are 3 * (32, 0, -32) + (32, 0, 0) + 3 * (32, 0, 32) = (224, 0, 0):
     //   frontal (0, 0, -8192).
     //   (15,y): per row 4 * (32, 0, -32) + (32, 0, 0) + 2 * (32, 0, 32) = (224, 0, -64); U = (1568, 0, -448),
     //   V = (0, 1568, 0) -> U' = (25088, 0, -7168), V' = (0, 25088, 0), D = (5488, 0, 19208), len = 19976
     //   -> (-2251, 0, -7877); (17,y) mirrored: (2251, 0, -7877).
-    // Stride 4 at (16,6): 3 left, 3 right, 2 crease normals: S = 6 * 8192 * 5793 + 2 * 2^26 = 418955264 <
-    // 8 * (2^26 - 2086252) = 520180896 -> not fillable. Stride 1: S = 6 * 8192 * 7877 + 2 * 2^26 = 521388032 >=
-    // 520180896 -> fillable. d = 1 - 0 <= 10 either way. (4,6) sees only left-plane normals: fillable with both.
+    // Stride 4 at (16,6), kp = 4: horizontal (20,6).(12,6) = -5793^2 + 5793^2 = 0, vertical (16,10).(16,2) = 2^26,
+    // diagonals (20,10).(12,2) = 0 and (20,2).(12,10) = 0: S = 67108864 < 221549344 -> not fillable (mean 1 - cos
+    // 0.75). Stride 1, kp = 4: horizontal and both diagonals (17,.).(15,.) = 7877^2 - 2251^2 = 56980128, vertical
+    // 2^26: S = 3 * 56980128 + 67108864 = 238049248 >= 221549344 -> fillable (mean 1 - cos 0.113: the window blurs
+    // the crease over the neighbours). d = 1 - 0 <= 10 either way.
+    // (4,6) sees only left-plane normals at both strides (S = 4 * 67117698): fillable.
+    // (With the default ct = 0.25 the crease pixel would be an edge at both strides: 238049248 < 260090448.)
     const std::vector<float> pts =
         grid_points(32, 12, [](int x, int) { return 1000.0f + static_cast<float>(x > 16 ? x - 16 : 16 - x); });
     Params p = robust_params();
     p.normal_window = 3;
+    p.ct = 0.6;
     Output s4 = pyrseg_ref::segment(pts.data(), nullptr, 32, 12, p);
     ASSERT_TRUE(s4.ok) << s4.error;
     EXPECT_EQ(normal_at(s4.normals, 32, 16, 6), q13(0, 0, -8192));
@@ -1264,6 +1494,13 @@ TEST(ReferenceRobustMetric, CreaseSeenAtStrideFourNotAtStrideOne) {
     EXPECT_EQ(normal_at(s4.normals, 32, 17, 6), q13(2251, 0, -7877));
     EXPECT_EQ(normal_at(s4.normals, 32, 12, 6), q13(-5793, 0, -5793));
     EXPECT_EQ(normal_at(s4.normals, 32, 20, 6), q13(5793, 0, -5793));
+    // The other ends of the stride-4 pairs.
+    EXPECT_EQ(normal_at(s4.normals, 32, 16, 2), q13(0, 0, -8192));
+    EXPECT_EQ(normal_at(s4.normals, 32, 16, 10), q13(0, 0, -8192));
+    EXPECT_EQ(normal_at(s4.normals, 32, 12, 2), q13(-5793, 0, -5793));
+    EXPECT_EQ(normal_at(s4.normals, 32, 12, 10), q13(-5793, 0, -5793));
+    EXPECT_EQ(normal_at(s4.normals, 32, 20, 2), q13(5793, 0, -5793));
+    EXPECT_EQ(normal_at(s4.normals, 32, 20, 10), q13(5793, 0, -5793));
     EXPECT_EQ(s4.fillable[6 * 32 + 16], 0);
     EXPECT_EQ(s4.fillable[6 * 32 + 4], 1);
 
@@ -1273,133 +1510,192 @@ TEST(ReferenceRobustMetric, CreaseSeenAtStrideFourNotAtStrideOne) {
     EXPECT_EQ(s1.normals, s4.normals);  // the stride does not touch the normals
     EXPECT_EQ(s1.fillable[6 * 32 + 16], 1);
     EXPECT_EQ(s1.fillable[6 * 32 + 4], 1);
+
+    p.ct = 0.25;  // 238049248 < 260090448
+    Output s1_default = pyrseg_ref::segment(pts.data(), nullptr, 32, 12, p);
+    ASSERT_TRUE(s1_default.ok) << s1_default.error;
+    EXPECT_EQ(s1_default.fillable[6 * 32 + 16], 0);
 }
 
 TEST(ReferenceRobustMetric, StrideLooksOnlyAtPixelsAtTheStride) {
-    // 9x1 at z = 1000, pixel 3 faces away (0, 0, 1): S = -2^26 with a frontal pixel, far below 2^26 - L.
-    // Stride 4: pixel 3 sees pixel 7, pixel 7 sees pixel 3 (both fail); every other pixel sees only frontal ones.
-    // Stride 1: pixels 2, 3, 4 see pixel 3 (or are it): S = 2^26 - 2^26 = 0 < 2 * (2^26 - L).
-    std::vector<std::vector<float>> nrm(9, kFront);
-    nrm[3] = kBack;
-    const std::vector<float> z(9, 1000.0f);
+    // 17x1 at z = 1000, all frontal but pixel 8, which faces away (0, 0, 1): a pair with it has S = -2^26 < 2^26 - L.
+    // Stride 4: pixels 4..12 have a pair (x - 4, x + 4). Pixel 4 (pair 0, 8) and pixel 12 (pair 8, 16) fail; pixel 8
+    // (pair 4, 12) passes: its own normal takes no part. Pixels 0..3 and 13..16 have no pair.
+    // Stride 1: pixels 1..15 have a pair; pixel 7 (pair 6, 8) and pixel 9 (pair 8, 10) fail, pixel 8 (7, 9) passes.
+    std::vector<std::vector<float>> nrm(17, kFront);
+    nrm[8] = kBack;
+    const std::vector<float> z(17, 1000.0f);
     Params p = robust_params();
-    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{1, 1, 1, 0, 1, 1, 1, 0, 1}));
+    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0}));
     p.curvature_stride = 1;
-    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{1, 1, 0, 0, 0, 1, 1, 1, 1}));
+    EXPECT_EQ(robust_row(z, nrm, p), (std::vector<std::uint8_t>{0, 1, 1, 1, 1, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1, 1, 0}));
 
-    // 3x3 flat frontal: stride 2 reaches the corners (3 pixels at stride) and edge midpoints (1), not the centre
-    // (ks = 0 -> not fillable); stride 3 reaches nothing.
-    const std::vector<float> pts = grid_points(3, 3, [](int, int) { return 1000.0f; });
-    const std::vector<float> flat = constant_normals(9, 0.0f, 0.0f, -1.0f);
+    // 5x5 flat frontal. Stride 2: a pixel has a horizontal pair iff x = 2, a vertical one iff y = 2, diagonal ones
+    // only at the centre (4 pairs): fillable iff x = 2 or y = 2. Stride 3 reaches no pair (x - 3 >= 0 and x + 3 <= 4
+    // is impossible): nothing fillable. Stride 1: a pair unless x and y are both 0 or 4: all but the 4 corners.
+    const std::vector<std::vector<float>> flat(25, kFront);
     p.curvature_stride = 2;
-    Output two = pyrseg_ref::segment(pts.data(), flat.data(), 3, 3, p);
-    ASSERT_TRUE(two.ok) << two.error;
-    EXPECT_EQ(two.fillable, (std::vector<std::uint8_t>{1, 1, 1, 1, 0, 1, 1, 1, 1}));
+    EXPECT_EQ(robust_grid(5, 5, flat, p), mask_of({"..#..", "..#..", "#####", "..#..", "..#.."}));
     p.curvature_stride = 3;
-    Output three = pyrseg_ref::segment(pts.data(), flat.data(), 3, 3, p);
-    EXPECT_EQ(three.fillable, (std::vector<std::uint8_t>(9, 0)));
+    EXPECT_EQ(robust_grid(5, 5, flat, p), std::vector<std::uint8_t>(25, 0));
+    p.curvature_stride = 1;
+    EXPECT_EQ(robust_grid(5, 5, flat, p), mask_of({".###.", "#####", "#####", "#####", ".###."}));
+}
+
+TEST(ReferenceRobustMetric, PairsAreOppositePixelsOnFourAxes) {
+    // 3x3 at z = 1000, stride 1, the centre (1,1) has the 4 pairs (2,1)/(0,1), (1,2)/(1,0), (2,2)/(0,0) and
+    // (2,0)/(0,2). All frontal: S = 4 * 2^26 -> fillable. One pixel facing away spoils exactly one pair:
+    // S = 3 * 2^26 - 2^26 = 134217728 < 4 * (2^26 - L) = 260090448 -> the centre is an edge, whichever axis it is on.
+    const auto centre_fillable = [](int x, int y, const std::vector<float>& n) {
+        std::vector<std::vector<float>> nrm(9, kFront);
+        nrm[static_cast<std::size_t>(y * 3 + x)] = n;
+        return robust_grid(3, 3, nrm, stride1())[4];
+    };
+    EXPECT_EQ(centre_fillable(1, 1, kFront), 1);
+    EXPECT_EQ(centre_fillable(2, 1, kBack), 0);  // (1, 0)
+    EXPECT_EQ(centre_fillable(1, 2, kBack), 0);  // (0, 1)
+    EXPECT_EQ(centre_fillable(0, 0, kBack), 0);  // (1, 1)
+    EXPECT_EQ(centre_fillable(2, 0, kBack), 0);  // (1, -1)
+    // The centre's own normal takes no part: facing away, it is still fillable (S = 4 * 2^26).
+    EXPECT_EQ(centre_fillable(1, 1, kBack), 1);
+    // An invalid end drops its pair: (2,0) invalid leaves kp = 3, S = 3 * 2^26 >= 3 * 65022612 -> fillable. (Were
+    // the pair counted with a zero dot product, kp = 4 and 201326592 < 260090448: an edge.)
+    EXPECT_EQ(centre_fillable(2, 0, kNone), 1);
+    // Edge midpoints of the 3x3: (1,0) has only the pair (0,0)/(2,0), (0,1) only (0,0)/(0,2); corners have none.
+    // With (0,0) facing away both midpoints next to it fail (S = -2^26) and the other two pass.
+    std::vector<std::vector<float>> corner_back(9, kFront);
+    corner_back[0] = kBack;
+    EXPECT_EQ(robust_grid(3, 3, corner_back, stride1()), mask_of({"...", "..#", ".#."}));
 }
 
 TEST(ReferenceRobustMetric, CurvatureLimitIsFloorOfTAndInclusive) {
-    // Two pixels (stride 1, ks = 1): pass iff S >= 2^26 - L.
+    // Three pixels in a row at stride 1: only the middle one has a pair (pixels 0 and 2, kp = 1), so it passes iff
+    // qn_0 . qn_2 >= 2^26 - L; the ends have kp = 0 and are never fillable. The middle pixel's own normal takes no
+    // part: it faces away throughout.
     // ct = acos(1 - 8191.75 / 2^26): A = (float)(c0 * 2^26) = 8191.75 -> L = 8191; normals (0,0,-1) and
-    // (0,0,-8191/8192): S = 8192 * 8191 = 67100672 < 67100673 -> edge. With 8192.25: L = 8192, S = 2^26 - L: passes.
+    // (0,0,-8191/8192): S = 8192 * 8191 = 67100672 < 2^26 - 8191 = 67100673 -> edge. With 8192.25: L = 8192,
+    // S = 2^26 - L: passes.
     Params p = stride1();
     const std::vector<float> almost = {0.0f, 0.0f, -8191.0f / 8192.0f};
+    const std::vector<float> z(3, 1000.0f);
+    const std::vector<std::uint8_t> none = {0, 0, 0};
+    const std::vector<std::uint8_t> middle = {0, 1, 0};
     p.ct = std::acos(1.0 - 8191.75 / 67108864.0);
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, almost}, p), (std::vector<std::uint8_t>{0, 0}));
+    EXPECT_EQ(robust_row(z, {kFront, kBack, almost}, p), none);
     p.ct = std::acos(1.0 - 8192.25 / 67108864.0);
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, almost}, p), (std::vector<std::uint8_t>{1, 1}));
+    EXPECT_EQ(robust_row(z, {kFront, kBack, almost}, p), middle);
 
     // ct = pi/2: c0 = 1 - 6.1e-17 rounds to 2^26 as a float -> L = 2^26, the test is S >= 0.
     p.ct = std::numbers::pi / 2.0;
     const std::vector<float> side = {1.0f, 0.0f, 0.0f};
     const std::vector<float> side_back = {1.0f, 0.0f, 1.0f / 8192.0f};
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, side}, p), (std::vector<std::uint8_t>{1, 1}));       // S = 0
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, side_back}, p), (std::vector<std::uint8_t>{0, 0}));  // S = -8192
+    EXPECT_EQ(robust_row(z, {kFront, kBack, side}, p), middle);     // S = 0
+    EXPECT_EQ(robust_row(z, {kFront, kBack, side_back}, p), none);  // S = -8192
 
-    // The default stride 4 finds no pixel in a 2x1 image: ks = 0 -> never fillable.
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kFront}, robust_params()), (std::vector<std::uint8_t>{0, 0}));
+    // The default stride 4 finds no pair in an 8x1 image (x - 4 >= 0 and x + 4 <= 7 is impossible): kp = 0 ->
+    // nothing fillable. In 9x1 exactly pixel 4 has one (pixels 0 and 8).
+    const Params d = robust_params();
+    EXPECT_EQ(robust_row(std::vector<float>(8, 1000.0f), std::vector<std::vector<float>>(8, kFront), d),
+              std::vector<std::uint8_t>(8, 0));
+    EXPECT_EQ(robust_row(std::vector<float>(9, 1000.0f), std::vector<std::vector<float>>(9, kFront), d),
+              (std::vector<std::uint8_t>{0, 0, 0, 0, 1, 0, 0, 0, 0}));
 }
 
 TEST(ReferenceRobustMetric, CurvatureAtAndAbovePi) {
-    // ct >= pi: A = 2^28, Bc = 0 -> L = 2^28, the test is S >= -3 * ks * 2^26: always. Opposite unit normals
-    // (0,0,-1), (0,0,1): S = -2^26 -> passes. Just below pi c0 = 2 as a double, so A = 2^27 -> L = 2^27, which
-    // passes them with equality. ct = 3.1:
-    // A = (float)((1 - cos 3.1) * 2^26) < 2^27 -> S = -2^26 < 2^26 - L -> edge.
+    // Three pixels, stride 1: the middle one's pair is (0, 2). ct >= pi: A = 2^28, Bc = 0 -> L = 2^28, the test is
+    // S >= kp * (2^26 - 2^28) = -3 * kp * 2^26: always. Opposite unit normals (0,0,-1), (0,0,1): S = -2^26 -> passes.
+    // Just below pi c0 = 2 as a double, so A = 2^27 -> L = 2^27: -2^26 >= 2^26 - 2^27 passes with equality.
+    // ct = 3.1: A = 134159688 < 2^27 -> 2^26 - L = -67050824 > S -> edge.
     Params p = stride1();
-    const std::vector<std::uint8_t> both = {1, 1};
-    const std::vector<std::uint8_t> none = {0, 0};
+    const std::vector<float> z(3, 1000.0f);
+    const std::vector<std::uint8_t> middle = {0, 1, 0};
+    const std::vector<std::uint8_t> none = {0, 0, 0};
     p.ct = std::numbers::pi;
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    EXPECT_EQ(robust_row(z, {kFront, kFront, kBack}, p), middle);
     p.ct = 100.0;
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    EXPECT_EQ(robust_row(z, {kFront, kFront, kBack}, p), middle);
     p.ct = std::nextafter(std::numbers::pi, 0.0);
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), both);
+    EXPECT_EQ(robust_row(z, {kFront, kFront, kBack}, p), middle);
     p.ct = 3.1;
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {kFront, kBack}, p), none);
+    EXPECT_EQ(robust_row(z, {kFront, kFront, kBack}, p), none);
 
     // (0.70710677, 0, -0.70710677) quantizes to (5793, 0, -5793), |qn|^2 = 67117698 > 2^26, so the opposite pair has
     // S = -67117698 < -2^26: only L = 2^28 (ct >= pi) passes it whatever the normals; just below pi it is an edge.
     const std::vector<float> diag = {0.70710677f, 0.0f, -0.70710677f};
     const std::vector<float> diag_back = {-0.70710677f, 0.0f, 0.70710677f};
     p.ct = std::numbers::pi;
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {diag, diag_back}, p), both);
+    EXPECT_EQ(robust_row(z, {diag, kFront, diag_back}, p), middle);
     p.ct = std::nextafter(std::numbers::pi, 0.0);
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f}, {diag, diag_back}, p), none);
+    EXPECT_EQ(robust_row(z, {diag, kFront, diag_back}, p), none);
+
+    // The extreme: 3x3, stride 1, every pair of the centre made of (1,1,1) and (-1,-1,-1) (qn = +-(8192, 8192,
+    // 8192), dot -3 * 2^26): S = 4 * -3 * 2^26 = -3 * 2^28 = kp * (2^26 - 2^28): passes with equality at ct = pi.
+    // Just below pi: kp * (2^26 - 2^27) = -2^28 > S -> edge. The midpoints (0,1) (pair (0,0)/(0,2)) and (2,1)
+    // (pair (2,0)/(2,2)) also pair up with down: they follow the centre. (1,0) (two downs) and (1,2) (two ups) pass
+    // at any ct; corners have no pair.
+    const std::vector<float> up = {1.0f, 1.0f, 1.0f};
+    const std::vector<float> down = {-1.0f, -1.0f, -1.0f};
+    const std::vector<std::vector<float>> opposed = {down, down, down, down, kFront, up, up, up, up};
+    p.ct = std::numbers::pi;
+    EXPECT_EQ(robust_grid(3, 3, opposed, p), mask_of({".#.", "###", ".#."}));
+    p.ct = std::nextafter(std::numbers::pi, 0.0);
+    EXPECT_EQ(robust_grid(3, 3, opposed, p), mask_of({".#.", "...", ".#."}));
 }
 
 TEST(ReferenceRobustMetric, DepthLimitGrowsWithDepthSquared) {
     // dt = 10 mm, dt_per_m2 = 1: Bd = (float)1e-6. z = 2000: z * z = 4e6, Bd * 4e6 rounds to 4, D = 14 exactly.
-    // The middle pixel sees dd = 0 and the step -> d = step; the ends d = 0.
+    // Three frontal pixels at stride 1: the middle one passes the curvature test (its pair, S = 2^26) and sees
+    // dd = 0 and the step -> d = step; the ends have no pair (kp = 0) and are never fillable, whatever their depth.
     Params p = stride1();
     p.dt_per_m2 = 1.0;
-    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 1, 1}));
-    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.0f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 1, 1}));  // d = 14 = D
-    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.001f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 0, 1}));  // d = 14.000977 > D
+    const std::vector<std::vector<float>> front(3, kFront);
+    const std::vector<std::uint8_t> middle = {0, 1, 0};
+    const std::vector<std::uint8_t> none = {0, 0, 0};
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, front, p), middle);
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.0f}, front, p), middle);  // d = 14 = D
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2014.001f}, front, p), none);  // d = 14.000977 > D
     // At 1 m the growth is only 1 mm: D = 11.
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1012.0f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 0, 1}));
-    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1011.0f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1012.0f}, front, p), none);
+    EXPECT_EQ(robust_row({1000.0f, 1000.0f, 1011.0f}, front, p), middle);
     // z * z = +inf (z = 1e20): D = 10 + inf = +inf, any finite d passes.
-    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, {kFront, kFront, kFront}, p), (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, front, p), middle);
     // Without the growth D = dt_units = 10.
     p.dt_per_m2 = 0.0;
-    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, {kFront, kFront, kFront}, p),
-              (std::vector<std::uint8_t>{1, 0, 1}));
-    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, {kFront, kFront, kFront}, p), (std::vector<std::uint8_t>{1, 0, 1}));
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2012.0f}, front, p), none);
+    EXPECT_EQ(robust_row({2000.0f, 2000.0f, 2010.0f}, front, p), middle);
+    EXPECT_EQ(robust_row({1e20f, 1e20f, 3e20f}, front, p), none);
 
     // Metres: dt_units = (float)0.01, Bd = (float)1e-3; z = 2: D = 0.01 + 0.004 ~ 0.014 >= 2.012f - 2 ~ 0.012.
     Params m = stride1();
     m.unit_mm = 1000.0;
     m.dt_per_m2 = 1.0;
-    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, {kFront, kFront, kFront}, m), (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, front, m), middle);
     m.dt_per_m2 = 0.0;
-    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, {kFront, kFront, kFront}, m), (std::vector<std::uint8_t>{1, 0, 1}));
+    EXPECT_EQ(robust_row({2.0f, 2.0f, 2.012f}, front, m), none);
 }
 
 TEST(ReferenceRobustMetric, CurvatureGrowthMakesANoisyFarSurfaceFillable) {
-    // Normals alternating (+-1024, 0, -8128) / 8192 along a row: each pixel's neighbours have the other sign,
-    // qn . qn' = 8128^2 - 1024^2 = 65015808, so a pixel passes iff L >= 2^26 - 65015808 = 2093056.
-    // No growth: L = 2086252 -> edges. ct_growth_per_m2 = 0.01: Bc = (float)(c0 * 2^26 * 0.01 * 1e-6) =
+    // Normals tilted (+-1024, 0, -8128) / 8192 in the pattern + + - - + + - - along a row: at stride 1 every inner
+    // pixel's pair (x - 1, x + 1) has opposite tilts, qn_a . qn_b = 8128^2 - 1024^2 = 65015808, so it passes iff
+    // L >= 2^26 - 65015808 = 2093056 (the ends have no pair).
+    // No growth: L = 2086252 -> edges. ct_growth_per_m2 = 0.01: Bc = (float)(((c0 * 2^26) * 0.01) * 1e-6) =
     // 0.0208625197...; z = 3000: t = A + Bc * 9e6 = 2274014.75 -> L = 2274014: fillable. The same surface at z = 500:
     // t = 2091467.75 -> L = 2091467 < 2093056: still edges.
     const std::vector<float> plus = {1024.0f / 8192.0f, 0.0f, -8128.0f / 8192.0f};
     const std::vector<float> minus = {-1024.0f / 8192.0f, 0.0f, -8128.0f / 8192.0f};
-    const std::vector<std::vector<float>> noisy = {plus, minus, plus};
+    const std::vector<std::vector<float>> noisy = {plus, plus, minus, minus, plus, plus, minus, minus};
+    const std::vector<std::uint8_t> none(8, 0);
+    const std::vector<std::uint8_t> inner = {0, 1, 1, 1, 1, 1, 1, 0};
     Params p = stride1();
-    EXPECT_EQ(robust_row({3000.0f, 3000.0f, 3000.0f}, noisy, p), (std::vector<std::uint8_t>{0, 0, 0}));
+    EXPECT_EQ(robust_row(std::vector<float>(8, 3000.0f), noisy, p), none);
     p.ct_growth_per_m2 = 0.01;
-    EXPECT_EQ(robust_row({3000.0f, 3000.0f, 3000.0f}, noisy, p), (std::vector<std::uint8_t>{1, 1, 1}));
-    EXPECT_EQ(robust_row({500.0f, 500.0f, 500.0f}, noisy, p), (std::vector<std::uint8_t>{0, 0, 0}));
-    // z * z = +inf: t = +inf -> L = 2^27, even opposite normals pass.
-    EXPECT_EQ(robust_row({1e20f, 1e20f}, {kFront, kBack}, p), (std::vector<std::uint8_t>{1, 1}));
+    EXPECT_EQ(robust_row(std::vector<float>(8, 3000.0f), noisy, p), inner);
+    EXPECT_EQ(robust_row(std::vector<float>(8, 500.0f), noisy, p), none);
+    // z * z = +inf: t = +inf -> L = 2^28, even opposite normals pass (S = -2^26 >= 2^26 - 2^28).
+    const std::vector<float> far(3, 1e20f);
+    EXPECT_EQ(robust_row(far, {kFront, kFront, kBack}, p), (std::vector<std::uint8_t>{0, 1, 0}));
     p.ct_growth_per_m2 = 0.0;
-    EXPECT_EQ(robust_row({1e20f, 1e20f}, {kFront, kBack}, p), (std::vector<std::uint8_t>{0, 0}));
+    EXPECT_EQ(robust_row(far, {kFront, kFront, kBack}, p), (std::vector<std::uint8_t>{0, 0, 0}));
 }
 
 TEST(ReferenceRobustMetric, ParameterErrors) {
