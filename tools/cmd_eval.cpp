@@ -427,11 +427,11 @@ void print_cells(const std::vector<Cell>& row) {
     std::fflush(stdout);
 }
 
-const char* kMetricsParagraph =
+constexpr const char* kMetricsHead =
     " pixels (floor, bin bottom, walls, objects), summed over the seeds. *merged*: objects whose claiming "
     "segment (the one holding more than half of the object) claims another object too. *split*: objects "
     "whose largest segment holds less than ";
-const char* kMetricsParagraphTail =
+constexpr const char* kMetricsTail =
     "% of their labelled pixels, or that have none labelled. *ARI*: adjusted Rand index on ground-truth "
     "pixels, each unlabelled pixel a singleton, mean over the seeds. *labelled*: share of ground-truth pixels "
     "with a segment. *segments*: distinct segments on ground-truth pixels, mean per frame. *bridges*: bridges "
@@ -471,10 +471,11 @@ void noise_sweep(const std::vector<Size>& sizes, int seeds, const std::vector<do
         }
         const std::string name = size_name(size);
         std::vector<std::string> panels;
+        panels.reserve(noises.size());
         for (const double noise : noises) panels.push_back("noise " + format("%g", noise) + " mm");
         const std::string seeds_text = std::to_string(seeds) + (seeds == 1 ? " seed" : " seeds");
         md << "\n## " << name << "\n\n" << table(cells, Sweep::noise) << "\n";
-        md << write_plots(out_dir, cells, panels, bridges, name, " vs bridge width, " + name + ", " + seeds_text);
+        md << write_plots(out_dir, cells, panels, bridges, name, " vs bridge width, " + name + (", " + seeds_text));
     }
 }
 
@@ -700,6 +701,7 @@ struct SensorSweep {
 void sensor_sweep(const SensorSweep& sweep, const fs::path& out_dir, std::ostringstream& md) {
     const double middle = sweep.distances[(sweep.distances.size() - 1) / 2];
     std::vector<std::uint64_t> tune_seeds;
+    tune_seeds.reserve(std::size_t(std::max(0, sweep.tune_seeds)));
     const std::uint64_t first_tune = std::uint64_t(std::max(1000, sweep.seeds)) + 1;
     for (int i = 0; i < sweep.tune_seeds; ++i) tune_seeds.push_back(first_tune + std::uint64_t(i));
     const std::string tune_range = std::to_string(tune_seeds.front()) +
@@ -773,7 +775,7 @@ void sensor_sweep(const SensorSweep& sweep, const fs::path& out_dir, std::ostrin
         const std::string summary_file = "ari_summary_" + name + ".png";
         write_png((out_dir / summary_file).string(),
                   render_line_chart(summary_chart(
-                      runs, sweep.distances, "adjusted rand index vs camera distance, " + name + ", " + seeds_text)));
+                      runs, sweep.distances, "adjusted rand index vs camera distance, " + name + (", " + seeds_text))));
         md << "![ari_summary](" << summary_file << ")\n\n";
 
         md << "### PCL's settings per sensor model\n\n";
@@ -813,7 +815,7 @@ void sensor_sweep(const SensorSweep& sweep, const fs::path& out_dir, std::ostrin
                << ". PCL: " << (run.tuning.done ? run.tuning.chosen : std::string("not built")) << ".\n\n"
                << table(run.cells, Sweep::sensors) << "\n"
                << write_plots(out_dir, run.cells, panels, sweep.bridges, run.name + "_" + name,
-                              " vs bridge width, " + run.name + ", " + name + ", " + seeds_text);
+                              " vs bridge width, " + run.name + (", " + name) + (", " + seeds_text));
         }
     }
 }
@@ -894,8 +896,8 @@ int cmd_eval(const std::vector<std::string>& argv) {
            << ", " << std::thread::hardware_concurrency() << " hardware threads. Sensor models and camera distances "
            << "as the synthetic generator models them (docs/sensors.md).\n\n";
     }
-    md << "Objects: ground-truth ids with >= " << eval::kMinObjectPixels << kMetricsParagraph
-       << int(eval::kSplitShare * 100) << kMetricsParagraphTail;
+    md << "Objects: ground-truth ids with >= " << eval::kMinObjectPixels << kMetricsHead << int(eval::kSplitShare * 100)
+       << kMetricsTail;
 
     const auto start = std::chrono::steady_clock::now();
     if (mode == Sweep::noise) {
