@@ -381,6 +381,40 @@ TEST(Cli, CapeDepthImageWithKinectPresetEachWallIsOneSegment) {
         {{{100, 100}, {100, 400}, {250, 250}, {380, 60}}, {{300, 150, 639, 479}}, {{500, 400}}});
 }
 
+// Without --sensor the defaults apply, and a frame noisier than they suit gets a hint naming a preset; --sensor auto
+// picks that preset; a scanner-like frame gets neither; unknown names are refused with the list.
+TEST(Cli, SensorHintAutoAndUnknownNames) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "scanner.pcd", pyrseg::cli_test::scene_cloud(160, 120, 1),
+                          pyrseg::io::PcdEncoding::binary);
+    CliRun r = run("segment " + (dir / "scanner.pcd").string() + " --labels " + (dir / "a.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("hint:"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "scanner.pcd").string() + " --sensor auto --labels " + (dir / "a.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("sensor auto: structured-light"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "scanner.pcd").string() + " --sensor kinect --labels " + (dir / "a.npy").string());
+    EXPECT_EQ(r.status, 1) << r.output;  // like the other bad parameter values (--ct -1, --backend nope)
+    EXPECT_NE(r.output.find("known: structured-light, kinect-v1, realsense-d435, azure-kinect, auto"),
+              std::string::npos)
+        << r.output;
+    r = run("segment --help");
+    EXPECT_NE(r.output.find("--sensor NAME"), std::string::npos);
+    EXPECT_NE(r.output.find("--edge-rounds E"), std::string::npos);
+    if (fs::exists(mug_scan())) {
+        r = run("segment " + mug_scan().string() + " --unit-mm 1000 --labels " + (dir / "m.npy").string());
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find("hint:"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("Try --sensor kinect-v1"), std::string::npos) << r.output;
+        r = run("segment " + mug_scan().string() + " --unit-mm 1000 --sensor auto --labels " +
+                (dir / "m.npy").string());
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find("sensor auto: kinect-v1"), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("hint:"), std::string::npos) << r.output;
+    }
+    fs::remove_all(dir);
+}
+
 TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
     const fs::path dir = temp_dir();
     const CliRun r = run("demo --size 160x120 --runs 1 --data " + (dir / "none").string() + " --out " + dir.string());
