@@ -11,7 +11,7 @@ inline constexpr int kDefaultBridgeLevels = 2;              // b
 inline constexpr int kDefaultUnjoinableGap = 2;             // g
 inline constexpr int kDefaultNormalRadius = 2;              // normals pass neighbour offset, pixels
 inline constexpr int kDefaultNormalWindow = 3;              // robust normals: (2R+1)^2 window of tangents
-inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: normals compared this far apart
+inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: pairs of normals s before and after
 inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
 inline constexpr int kMaxEdgeRounds = 63;
@@ -38,7 +38,8 @@ struct Params {
     Metric metric = Metric::paper;
     // The robust metric's own parameters; with Metric::paper they must keep these defaults.
     int normal_window = kDefaultNormalWindow;        // R, 1..7: estimated normals sum tangents over (2R+1)^2 pixels
-    int curvature_stride = kDefaultCurvatureStride;  // s, 1..64: the curvature term compares normals s pixels apart
+    int curvature_stride = kDefaultCurvatureStride;  // s, 1..64: the curvature term compares the normals s
+                                                     // pixels before and after each pixel, along 4 axes
     double dt_per_m2 = 0.0;         // millimetres added to dt per square metre of depth (dt + dt_per_m2 * z_m^2)
     double ct_growth_per_m2 = 0.0;  // 1 - cos(ct) grows by this factor per square metre of depth
 };
