@@ -18,6 +18,7 @@
 #include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
+#include "tools/pcl_peer.hpp"
 #include "tools/progress.hpp"
 
 namespace pyrseg::cli {
@@ -27,7 +28,8 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
-    "                      [--ply OUT.ply] [--stats OUT.json|OUT.csv] [--backend NAME] [input options] [parameters]\n"
+    "                      [--ply OUT.ply] [--stats OUT.json|OUT.csv] [--pcl-png OUT.png] [--backend NAME]\n"
+    "                      [input options] [parameters]\n"
     "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,stats]\n"
     "                      [--progress auto|bar|lines|none]\n"
     "\n"
@@ -41,6 +43,9 @@ constexpr const char* kSegmentUsage =
     "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
     "  --stats OUT.json      per segment: label, pixel count, bounding box, 3D centroid (the cloud's units) and\n"
     "  --stats OUT.csv       mean normal, computed by the backend; JSON, or CSV when the name ends in .csv\n"
+    "  --pcl-png OUT.png     PCL's organized segmentation of the same frame in colour, to compare (builds with\n"
+    "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
+    "                        PCL's defaults\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
@@ -52,8 +57,8 @@ constexpr const char* kSegmentUsage =
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply, stats;
-    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || stats; }
+    std::optional<fs::path> labels, png, mask, figure, ply, stats, pcl_png;
+    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || stats || pcl_png; }
 };
 
 struct FrameReport {
@@ -93,7 +98,8 @@ bool same_params(const Params& a, const Params& b) {
 FrameReport segment_frame(const fs::path& input, const Args& args, const Params& base_params, const OutputPaths& out,
                           std::unique_ptr<Segmenter>& segmenter) {
     // NAME.png or NAME.ply in the input's own folder would be the input itself.
-    for (const std::optional<fs::path>* o : {&out.labels, &out.png, &out.mask, &out.figure, &out.ply, &out.stats}) {
+    for (const std::optional<fs::path>* o :
+         {&out.labels, &out.png, &out.mask, &out.figure, &out.ply, &out.stats, &out.pcl_png}) {
         std::error_code ec;
         if (o->has_value() && fs::equivalent(**o, input, ec)) {
             throw Error(ErrorCode::io, (*o)->string() + ": is the input; refusing to overwrite it");
@@ -115,9 +121,12 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     const std::optional<SensorChoice> sensor = parse_sensor(args);
     std::string sensor_note;
     Params params = base_params;
+    std::optional<SensorKind> kind;  // the sensor the parameters are for, when one is named or chosen
+    if (sensor && !sensor->automatic) kind = sensor->kind;
     if (!sensor || sensor->automatic) {
         const FrameNoise noise = measure_frame_noise(view, base_params.unit_mm);
         if (sensor) {
+            kind = noise.suggested;
             params = parse_params(args, noise.suggested);
             sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
         } else if (noise.suggested != SensorKind::structured_light) {
@@ -144,15 +153,21 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));
     if (out.ply) io::write_ply(*out.ply, cloud, result.labels.data(), true);
+    std::string pcl_note;
+    if (out.pcl_png) {
+        const PclRun pcl = pcl_segment(cloud, params.unit_mm, kind);
+        write_png(*out.pcl_png, colorize(pcl.labels, cloud.width, cloud.height));
+        pcl_note = "; " + std::to_string(pcl.regions) + " PCL regions (" + pcl.settings + ")";
+    }
     if (out.stats) {
         io::write_segment_stats(*out.stats, result.segments,
                                 io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
     }
     char line[512];
-    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s%s",
+    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s",
                   input.string().c_str(), loaded.kind.c_str(), result.width, result.height,
                   cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
-                  segmenter->backend_name().c_str(), sensor_note.c_str());
+                  segmenter->backend_name().c_str(), sensor_note.c_str(), pcl_note.c_str());
     return {line, result.segment_count, elapsed.count()};
 }
 
@@ -254,7 +269,8 @@ int run_batch(const Args& args, const Params& params) {
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
-    values.insert({"labels", "png", "mask-png", "figure", "ply", "stats", "backend", "out-dir", "write", "progress"});
+    values.insert(
+        {"labels", "png", "mask-png", "figure", "ply", "stats", "pcl-png", "backend", "out-dir", "write", "progress"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -269,6 +285,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (auto v = args.value("figure")) out.figure = *v;
     if (auto v = args.value("ply")) out.ply = *v;
     if (auto v = args.value("stats")) out.stats = *v;
+    if (auto v = args.value("pcl-png")) out.pcl_png = *v;
     const Params params = parse_params(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
@@ -279,7 +296,8 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
     }
-    if (!out.any()) throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure, --ply or --stats"};
+    if (!out.any())
+        throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure, --ply, --stats or --pcl-png"};
     std::unique_ptr<Segmenter> segmenter;
     std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter).line.c_str());
     return 0;
