@@ -415,6 +415,26 @@ TEST(Cli, SensorHintAutoAndUnknownNames) {
     fs::remove_all(dir);
 }
 
+// --pcl-png draws PCL's segmentation of the same frame when pyrseg is built with PCL, and says why not otherwise.
+TEST(Cli, PclPngComparesWithThePeer) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "scene.pcd", pyrseg::cli_test::scene_cloud(160, 120, 3),
+                          pyrseg::io::PcdEncoding::binary);
+    const CliRun r =
+        run("segment " + (dir / "scene.pcd").string() + " --sensor kinect-v1 --pcl-png " + (dir / "pcl.png").string());
+#ifdef PYRSEG_TEST_PCL_PEER
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "pcl.png"));
+    EXPECT_NE(r.output.find("PCL regions"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("tuned for kinect-v1"), std::string::npos) << r.output;
+#else
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("no PCL peer"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "pcl.png"));
+#endif
+    fs::remove_all(dir);
+}
+
 TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
     const fs::path dir = temp_dir();
     const CliRun r = run("demo --size 160x120 --runs 1 --data " + (dir / "none").string() + " --out " + dir.string());
