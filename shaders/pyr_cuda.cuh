@@ -17,6 +17,7 @@ struct PyrCudaCtx {
     unsigned* sums;
     unsigned* fill; /* the fills' union-find: parents, then minima */
     unsigned* out;
+    unsigned* texels; /* the robust normals' texels, PYR_TEXEL_WORDS per pixel */
     unsigned w;
 };
 
@@ -27,6 +28,8 @@ struct PyrArgs {
 #define PYR_CTX_PARAM const PyrCudaCtx& pyr_ctx
 #define PYR_CTX_ARG pyr_ctx
 #define PYR_PT(x, y, c) pyr_ctx.points[((y)*pyr_ctx.w + (x)) * 3u + (c)]
+#define PYR_TEXEL_WORD(i) pyr_ctx.texels[i]
+#define PYR_STORE_TEXEL_WORD(i, v) (pyr_ctx.texels[i] = (v))
 #define PYR_Q_VALID(i) (pyr_ctx.quant[(i)*2u + 1u] >> 16u)
 #define PYR_QN(i, c) \
     pyr_unpack_q16(pyr_ctx.quant[(i)*2u + (static_cast<unsigned>(c) >> 1u)] >> ((static_cast<unsigned>(c) & 1u) * 16u))

@@ -38,14 +38,27 @@ PYR_KERNEL_2D(normals) {
 }
 #endif
 
-/* normals_robust (2D, w x h): h, radius, window, point scale (float 2^e) */
+/* robust_texels (2D, w x h): h, radius, point scale (float 2^e). Each pixel's tangents and fixed-point depth, once,
+ * for the windows of normals_robust. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_ROBUST_TEXELS)
+PYR_KERNEL_2D(robust_texels) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    pyr_robust_texel_store(PYR_ENTRY_CTX, y * PYR_W + x,
+                           pyr_robust_texel(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1), PYR_ARG_F32(2)));
+}
+#endif
+
+/* normals_robust (2D, w x h): h, window, point scale (float 2^e) */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_NORMALS_ROBUST)
 PYR_KERNEL_2D(normals_robust) {
     pyr_u32 h = PYR_ARG(0);
     pyr_u32 x = PYR_X;
     pyr_u32 y = PYR_Y;
     if (x >= PYR_W || y >= h) return;
-    PyrIVec3 q = pyr_robust_normal_q(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1), PYR_ARG(2), PYR_ARG_F32(3));
+    PyrIVec3 q = pyr_robust_normal_q(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(1), PYR_ARG_F32(2));
     pyr_u32 i = y * PYR_W + x;
     PYR_STORE_NORMAL(i * 3u + 0u, PYR_F32(q.x) * PYR_NORMAL_UNIT);
     PYR_STORE_NORMAL(i * 3u + 1u, PYR_F32(q.y) * PYR_NORMAL_UNIT);

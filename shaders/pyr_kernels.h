@@ -12,6 +12,7 @@
 
 #define PYR_KERNEL_TABLE(K)              \
     K(normals, NORMALS, 2)               \
+    K(robust_texels, ROBUST_TEXELS, 2)   \
     K(normals_robust, NORMALS_ROBUST, 2) \
     K(quantize, QUANTIZE, 1)             \
     K(metric, METRIC, 2)                 \

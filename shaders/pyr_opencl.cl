@@ -3,11 +3,14 @@
 #define PYR_CTX_PARAM                                                                                              \
     __global const float *pyr_buf_points, __global float *pyr_buf_normals, __global uint *pyr_buf_quant,          \
         __global uchar *pyr_buf_mask, __global uint *pyr_buf_labels, __global uint *pyr_buf_lut,                 \
-        __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out, uint pyr_w
+        __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out,                    \
+        __global uint *pyr_buf_texels, uint pyr_w
 #define PYR_CTX_ARG                                                                                               \
     pyr_buf_points, pyr_buf_normals, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut, pyr_buf_sums,     \
-        pyr_buf_fill, pyr_buf_out, pyr_w
+        pyr_buf_fill, pyr_buf_out, pyr_buf_texels, pyr_w
 #define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
+#define PYR_TEXEL_WORD(i) pyr_buf_texels[i]
+#define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_texels[i] = (v))
 #define PYR_Q_VALID(i) (pyr_buf_quant[(i) * 2u + 1u] >> 16u)
 #define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i) * 2u + ((uint)(c) >> 1u)] >> (((uint)(c) & 1u) * 16u))
 #define PYR_QZ(i) pyr_buf_points[(i) * 3u + 2u]

@@ -75,15 +75,44 @@ PYR_FN PyrRobustTexel pyr_robust_texel(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_
     return t;
 }
 
-/* Where a window reads its texels. GPUs compute each where it is needed (neighbouring invocations share the point
- * loads in cache); the CPU defines this to read texels it computed once per frame. It expands inside
- * pyr_robust_normal_q, whose parameters (w, h, r, scale) it names. */
+/* Where a window reads its texels: every backend computes each pixel's texel once per frame (pyr_robust_texel) and
+ * the windows read them. The CPU defines PYR_ROBUST_TEXEL over its own array; a GPU dialect defines
+ * PYR_TEXEL_WORD(i) and PYR_STORE_TEXEL_WORD(i, v) over a buffer of PYR_TEXEL_WORDS words per pixel (the
+ * robust_texels kernel writes them). The macro expands inside pyr_robust_normal_q, whose parameter w it names. */
+#ifdef PYR_TEXEL_WORD
+PYR_FN void pyr_robust_texel_store(PYR_CTX_PARAM, pyr_u32 i, PyrRobustTexel t) {
+    pyr_u32 k = i * PYR_TEXEL_WORDS;
+    PYR_STORE_TEXEL_WORD(k + 0u, PYR_U32(t.gz));
+    PYR_STORE_TEXEL_WORD(k + 1u, t.tangents);
+    PYR_STORE_TEXEL_WORD(k + 2u, PYR_U32(t.th.x));
+    PYR_STORE_TEXEL_WORD(k + 3u, PYR_U32(t.th.y));
+    PYR_STORE_TEXEL_WORD(k + 4u, PYR_U32(t.th.z));
+    PYR_STORE_TEXEL_WORD(k + 5u, PYR_U32(t.tv.x));
+    PYR_STORE_TEXEL_WORD(k + 6u, PYR_U32(t.tv.y));
+    PYR_STORE_TEXEL_WORD(k + 7u, PYR_U32(t.tv.z));
+}
+
+PYR_FN PyrRobustTexel pyr_robust_texel_load(PYR_CTX_PARAM, pyr_u32 i) {
+    pyr_u32 k = i * PYR_TEXEL_WORDS;
+    PyrRobustTexel t;
+    t.gz = PYR_I32(PYR_TEXEL_WORD(k + 0u));
+    t.tangents = PYR_TEXEL_WORD(k + 1u);
+    t.th.x = PYR_I32(PYR_TEXEL_WORD(k + 2u));
+    t.th.y = PYR_I32(PYR_TEXEL_WORD(k + 3u));
+    t.th.z = PYR_I32(PYR_TEXEL_WORD(k + 4u));
+    t.tv.x = PYR_I32(PYR_TEXEL_WORD(k + 5u));
+    t.tv.y = PYR_I32(PYR_TEXEL_WORD(k + 6u));
+    t.tv.z = PYR_I32(PYR_TEXEL_WORD(k + 7u));
+    return t;
+}
+#define PYR_ROBUST_TEXEL(jx, jy) pyr_robust_texel_load(PYR_CTX_ARG, (jy)*w + (jx))
+#endif
 #ifndef PYR_ROBUST_TEXEL
-#define PYR_ROBUST_TEXEL(jx, jy) pyr_robust_texel(PYR_CTX_ARG, w, h, jx, jy, r, scale)
+#error "define PYR_ROBUST_TEXEL (the CPU) or PYR_TEXEL_WORD and PYR_STORE_TEXEL_WORD (a GPU dialect)"
 #endif
 
-PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r,
-                                    pyr_u32 window, pyr_f32 scale) {
+PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 window,
+                                    pyr_f32 scale) {
     PyrIVec3 none;
     none.x = 0;
     none.y = 0;

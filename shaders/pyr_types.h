@@ -30,6 +30,8 @@ struct PyrIVec3 {
 
 /* One pixel's share of the robust normals' windows (docs/algorithm.md section 8b): its fixed-point depth G(z) (-1
  * when the point is not point-valid) and its tangents, bit 0 of `tangents` when t_h exists, bit 1 when t_v does. */
+/* The words of a texel in a GPU buffer (shaders/pyr_robust.h: pyr_robust_texel_store). */
+#define PYR_TEXEL_WORDS 8u
 PYR_TYPEDEF(PyrRobustTexel)
 struct PyrRobustTexel {
     pyr_i32 gz;

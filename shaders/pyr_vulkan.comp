@@ -18,10 +18,11 @@ layout(std430, set = 0, binding = 5) buffer PyrLutBuf { uint pyr_buf_lut[]; }; /
 layout(std430, set = 0, binding = 6) buffer PyrSumsBuf { uint pyr_buf_sums[]; };   /* compaction scan; K last */
 layout(std430, set = 0, binding = 7) coherent buffer PyrFillBuf { uint pyr_buf_fill[]; }; /* fills' union-find */
 layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };     /* compacted labels */
+layout(std430, set = 0, binding = 9) buffer PyrTexelsBuf { uint pyr_buf_texels[]; }; /* robust normals' texels */
 /* The points and normals from float pyr_push.split on: the rest of the same buffers, bound from there when a frame's
  * xyz arrays exceed one binding's range (vulkan_backend.cpp). */
-layout(std430, set = 0, binding = 9) readonly buffer PyrPointsHiBuf { float pyr_buf_points_hi[]; };
-layout(std430, set = 0, binding = 10) buffer PyrNormalsHiBuf { float pyr_buf_normals_hi[]; };
+layout(std430, set = 0, binding = 10) readonly buffer PyrPointsHiBuf { float pyr_buf_points_hi[]; };
+layout(std430, set = 0, binding = 11) buffer PyrNormalsHiBuf { float pyr_buf_normals_hi[]; };
 #if defined(PYR_ENTRY_BIND_MASK)
 /* A mask frame's input words share binding 0 with the points (gpu_executor.cpp: bind_mask). */
 layout(std430, set = 0, binding = 0) readonly buffer PyrMaskInputBuf { uint pyr_buf_mask_input[]; };
@@ -50,6 +51,8 @@ void pyr_store_normal(uint k, float v) {
 #define PYR_CTX_PARAM uint pyr_w
 #define PYR_CTX_ARG pyr_w
 #define PYR_PT(x, y, c) pyr_point(((y) * pyr_w + (x)) * 3u + (c))
+#define PYR_TEXEL_WORD(i) pyr_buf_texels[i]
+#define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_texels[i] = (v))
 #define PYR_Q_VALID(i) (pyr_buf_quant[(i) * 2u + 1u] >> 16u)
 #define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i) * 2u + (uint(c) >> 1u)] >> ((uint(c) & 1u) * 16u))
 #define PYR_QZ(i) pyr_point((i) * 3u + 2u)

@@ -106,9 +106,9 @@ public:
         }
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
-                const PyrIVec3 q = robust ? kernels::pyr_robust_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y),
-                                                                         radius, window, scale)
-                                          : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
+                const PyrIVec3 q =
+                    robust ? kernels::pyr_robust_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), window, scale)
+                           : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
                 float* n = normals_.data() + 3 * (y * w + x);
                 n[0] = float(q.x) * PYR_NORMAL_UNIT;
                 n[1] = float(q.y) * PYR_NORMAL_UNIT;

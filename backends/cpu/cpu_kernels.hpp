@@ -45,9 +45,8 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_QN(i, c) static_cast<std::int32_t>(ctx.quant[i].q[c])
 #define PYR_QZ(i) (ctx.quant[i].z)
 // The robust normals read the texels estimate_normals computed once per frame (w: the image width, named by the
-// function it expands in, as are r and scale, which the GPUs' definition uses and this one need not).
-#define PYR_ROBUST_TEXEL(jx, jy) \
-    ((void)h, (void)r, (void)scale, ctx.robust_texels[static_cast<std::size_t>(jy) * (w) + (jx)])
+// function it expands in).
+#define PYR_ROBUST_TEXEL(jx, jy) (ctx.robust_texels[static_cast<std::size_t>(jy) * (w) + (jx)])
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))

@@ -143,11 +143,17 @@ public:
         upload_ = Memory<true>(staging.upload, "cudaMallocHost(upload staging)");
         download_ = Memory<true>(staging.download, "cudaMallocHost(download staging)");
         staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
-        ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points), buffer<float>(gpu::Buffer::normals),
-                          buffer<unsigned>(gpu::Buffer::quant),     buffer<unsigned char>(gpu::Buffer::mask),
-                          buffer<unsigned>(gpu::Buffer::labels),    buffer<unsigned>(gpu::Buffer::lut),
-                          buffer<unsigned>(gpu::Buffer::sums),      buffer<unsigned>(gpu::Buffer::fill),
-                          buffer<unsigned>(gpu::Buffer::out),       image_width};
+        ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points),
+                          buffer<float>(gpu::Buffer::normals),
+                          buffer<unsigned>(gpu::Buffer::quant),
+                          buffer<unsigned char>(gpu::Buffer::mask),
+                          buffer<unsigned>(gpu::Buffer::labels),
+                          buffer<unsigned>(gpu::Buffer::lut),
+                          buffer<unsigned>(gpu::Buffer::sums),
+                          buffer<unsigned>(gpu::Buffer::fill),
+                          buffer<unsigned>(gpu::Buffer::out),
+                          buffer<unsigned>(gpu::Buffer::texels),
+                          image_width};
     }
 
     void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {

@@ -21,7 +21,7 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr cl_uint kContextArgs = 10;  // PYR_CTX_PARAM in shaders/pyr_opencl.cl: the buffers, then the width
+constexpr cl_uint kContextArgs = 11;  // PYR_CTX_PARAM in shaders/pyr_opencl.cl: the buffers, then the width
 static_assert(kContextArgs == gpu::kBufferCount + 1);
 
 size_t round_up(size_t v, size_t m) {

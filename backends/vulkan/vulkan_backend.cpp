@@ -69,7 +69,7 @@ public:
             const std::string what = std::string("the ") + gpu::buffer_name(gpu::Buffer(b)) + " buffer";
             buffers_[b] = VulkanBuffer(*rt_, sizes[b], VulkanBuffer::Memory::device, what.c_str());
         }
-        // Points and normals (same size) beyond one binding's range continue in bindings 9 and 10.
+        // Points and normals (same size) beyond one binding's range continue in bindings 10 and 11.
         const VkDeviceSize xyz = sizes[size_t(gpu::Buffer::points)];
         split_bytes_ = xyz <= rt_->properties.limits.maxStorageBufferRange ? xyz : aligned_range();
         const gpu::StagingBytes staging = gpu::staging_bytes(sizes);

@@ -34,7 +34,7 @@ struct Args {
 
 // The buffers every GPU backend binds, in this order (OpenCL's kernel arguments, Vulkan's bindings, CUDA's
 // context). Sizes come from the plan (gpu::buffer_sizes); the mask holds mask_texel_bytes per texel.
-enum class Buffer : std::uint32_t { points, normals, quant, mask, labels, lut, sums, fill, out, count };
+enum class Buffer : std::uint32_t { points, normals, quant, mask, labels, lut, sums, fill, out, texels, count };
 inline constexpr std::size_t kBufferCount = std::size_t(Buffer::count);
 [[nodiscard]] const char* buffer_name(Buffer b);
 using BufferSizes = std::array<std::size_t, kBufferCount>;  // bytes

@@ -34,7 +34,8 @@ constexpr KernelInfo kKernels[] = {
 };
 static_assert(std::size(kKernels) == kKernelCount);
 
-constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels", "lut", "sums", "fill", "out"};
+constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels",
+                                        "lut",    "sums",    "fill",  "out",  "texels"};
 static_assert(std::size(kBufferNames) == kBufferCount);
 
 Args args(std::initializer_list<uint32_t> words) {
@@ -92,9 +93,10 @@ public:
 
     void estimate_normals() override {
         if (plan_.params.metric == Metric::robust) {
+            dispatch(Kernel::robust_texels, width(), height(),
+                     args({height(), uint32_t(plan_.params.normal_radius), bits(plan_.thresholds.point_scale)}));
             dispatch(Kernel::normals_robust, width(), height(),
-                     args({height(), uint32_t(plan_.params.normal_radius), uint32_t(plan_.params.normal_window),
-                           bits(plan_.thresholds.point_scale)}));
+                     args({height(), uint32_t(plan_.params.normal_window), bits(plan_.thresholds.point_scale)}));
             return;
         }
         dispatch(Kernel::normals, width(), height(), args({height(), uint32_t(plan_.params.normal_radius)}));
@@ -289,6 +291,8 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
     s[size_t(Buffer::fill)] = size_t(8) * fill_level.width * fill_level.height;
     s[size_t(Buffer::out)] = 4 * px;
+    // The robust normals' texels (shaders/pyr_robust.h), only for the robust metric.
+    s[size_t(Buffer::texels)] = plan.params.metric == Metric::robust ? 4 * size_t(PYR_TEXEL_WORDS) * px : 0;
     for (size_t& bytes : s) bytes = std::max<size_t>(bytes, 4);
     return s;
 }

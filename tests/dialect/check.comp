@@ -25,6 +25,8 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 #define PYR_STATS_ADD(w, v) atomicAdd(pyr_buf_lut[w], v)
 #define PYR_STATS_MAX(w, v) atomicMax(pyr_buf_lut[w], v)
+#define PYR_TEXEL_WORD(i) pyr_buf_lut[i]
+#define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_lut[i] = (v))
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -48,7 +50,8 @@ void main() {
     PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
     uint r = pyr_metric_fillable(PYR_CTX_ARG, 64u, 64u, x, y, 100, 1.0f);
     r += pyr_metric_robust_fillable(PYR_CTX_ARG, 64u, 64u, x, y, 4u, 100.0f, 0.5f, 1.0f, 0.25f);
-    r += PYR_U32(pyr_robust_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 1u, 3u, 16.0f).z);
+    r += PYR_U32(pyr_robust_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 3u, 16.0f).z);
+    pyr_robust_texel_store(PYR_CTX_ARG, y * 64u + x, pyr_robust_texel(PYR_CTX_ARG, 64u, 64u, x, y, 1u, 16.0f));
     r += pyr_mip_texel(PYR_CTX_ARG, lv, x, y);
     r += pyr_label_init_texel(PYR_CTX_ARG, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);

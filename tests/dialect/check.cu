@@ -21,6 +21,8 @@ struct Ctx {
 #define PYR_STORE_LUT(l, v) (ctx.lut[l] = (v))
 #define PYR_STATS_ADD(w, v) pyr_cuda_atomic_add(&ctx.lut[w], v)
 #define PYR_STATS_MAX(w, v) pyr_cuda_atomic_max(&ctx.lut[w], v)
+#define PYR_TEXEL_WORD(i) ctx.lut[i]
+#define PYR_STORE_TEXEL_WORD(i, v) (ctx.lut[i] = (v))
 #include "pyr_compact.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
@@ -41,7 +43,8 @@ __global__ void all_passes(Ctx ctx, int* out) {
     const PyrQuant qu = pyr_quantize(1.0f, 2.0f, 3.0f, 0.0f, 0.0f, -1.0f);
     unsigned r = pyr_metric_fillable(ctx, 64u, 64u, x, y, 100, 1.0f);
     r += pyr_metric_robust_fillable(ctx, 64u, 64u, x, y, 4u, 100.0f, 0.5f, 1.0f, 0.25f);
-    r += PYR_U32(pyr_robust_normal_q(ctx, 64u, 64u, x, y, 1u, 3u, 16.0f).z);
+    r += PYR_U32(pyr_robust_normal_q(ctx, 64u, 64u, x, y, 3u, 16.0f).z);
+    pyr_robust_texel_store(ctx, y * 64u + x, pyr_robust_texel(ctx, 64u, 64u, x, y, 1u, 16.0f));
     r += pyr_mip_texel(ctx, lv, x, y);
     r += pyr_label_init_texel(ctx, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(ctx, y * 64u, 1u, 64u, 0u);
