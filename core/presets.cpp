@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/cloud_layout.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg {
@@ -114,10 +115,8 @@ FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm) {
         out.reason = "the frame is too small to measure its noise";
         return out;
     }
-    const std::size_t row_stride = cloud.row_stride != 0 ? cloud.row_stride : std::size_t(cloud.width);
-    const auto z_at = [&](std::size_t x, std::size_t y) {
-        return double(cloud.points[(y * row_stride + x) * std::size_t(cloud.point_stride) + 2]) * unit_mm;
-    };
+    const core::CloudLayout layout = core::cloud_layout(cloud);
+    const auto z_at = [&](std::size_t x, std::size_t y) { return double(cloud.points[layout.at(x, y) + 2]) * unit_mm; };
     std::vector<float> second;  // |second difference|, mm
     std::vector<double> depths;
     for (std::size_t y = 0; y < std::size_t(cloud.height); y += 2) {  // every other row: plenty of samples

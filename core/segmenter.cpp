@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/backend_registry.hpp"
+#include "core/cloud_layout.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
 #include "pyrseg/backend.hpp"
@@ -85,11 +86,7 @@ Segmenter& Segmenter::operator=(Segmenter&&) noexcept = default;
 void Segmenter::segment(const CloudView& cloud, Result& out) {
     if (cloud.points == nullptr) throw Error(ErrorCode::invalid_argument, "cloud.points is null");
     check_frame_size("the cloud", cloud.width, cloud.height, impl_->plan);
-    if (cloud.point_stride < 3) {
-        throw Error(ErrorCode::invalid_argument,
-                    "cloud.point_stride " + std::to_string(cloud.point_stride) + " is smaller than 3 floats");
-    }
-    check_layout("the cloud's", cloud.row_stride, cloud.point_stride, cloud.width, cloud.height);
+    (void)core::cloud_layout(cloud);  // throws when the steps do not fit
     const auto input =
         cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
     run_frame(

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "core/cloud_layout.hpp"
 #include "pyrseg/cloud.hpp"
 #include "pyrseg/result.hpp"
 #include "shaders/pyr_types.h"
@@ -16,22 +17,20 @@ namespace pyrseg::core {
 inline void pack_xyz(const CloudView& cloud, const float* data, float* dst) {
     const std::size_t w = std::size_t(cloud.width);
     const std::size_t h = std::size_t(cloud.height);
-    const std::size_t row_stride = cloud.row_stride == 0 ? w : cloud.row_stride;
-    const std::size_t ps = std::size_t(cloud.point_stride);
-    if (ps == 3 && row_stride == w) {
+    const CloudLayout layout = cloud_layout(cloud);
+    if (layout.packed(w)) {
         std::memcpy(dst, data, 3 * w * h * sizeof(float));
         return;
     }
     for (std::size_t y = 0; y < h; ++y) {
-        for (std::size_t x = 0; x < w; ++x) {
-            std::memcpy(dst + 3 * (y * w + x), data + (y * row_stride + x) * ps, 3 * sizeof(float));
-        }
+        for (std::size_t x = 0; x < w; ++x)
+            std::memcpy(dst + 3 * (y * w + x), data + layout.at(x, y), 3 * sizeof(float));
     }
 }
 
 // Whether pack_xyz would only copy (the backend may then upload straight from the caller's memory).
 inline bool is_packed_xyz(const CloudView& cloud) {
-    return cloud.point_stride == 3 && (cloud.row_stride == 0 || cloud.row_stride == std::size_t(cloud.width));
+    return cloud_layout(cloud).packed(std::size_t(cloud.width));
 }
 
 // Where a frame's results lie in a backend's download staging memory (bytes from its start): labels, raw labels,

@@ -14,6 +14,7 @@
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
+#include "core/cloud_layout.hpp"
 #include "core/segment_stats.hpp"
 #include "pyrseg/error.hpp"
 
@@ -57,7 +58,7 @@ public:
     void bind_cloud(const CloudView& cloud) override {
         fill_rounds_ = 0;
         cloud_ = cloud;
-        if (cloud_.row_stride == 0) cloud_.row_stride = size_t(cloud_.width);
+        layout_ = core::cloud_layout(cloud);
         normals_estimated_ = false;
         from_mask_ = false;
     }
@@ -335,8 +336,8 @@ private:
     [[nodiscard]] PassContext context() {
         PassContext c;
         c.points = cloud_.points;
-        c.row_stride = cloud_.row_stride;
-        c.point_stride = size_t(cloud_.point_stride);
+        c.row_floats = layout_.row_floats;
+        c.point_floats = layout_.point_floats;
         c.quant = quant_.data();
         c.mask_valid = from_mask_ ? mask_valid_.data() : nullptr;
         c.mask = mask_.data();
@@ -346,12 +347,10 @@ private:
         return c;
     }
 
-    [[nodiscard]] const float* point(size_t x, size_t y) const {
-        return cloud_.points + (y * cloud_.row_stride + x) * size_t(cloud_.point_stride);
-    }
+    [[nodiscard]] const float* point(size_t x, size_t y) const { return cloud_.points + layout_.at(x, y); }
     [[nodiscard]] const float* normal(size_t x, size_t y) const {
         if (normals_estimated_) return normals_.data() + 3 * (y * size_t(plan_.width) + x);
-        return cloud_.normals + (y * cloud_.row_stride + x) * size_t(cloud_.point_stride);
+        return cloud_.normals + layout_.at(x, y);
     }
 
     // One round of the four directional sweeps (rows left-right then right-left, then columns top-down then
@@ -453,6 +452,7 @@ private:
     const core::Plan& plan_;
     ThreadPool pool_;
     CloudView cloud_{};
+    core::CloudLayout layout_{};
     std::vector<float> normals_;                 // estimated, packed
     std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
     std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)

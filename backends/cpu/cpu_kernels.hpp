@@ -18,8 +18,8 @@ struct QuantPixel {
 
 struct PassContext {
     const float* points = nullptr;  // the caller's cloud, strided
-    std::size_t row_stride = 0;     // in points
-    std::size_t point_stride = 3;   // in floats
+    std::size_t row_floats = 0;     // from one row to the next
+    std::size_t point_floats = 3;   // from one point to the next
     const QuantPixel* quant = nullptr;
     const std::uint8_t* mask_valid = nullptr;  // a caller's mask's validity, else null (validity is in quant)
     std::uint8_t* mask = nullptr;              // all levels
@@ -40,7 +40,8 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 
 #define PYR_CTX_PARAM const ::pyrseg::cpu::PassContext& ctx
 #define PYR_CTX_ARG ctx
-#define PYR_PT(x, y, c) (ctx.points[(static_cast<std::size_t>(y) * ctx.row_stride + (x)) * ctx.point_stride + (c)])
+#define PYR_PT(x, y, c) \
+    (ctx.points[static_cast<std::size_t>(y) * ctx.row_floats + static_cast<std::size_t>(x) * ctx.point_floats + (c)])
 #define PYR_Q_VALID(i) static_cast<std::uint32_t>(ctx.quant[i].valid)
 #define PYR_QN(i, c) static_cast<std::int32_t>(ctx.quant[i].q[c])
 #define PYR_QZ(i) (ctx.quant[i].z)

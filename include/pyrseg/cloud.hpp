@@ -7,13 +7,21 @@ namespace pyrseg {
 // Point (x, y) component c is points[(y * row_stride + x) * point_stride + c]; normals use the same layout.
 // point_stride 3 is packed xyz; 4 is PCL's padded PointXYZ; a PCL PointNormal array works with both pointers
 // into the same array (&cloud[0].x and &cloud[0].normal_x) and point_stride = sizeof(PointNormal)/sizeof(float).
+//
+// Layouts whose rows are not whole points (a ROS sensor_msgs/PointCloud2 with padded rows, an SDK's interleaved
+// buffer) are given in bytes instead: point (x, y) then starts y * row_step_bytes + x * point_step_bytes bytes after
+// `points` (and after `normals`). ROS: point_step and row_step, with `points` at the x field's offset; PCL:
+// sizeof(PointT). Byte steps must be multiples of 4 (floats are read in place, so the pointers must be 4-byte
+// aligned too); a step given in bytes replaces the one given in floats or points, which must then keep its default.
 struct CloudView {
     const float* points = nullptr;   // required; camera space, z along the optical axis, in the caller's unit
     const float* normals = nullptr;  // optional; unit length expected; estimated when null
     int width = 0;
     int height = 0;
-    std::size_t row_stride = 0;  // in points; 0 means width
-    int point_stride = 3;        // floats from one point to the next, >= 3
+    std::size_t row_stride = 0;        // in points; 0 means width
+    int point_stride = 3;              // floats from one point to the next, >= 3
+    std::size_t point_step_bytes = 0;  // bytes from one point to the next, >= 12; 0: point_stride floats
+    std::size_t row_step_bytes = 0;    // bytes from one row to the next; 0: row_stride points
 };
 
 }  // namespace pyrseg

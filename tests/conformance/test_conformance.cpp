@@ -12,6 +12,7 @@
 #include "conformance/cases.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
+#include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "support/oracle.hpp"
@@ -213,6 +214,57 @@ TEST_P(StridedClouds, MatchTheReferenceLikePackedOnes) {
         EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width));
         EXPECT_EQ(result.segment_count, ref.segment_count) << (given_normals ? "given normals" : "estimated normals");
         EXPECT_TRUE(same_segments(result.segments, ref.segments));
+    }
+}
+
+// A ROS sensor_msgs/PointCloud2-like buffer: fields x y z rgb normal_x normal_y normal_z curvature (point_step 32
+// bytes, normal_x at byte 16) in rows padded by 20 bytes (row_step = 32 * width + 20, not a whole number of points),
+// viewed in place through the byte steps, with the robust metric's preset too.
+TEST_P(StridedClouds, ByteStepsOfAPointCloud2MatchTheReference) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    synthetic::SceneOptions o;
+    o.width = 96;
+    o.height = 70;
+    o.seed = 11;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const std::size_t w = std::size_t(o.width);
+    const std::size_t h = std::size_t(o.height);
+    const std::size_t point_step = 32;
+    const std::size_t row_step = point_step * w + 20;
+    std::vector<float> buffer(h * row_step / sizeof(float), -12345.0f);
+    for (std::size_t y = 0; y < h; ++y) {
+        for (std::size_t x = 0; x < w; ++x) {
+            float* p = &buffer[(y * row_step + x * point_step) / sizeof(float)];
+            for (std::size_t c = 0; c < 3; ++c) {
+                p[c] = scene.points[3 * (y * w + x) + c];
+                p[4 + c] = scene.normals[3 * (y * w + x) + c];
+            }
+        }
+    }
+    for (const Params& params : {Params{}, sensor_preset(SensorKind::kinect_v1)}) {
+        for (const bool given_normals : {false, true}) {
+            const pyrseg_ref::Output ref =
+                pyrseg_ref::segment(scene.points.data(), given_normals ? scene.normals.data() : nullptr, o.width,
+                                    o.height, to_reference(params));
+            ASSERT_TRUE(ref.ok) << ref.error;
+            Segmenter segmenter(o.width, o.height, params, GetParam(), everything());
+            CloudView view;
+            view.points = buffer.data();
+            view.normals = given_normals ? buffer.data() + 4 : nullptr;
+            view.width = o.width;
+            view.height = o.height;
+            view.point_step_bytes = point_step;
+            view.row_step_bytes = row_step;
+            Result result;
+            segmenter.segment(view, result);
+            const std::string what = std::string(params.metric == Metric::robust ? "robust" : "paper") +
+                                     (given_normals ? ", given normals" : ", estimated normals");
+            EXPECT_TRUE(same_bytes("fillable mask", result.fillable_mask, ref.fillable, o.width)) << what;
+            EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, o.width, 3)) << what;
+            EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width)) << what;
+            EXPECT_TRUE(same_segments(result.segments, ref.segments)) << what;
+        }
     }
 }
 

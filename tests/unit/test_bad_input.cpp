@@ -137,6 +137,41 @@ TEST(BadInput, SizesAndLayoutsThatDoNotFitAreErrors) {
         v.point_stride = 2;
         (void)s.segment(v);
     });
+    // Byte steps: multiples of 4, at least x y z, rows that hold a row of points, one way of giving each step.
+    for (const std::size_t bad : {std::size_t(13), std::size_t(8), std::size_t(0) - 4}) {
+        expect_error(ErrorCode::invalid_argument, "point_step_bytes", [&] {
+            CloudView v = plane.view();
+            v.point_step_bytes = bad;
+            (void)s.segment(v);
+        });
+    }
+    expect_error(ErrorCode::invalid_argument, "row_step_bytes", [&] {
+        CloudView v = plane.view();
+        v.row_step_bytes = 12 * 32 - 4;  // one float short of a row of 32 packed points
+        (void)s.segment(v);
+    });
+    expect_error(ErrorCode::invalid_argument, "row_step_bytes", [&] {
+        CloudView v = plane.view();
+        v.row_step_bytes = 12 * 32 + 2;
+        (void)s.segment(v);
+    });
+    expect_error(ErrorCode::invalid_argument, "both given", [&] {
+        CloudView v = plane.view();
+        v.row_stride = 40;
+        v.row_step_bytes = 12 * 40;
+        (void)s.segment(v);
+    });
+    expect_error(ErrorCode::invalid_argument, "both given", [&] {
+        CloudView v = plane.view();
+        v.point_stride = 4;
+        v.point_step_bytes = 16;
+        (void)s.segment(v);
+    });
+    expect_error(ErrorCode::invalid_argument, "aligned", [&] {
+        CloudView v = plane.view();
+        v.points = reinterpret_cast<const float*>(reinterpret_cast<const char*>(v.points) + 1);
+        (void)s.segment(v);
+    });
     expect_error(ErrorCode::invalid_argument, "null", [&] {
         CloudView v = plane.view();
         v.points = nullptr;
