@@ -11,6 +11,7 @@
 namespace pyrseg::core {
 
 struct Plan;
+struct DepthTables;
 
 class PassExecutor {
 public:
@@ -22,6 +23,10 @@ public:
     // Input: a cloud (passes from normals on), or a caller's mask (passes from the pyramid on).
     virtual void bind_cloud(const CloudView& cloud) = 0;
     virtual void bind_mask(const MaskView& mask) = 0;
+    // A depth image and its per-frame constants (docs/algorithm.md section 1b); depth_to_points back-projects it
+    // into the points the passes from normals on read.
+    virtual void bind_depth(const DepthView& depth, const DepthTables& tables) = 0;
+    virtual void depth_to_points() = 0;
     virtual void estimate_normals() = 0;                          // when the cloud has no normals
     virtual void quantize() = 0;                                  // validity and qn per pixel
     virtual void metric() = 0;                                    // fillable mask B into level N

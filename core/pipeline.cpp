@@ -37,7 +37,8 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
     PassClock clock(timings, ex);
     const int n = plan.level_count;
     if (input != InputKind::mask) {
-        if (input == InputKind::cloud_without_normals) clock.run("normals", [&] { ex.estimate_normals(); });
+        if (input == InputKind::depth) clock.run("depth", [&] { ex.depth_to_points(); });
+        if (input != InputKind::cloud_with_normals) clock.run("normals", [&] { ex.estimate_normals(); });
         clock.run("quantize", [&] { ex.quantize(); });
         clock.run("metric", [&] { ex.metric(); });
     }

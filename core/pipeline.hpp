@@ -7,7 +7,7 @@
 
 namespace pyrseg::core {
 
-enum class InputKind { cloud_with_normals, cloud_without_normals, mask };
+enum class InputKind { cloud_with_normals, cloud_without_normals, depth, mask };
 
 // Runs the contract's passes in order on `executor`; times each pass (host wall time) into `timings`.
 void run_pipeline(const Plan& plan, InputKind input, PassExecutor& executor, std::vector<PassTiming>& timings);

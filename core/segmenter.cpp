@@ -6,6 +6,7 @@
 
 #include "core/backend_registry.hpp"
 #include "core/cloud_layout.hpp"
+#include "core/depth_tables.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
 #include "pyrseg/backend.hpp"
@@ -45,6 +46,7 @@ struct Segmenter::Impl {
     Outputs outputs;
     std::unique_ptr<core::PassExecutor> executor;
     std::vector<PassTiming> timings;
+    core::DepthTables depth_tables;  // a depth frame's constants, reused
 };
 
 namespace {
@@ -91,6 +93,19 @@ void Segmenter::segment(const CloudView& cloud, Result& out) {
         cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
     run_frame(
         *impl_, input, [&] { impl_->executor->bind_cloud(cloud); }, out);
+}
+
+void Segmenter::segment(const DepthView& depth, Result& out) {
+    check_frame_size("the depth image", depth.width, depth.height, impl_->plan);
+    core::make_depth_tables(depth, impl_->plan.params.unit_mm, impl_->depth_tables);
+    run_frame(
+        *impl_, core::InputKind::depth, [&] { impl_->executor->bind_depth(depth, impl_->depth_tables); }, out);
+}
+
+Result Segmenter::segment(const DepthView& depth) {
+    Result out;
+    segment(depth, out);
+    return out;
 }
 
 Result Segmenter::segment(const CloudView& cloud) {

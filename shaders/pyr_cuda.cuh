@@ -8,7 +8,7 @@
 
 /* The buffers in gpu::Buffer order, then the image width. */
 struct PyrCudaCtx {
-    const float* points;
+    float* points; /* depth frames write it */
     float* normals;
     unsigned* quant; /* two words per pixel: pyr_pack_q16(qx, qy), pyr_pack_q16(qz, valid) */
     unsigned char* mask;
@@ -44,6 +44,7 @@ struct PyrArgs {
 #define PYR_STATS_MAX(w, v) pyr_cuda_atomic_max(&pyr_ctx.lut[w], (v))
 
 #include "pyr_compact.h"
+#include "pyr_depth.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_labels.h"
@@ -92,6 +93,7 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 #define PYR_POINT(k) pyr_ctx.points[k]
 #define PYR_NORMAL(k) pyr_ctx.normals[k]
 #define PYR_STORE_NORMAL(k, v) (pyr_ctx.normals[k] = (v))
+#define PYR_STORE_POINT(k, v) (pyr_ctx.points[k] = (v))
 #define PYR_MASK_INPUT(i) (reinterpret_cast<const unsigned*>(pyr_ctx.points)[i])
 #define PYR_UF_LOAD(i) (*static_cast<volatile unsigned*>(&pyr_ctx.fill[i]))
 #define PYR_UF_STORE(i, v) (pyr_ctx.fill[i] = (v))

@@ -11,6 +11,7 @@
 #define PYR_KERNELS_H
 
 #define PYR_KERNEL_TABLE(K)              \
+    K(depth_points, DEPTH_POINTS, 2)     \
     K(normals, NORMALS, 2)               \
     K(robust_texels, ROBUST_TEXELS, 2)   \
     K(normals_robust, NORMALS_ROBUST, 2) \

@@ -1,7 +1,7 @@
 /* OpenCL C 1.2: the dialect of the entry points (shaders/pyr_entries.h). Every kernel takes the Segmenter's buffers
  * and the image width first (PYR_CTX_PARAM, set once per Segmenter by the host), then one PyrArgs by value. */
 #define PYR_CTX_PARAM                                                                                              \
-    __global const float *pyr_buf_points, __global float *pyr_buf_normals, __global uint *pyr_buf_quant,          \
+    __global float *pyr_buf_points, __global float *pyr_buf_normals, __global uint *pyr_buf_quant,          \
         __global uchar *pyr_buf_mask, __global uint *pyr_buf_labels, __global uint *pyr_buf_lut,                 \
         __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out,                    \
         __global uint *pyr_buf_texels, uint pyr_w
@@ -25,6 +25,7 @@
 #define PYR_STATS_MAX(w, v) atomic_max(&pyr_buf_lut[w], (v))
 
 #include "pyr_compact.h"
+#include "pyr_depth.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_kernels.h"
@@ -62,6 +63,7 @@ typedef struct PyrArgs {
 #define PYR_POINT(k) pyr_buf_points[k]
 #define PYR_NORMAL(k) pyr_buf_normals[k]
 #define PYR_STORE_NORMAL(k, v) (pyr_buf_normals[k] = (v))
+#define PYR_STORE_POINT(k, v) (pyr_buf_points[k] = (v))
 #define PYR_MASK_INPUT(i) (((__global const uint *)pyr_buf_points)[i])
 #define PYR_UF_LOAD(i) (((volatile __global uint *)pyr_buf_fill)[i])
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))

@@ -23,6 +23,7 @@
 #define PYR_U32(x) uint(x)
 #define PYR_F32(x) float(x)
 #define PYR_FLOAT_BITS(f) floatBitsToInt(f)
+#define PYR_BITS_FLOAT(u) uintBitsToFloat(u)
 #define PYR_RINT(f) roundEven(f)
 #define PYR_FABS(f) abs(f)
 #define PYR_SQRT(f) sqrt(f)
@@ -40,6 +41,7 @@
 #define PYR_U32(x) ((uint)(x))
 #define PYR_F32(x) ((float)(x))
 #define PYR_FLOAT_BITS(f) as_int(f)
+#define PYR_BITS_FLOAT(u) as_float(u)
 #define PYR_RINT(f) rint(f)
 #define PYR_FABS(f) fabs(f)
 #define PYR_SQRT(f) sqrt(f)
@@ -57,10 +59,12 @@
 #define PYR_F32(x) static_cast<float>(x)
 #ifdef __CUDA_ARCH__
 #define PYR_FLOAT_BITS(f) __float_as_int(f)
+#define PYR_BITS_FLOAT(u) __uint_as_float(u)
 #define PYR_MSB(u) (31 - __clz(static_cast<int>(u)))
 #else
 #include <bit>
 #define PYR_FLOAT_BITS(f) std::bit_cast<int>(f)
+#define PYR_BITS_FLOAT(u) std::bit_cast<float>(static_cast<unsigned int>(u))
 #define PYR_MSB(u) (static_cast<int>(std::bit_width(static_cast<unsigned int>(u))) - 1)
 #endif
 #define PYR_RINT(f) rintf(f)
@@ -106,6 +110,7 @@ static inline unsigned int pyr_cuda_host_atomic_min(unsigned int* p, unsigned in
 #define PYR_U32(x) static_cast<std::uint32_t>(x)
 #define PYR_F32(x) static_cast<float>(x)
 #define PYR_FLOAT_BITS(f) std::bit_cast<std::int32_t>(static_cast<float>(f))
+#define PYR_BITS_FLOAT(u) std::bit_cast<float>(static_cast<std::uint32_t>(u))
 #define PYR_RINT(f) std::nearbyint(f)
 #define PYR_FABS(f) std::fabs(f)
 #define PYR_SQRT(f) std::sqrt(f)

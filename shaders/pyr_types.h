@@ -21,6 +21,13 @@ PYR_FN PyrLevel pyr_level(pyr_u32 width, pyr_u32 height, pyr_u32 offset) {
     return lv;
 }
 
+PYR_TYPEDEF(PyrFVec3)
+struct PyrFVec3 {
+    pyr_f32 x;
+    pyr_f32 y;
+    pyr_f32 z;
+};
+
 PYR_TYPEDEF(PyrIVec3)
 struct PyrIVec3 {
     pyr_i32 x;

@@ -9,7 +9,7 @@
 #define PYR_GLSL 1
 #include "pyr_kernels.h"
 
-layout(std430, set = 0, binding = 0) readonly buffer PyrPointsBuf { float pyr_buf_points[]; };
+layout(std430, set = 0, binding = 0) buffer PyrPointsBuf { float pyr_buf_points[]; }; /* depth frames write it */
 layout(std430, set = 0, binding = 1) buffer PyrNormalsBuf { float pyr_buf_normals[]; };
 layout(std430, set = 0, binding = 2) buffer PyrQuantBuf { uint pyr_buf_quant[]; }; /* two words per pixel */
 layout(std430, set = 0, binding = 3) buffer PyrMaskBuf { uint pyr_buf_mask[]; }; /* one uint per texel */
@@ -21,7 +21,7 @@ layout(std430, set = 0, binding = 8) buffer PyrOutBuf { uint pyr_buf_out[]; };  
 layout(std430, set = 0, binding = 9) buffer PyrTexelsBuf { uint pyr_buf_texels[]; }; /* robust normals' texels */
 /* The points and normals from float pyr_push.split on: the rest of the same buffers, bound from there when a frame's
  * xyz arrays exceed one binding's range (vulkan_backend.cpp). */
-layout(std430, set = 0, binding = 10) readonly buffer PyrPointsHiBuf { float pyr_buf_points_hi[]; };
+layout(std430, set = 0, binding = 10) buffer PyrPointsHiBuf { float pyr_buf_points_hi[]; };
 layout(std430, set = 0, binding = 11) buffer PyrNormalsHiBuf { float pyr_buf_normals_hi[]; };
 #if defined(PYR_ENTRY_BIND_MASK)
 /* A mask frame's input words share binding 0 with the points (gpu_executor.cpp: bind_mask). */
@@ -39,6 +39,13 @@ float pyr_point(uint k) {
 }
 float pyr_normal(uint k) {
     return k < pyr_push.split ? pyr_buf_normals[k] : pyr_buf_normals_hi[k - pyr_push.split];
+}
+void pyr_store_point(uint k, float v) {
+    if (k < pyr_push.split) {
+        pyr_buf_points[k] = v;
+    } else {
+        pyr_buf_points_hi[k - pyr_push.split] = v;
+    }
 }
 void pyr_store_normal(uint k, float v) {
     if (k < pyr_push.split) {
@@ -66,6 +73,7 @@ void pyr_store_normal(uint k, float v) {
 #define PYR_STATS_MAX(w, v) atomicMax(pyr_buf_lut[w], (v))
 
 #include "pyr_compact.h"
+#include "pyr_depth.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_labels.h"
@@ -101,6 +109,7 @@ void pyr_store_normal(uint k, float v) {
 #define PYR_POINT(k) pyr_point(k)
 #define PYR_NORMAL(k) pyr_normal(k)
 #define PYR_STORE_NORMAL(k, v) pyr_store_normal((k), (v))
+#define PYR_STORE_POINT(k, v) pyr_store_point((k), (v))
 #define PYR_UF_LOAD(i) pyr_buf_fill[i]
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
 #define PYR_UF_MIN(i, v) atomicMin(pyr_buf_fill[i], (v))

@@ -145,7 +145,8 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
     const auto start = std::chrono::steady_clock::now();
-    const Result result = segmenter->segment(view);
+    const Result result =
+        loaded.depth ? segmenter->segment(loaded.depth->view(cloud.width, cloud.height)) : segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
 
     if (out.labels) write_labels(*out.labels, result);

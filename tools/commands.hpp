@@ -1,10 +1,12 @@
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "pyrseg/depth.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/presets.hpp"
@@ -37,10 +39,20 @@ struct SensorChoice {
 // --depth-scale), turned into a cloud in millimetres.
 extern const char* const kInputHelp;
 extern const std::set<std::string> kInputValueOptions;
+// A depth image's samples as the file holds them, for Segmenter::segment(DepthView): back-projected on the device.
+struct DepthFrame {
+    std::vector<std::uint16_t> u16;  // one of the two, W*H
+    std::vector<float> f32;
+    double metres_per_unit = 0.001;
+    io::Intrinsics intrinsics;
+    [[nodiscard]] DepthView view(int width, int height) const;
+};
+
 struct LoadedInput {
-    io::PointCloud cloud;
-    std::string kind;  // "PCD", "depth image"
-    bool millimetres;  // the cloud is in millimetres whatever --unit-mm says
+    io::PointCloud cloud;  // the points (for depth images, back-projected on the host: outputs that need a cloud)
+    std::string kind;      // "PCD", "depth image"
+    bool millimetres;      // the cloud is in millimetres whatever --unit-mm says
+    std::optional<DepthFrame> depth;  // depth images and NumPy depth maps: segmented from these samples
 };
 [[nodiscard]] LoadedInput load_input(const std::filesystem::path& path, const Args& args);
 // Whether load_input reads files with this path's extension (batches pick such files out of folders).

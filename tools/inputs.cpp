@@ -1,5 +1,6 @@
 // What `pyrseg segment` reads: organized PCD and PLY clouds, and depth images back-projected with pinhole intrinsics.
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -34,6 +35,44 @@ std::string lower_extension(const std::filesystem::path& path) {
     return ext;
 }
 
+// The frame's samples as DepthView reads them: 16-bit images stay integers (their float copies are exact), float
+// images stay floats.
+DepthFrame depth_frame(const io::DepthImage& image, const io::Intrinsics& k, double per_metre) {
+    DepthFrame f;
+    if (image.floating) {
+        f.f32 = image.depth;
+    } else {
+        f.u16.resize(image.depth.size());
+        for (std::size_t i = 0; i < image.depth.size(); ++i) f.u16[i] = static_cast<std::uint16_t>(image.depth[i]);
+    }
+    f.metres_per_unit = 1.0 / per_metre;
+    f.intrinsics = k;
+    return f;
+}
+
+// A NumPy depth map (H x W uint16 or float32) as a depth image.
+io::DepthImage depth_map_of(const io::NpyArray& npy, const std::filesystem::path& path) {
+    io::DepthImage image;
+    image.height = int(npy.shape[0]);
+    image.width = int(npy.shape[1]);
+    const std::size_t n = npy.shape[0] * npy.shape[1];
+    image.depth.resize(n);
+    if (npy.dtype == "<u2") {
+        for (std::size_t i = 0; i < n; ++i) {
+            std::uint16_t v = 0;
+            std::memcpy(&v, npy.bytes.data() + 2 * i, 2);
+            image.depth[i] = float(v);
+        }
+    } else if (npy.dtype == "<f4") {
+        std::memcpy(image.depth.data(), npy.bytes.data(), 4 * n);
+        image.floating = true;
+    } else {
+        throw Error(ErrorCode::format,
+                    path.string() + ": a NumPy depth map must be uint16 or float32 (H x W), got '" + npy.dtype + "'");
+    }
+    return image;
+}
+
 bool is_cloud_extension(const std::string& ext) {
     return ext == ".pcd" || ext == ".npy" || ext == ".ply";
 }
@@ -66,6 +105,20 @@ io::Intrinsics intrinsics_from(const Args& args, const std::filesystem::path& in
 
 }  // namespace
 
+DepthView DepthFrame::view(int width, int height) const {
+    DepthView v;
+    v.depth = u16.empty() ? static_cast<const void*>(f32.data()) : static_cast<const void*>(u16.data());
+    v.format = u16.empty() ? DepthFormat::f32 : DepthFormat::u16;
+    v.width = width;
+    v.height = height;
+    v.metres_per_unit = metres_per_unit;
+    v.fx = intrinsics.fx;
+    v.fy = intrinsics.fy;
+    v.cx = intrinsics.cx;
+    v.cy = intrinsics.cy;
+    return v;
+}
+
 bool is_supported_input(const std::filesystem::path& path) {
     const std::string ext = lower_extension(path);
     return is_cloud_extension(ext) || is_depth_image_extension(ext);
@@ -75,15 +128,29 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
     const std::string ext = lower_extension(path);
     if (is_cloud_extension(ext)) {
         for (const std::string& option : kInputValueOptions) {
-            if (args.value(option)) {
+            if (args.value(option) && ext != ".npy") {
                 std::string message = "--" + option;
                 message += " applies to depth images, not to " + ext;
                 throw UsageError{message};
             }
         }
-        if (ext == ".npy") return {io::read_npy_cloud(path), "NumPy cloud", false};
-        if (ext == ".ply") return {io::read_ply(path), "PLY", false};
-        return {io::read_pcd(path), "PCD", false};
+        if (ext == ".npy") {
+            const io::NpyArray npy = io::read_npy(path);
+            if (npy.shape.size() != 2) return {io::read_npy_cloud(path), "NumPy cloud", false, std::nullopt};
+            // H x W: a depth map, which needs intrinsics and takes --depth-scale like a depth image.
+            if (args.value("unit-mm")) {
+                throw UsageError{"--unit-mm applies to point clouds; a depth map's units are set by --depth-scale"};
+            }
+            const io::DepthImage image = depth_map_of(npy, path);
+            const io::Intrinsics k = intrinsics_from(args, path);
+            double per_metre = image.floating ? 1.0 : 1000.0;
+            if (auto s = args.number("depth-scale")) per_metre = *s;
+            if (!(per_metre > 0)) throw UsageError{"--depth-scale must be > 0"};
+            return {io::depth_to_cloud(image, k, 1000.0 / per_metre), "NumPy depth map", true,
+                    depth_frame(image, k, per_metre)};
+        }
+        if (ext == ".ply") return {io::read_ply(path), "PLY", false, std::nullopt};
+        return {io::read_pcd(path), "PCD", false, std::nullopt};
     }
     if (is_depth_image_extension(ext)) {
         if (args.value("unit-mm")) {
@@ -94,7 +161,8 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
         double per_metre = depth.floating ? 1.0 : 1000.0;
         if (auto s = args.number("depth-scale")) per_metre = *s;
         if (!(per_metre > 0)) throw UsageError{"--depth-scale must be > 0"};
-        return {io::depth_to_cloud(depth, k, 1000.0 / per_metre), "depth image", true};
+        return {io::depth_to_cloud(depth, k, 1000.0 / per_metre), "depth image", true,
+                depth_frame(depth, k, per_metre)};
     }
     throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +
                                        "' (pyrseg reads .pcd, .ply and .npy clouds, and .png/.tif/.tiff depth images)");

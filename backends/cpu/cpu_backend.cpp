@@ -15,6 +15,7 @@
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
 #include "core/cloud_layout.hpp"
+#include "core/depth_tables.hpp"
 #include "core/segment_stats.hpp"
 #include "pyrseg/error.hpp"
 
@@ -61,6 +62,48 @@ public:
         layout_ = core::cloud_layout(cloud);
         normals_estimated_ = false;
         from_mask_ = false;
+    }
+
+    // The depth image stays where the caller has it; depth_to_points writes the points this backend owns.
+    void bind_depth(const DepthView& depth, const core::DepthTables& tables) override {
+        fill_rounds_ = 0;
+        depth_ = depth;
+        depth_tables_ = &tables;
+        normals_estimated_ = false;
+        from_mask_ = false;
+    }
+
+    void depth_to_points() override {
+        const size_t w = size_t(plan_.width);
+        if (depth_points_.empty()) depth_points_.resize(3 * plan_.pixel_count());  // once per Segmenter
+        const size_t sample = core::DepthTables::sample_bytes(depth_.format);
+        const size_t step = depth_.row_step_bytes == 0 ? w * sample : depth_.row_step_bytes;
+        const auto format = depth_.format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;
+        const core::DepthTables& t = *depth_tables_;
+        rows(size_t(plan_.height), [&](size_t y) {
+            const auto* row = static_cast<const unsigned char*>(depth_.depth) + y * step;
+            for (size_t x = 0; x < w; ++x) {
+                uint32_t bits = 0;
+                if (format == PYR_DEPTH_U16) {
+                    std::uint16_t d = 0;
+                    std::memcpy(&d, row + 2 * x, 2);  // rows may start at any byte
+                    bits = d;
+                } else {
+                    std::memcpy(&bits, row + 4 * x, 4);
+                }
+                const PyrFVec3 p = kernels::pyr_depth_point(bits, format, t.scale, t.ku[x], t.kv[y]);
+                float* out = depth_points_.data() + 3 * (y * w + x);
+                out[0] = p.x;
+                out[1] = p.y;
+                out[2] = p.z;
+            }
+        });
+        CloudView cloud;
+        cloud.points = depth_points_.data();
+        cloud.width = plan_.width;
+        cloud.height = plan_.height;
+        cloud_ = cloud;
+        layout_ = core::cloud_layout(cloud);
     }
 
     void bind_mask(const MaskView& mask) override {
@@ -456,6 +499,9 @@ private:
     std::vector<float> normals_;                 // estimated, packed
     std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
     std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)
+    DepthView depth_{};                          // a depth frame, as the caller has it
+    const core::DepthTables* depth_tables_ = nullptr;
+    std::vector<float> depth_points_;  // its back-projection (depth frames only)
     std::vector<QuantPixel> quant_;
     std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
     std::vector<std::uint8_t> mask_;        // all levels

@@ -58,6 +58,7 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 
 namespace pyrseg::cpu::kernels {
 #include "shaders/pyr_compact.h"
+#include "shaders/pyr_depth.h"
 #include "shaders/pyr_edges.h"
 #include "shaders/pyr_fill.h"
 #include "shaders/pyr_labels.h"

@@ -143,7 +143,7 @@ public:
         upload_ = Memory<true>(staging.upload, "cudaMallocHost(upload staging)");
         download_ = Memory<true>(staging.download, "cudaMallocHost(download staging)");
         staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
-        ctx_ = PyrCudaCtx{buffer<const float>(gpu::Buffer::points),
+        ctx_ = PyrCudaCtx{buffer<float>(gpu::Buffer::points),
                           buffer<float>(gpu::Buffer::normals),
                           buffer<unsigned>(gpu::Buffer::quant),
                           buffer<unsigned char>(gpu::Buffer::mask),

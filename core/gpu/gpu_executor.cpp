@@ -10,9 +10,11 @@
 #include <utility>
 #include <vector>
 
+#include "core/depth_tables.hpp"
 #include "core/segment_stats.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
+#include "shaders/pyr_depth.h"
 
 namespace pyrseg::gpu {
 
@@ -69,6 +71,24 @@ public:
         upload_xyz(cloud, cloud.points, Buffer::points, host_points_);
         if (cloud.normals != nullptr) upload_xyz(cloud, cloud.normals, Buffer::normals, host_normals_);
         from_mask_ = false;
+    }
+
+    // The samples travel in the quant buffer and the ray slopes in the labels buffer, which the passes before the
+    // quantize pass (depth, normals) do not otherwise use: 2 (u16) or 4 (f32) bytes a pixel instead of 12.
+    void bind_depth(const DepthView& depth, const core::DepthTables& tables) override {
+        start_frame();
+        core::pack_depth(depth, host_depth_);
+        device_->upload(Buffer::quant, 0, host_depth_.data(), 4 * host_depth_.size());
+        host_rays_.assign(tables.ku.begin(), tables.ku.end());
+        host_rays_.insert(host_rays_.end(), tables.kv.begin(), tables.kv.end());
+        device_->upload(Buffer::labels, 0, host_rays_.data(), 4 * host_rays_.size());
+        depth_format_ = depth.format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;
+        depth_scale_ = tables.scale;
+        from_mask_ = false;
+    }
+
+    void depth_to_points() override {
+        dispatch(Kernel::depth_points, width(), height(), args({height(), depth_format_, bits(depth_scale_)}));
     }
 
     // The caller's mask travels in the points buffer, which a mask frame does not otherwise use: one word per pixel,
@@ -252,6 +272,10 @@ private:
     std::unique_ptr<Device> device_;
     DeviceLimits limits_;
     std::vector<float> host_points_, host_normals_;  // staging for strided clouds
+    std::vector<std::uint32_t> host_depth_;          // a depth frame's samples, packed
+    std::vector<float> host_rays_;                   // its ku then kv
+    uint32_t depth_format_ = PYR_DEPTH_U16;
+    float depth_scale_ = 0;
     std::vector<uint32_t> host_mask_;
     std::vector<unsigned char> staged_;  // the frame's results, laid out as core::StagedResults
     std::vector<uint32_t> host_stats_;

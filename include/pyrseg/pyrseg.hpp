@@ -2,6 +2,7 @@
 // pyrseg: fast bridgeless pyramid segmentation of organized point clouds.
 #include "pyrseg/backend.hpp"
 #include "pyrseg/cloud.hpp"
+#include "pyrseg/depth.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/presets.hpp"

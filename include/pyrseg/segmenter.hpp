@@ -7,14 +7,15 @@
 #include <vector>
 
 #include "pyrseg/cloud.hpp"
+#include "pyrseg/depth.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/result.hpp"
 
 namespace pyrseg {
 
 struct PassTiming {
-    // "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill", "edges", "compact", "stats", then
-    // "upload" (the frame to the backend) and "download" (the results back).
+    // "depth" (a DepthView's back-projection), "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill",
+    // "edges", "compact", "stats", then "upload" (the frame to the backend) and "download" (the results back).
     const char* pass;
     double milliseconds;
 };
@@ -34,6 +35,10 @@ public:
     // Segments one frame into `out`. The frame must have the Segmenter's size.
     void segment(const CloudView& cloud, Result& out);
     [[nodiscard]] Result segment(const CloudView& cloud);
+    // Segments a depth image, back-projected on the device (docs/algorithm.md section 1b) into points in the
+    // Segmenter's unit_mm; normals are estimated. Throws pyrseg::Error for bad metres_per_unit or intrinsics.
+    void segment(const DepthView& depth, Result& out);
+    [[nodiscard]] Result segment(const DepthView& depth);
     // Labels a caller-made fillable mask (the pyramid without the normals and metric passes).
     void segment_mask(const MaskView& mask, Result& out);
 

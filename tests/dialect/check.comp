@@ -28,6 +28,7 @@ layout(std430, binding = 5) writeonly buffer Out { int outv[]; };
 #define PYR_TEXEL_WORD(i) pyr_buf_lut[i]
 #define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_lut[i] = (v))
 #include "pyr_compact.h"
+#include "pyr_depth.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_labels.h"
@@ -57,6 +58,7 @@ void main() {
     r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
     r += pyr_edge_label(PYR_CTX_ARG, lv, x, y, 2u);
+    r += PYR_U32(PYR_FLOAT_BITS(pyr_depth_point(x, PYR_DEPTH_F32, 0.5f, 0.25f, -0.25f).x));
     r += pyr_compact_label(PYR_CTX_ARG, 3u);
     r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);
     r += pyr_count_marks(PYR_CTX_ARG, 0u, 64u);

@@ -24,6 +24,7 @@ struct Ctx {
 #define PYR_TEXEL_WORD(i) ctx.lut[i]
 #define PYR_STORE_TEXEL_WORD(i, v) (ctx.lut[i] = (v))
 #include "pyr_compact.h"
+#include "pyr_depth.h"
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_labels.h"
@@ -50,6 +51,7 @@ __global__ void all_passes(Ctx ctx, int* out) {
     r += pyr_sweep_line(ctx, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
     r += pyr_edge_label(ctx, lv, x, y, 2u);
+    r += PYR_U32(PYR_FLOAT_BITS(pyr_depth_point(x, PYR_DEPTH_F32, 0.5f, 0.25f, -0.25f).x));
     r += pyr_compact_label(ctx, 3u);
     r += pyr_sweep_row(ctx, lv, y, 0u) + pyr_sweep_column(ctx, lv, x, 1u);
     r += pyr_count_marks(ctx, 0u, 64u);
