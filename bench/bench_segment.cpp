@@ -1,4 +1,5 @@
-// pyrseg per backend: the whole pipeline (with the paper's metric, and as pipeline_robust with the robust metric of
+// pyrseg per backend: the whole pipeline (and, as pipeline_depth, from a uint16 depth image back-projected on the
+// device) (with the paper's metric, and as pipeline_robust with the robust metric of
 // the kinect-v1 preset on the same frames, so that its cost shows per pass) (points, with estimated or given normals,
 // to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame size,
 // next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers, carry
@@ -7,7 +8,11 @@
 //   pyrseg_bench --benchmark_format=json > b.json && pyrseg_bench_summary b.json   ratio tables and a plot
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +30,35 @@ void pipeline(benchmark::State& state, const std::string& backend, int width, in
     time_frames(
         state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
         [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params);
+}
+
+// The scene as a depth camera hands it over: whole millimetres in uint16 (0: no data), with its intrinsics.
+struct DepthFrame {
+    std::vector<std::uint16_t> samples;
+    DepthView view;
+};
+
+const DepthFrame& depth_frame(int width, int height) {
+    static std::map<std::pair<int, int>, std::unique_ptr<DepthFrame>> cache;
+    auto& slot = cache[{width, height}];
+    if (!slot) {
+        const synthetic::Scene& s = scene(width, height);
+        slot = std::make_unique<DepthFrame>();
+        slot->samples.resize(std::size_t(width) * std::size_t(height));
+        for (std::size_t i = 0; i < slot->samples.size(); ++i) {
+            const float z = s.points[3 * i + 2];
+            slot->samples[i] = std::isfinite(z) && z > 0 && z < 65535 ? std::uint16_t(std::lround(z)) : 0;
+        }
+        slot->view = DepthView{slot->samples.data(), DepthFormat::u16, width, height, 0, 0.001, s.fx, s.fy, s.cx, s.cy};
+    }
+    return *slot;
+}
+
+// A depth frame: 2 bytes a pixel uploaded, back-projected on the device, then as pipeline/ with estimated normals.
+void depth_pipeline(benchmark::State& state, const std::string& backend, int width, int height) {
+    const DepthFrame& frame = depth_frame(width, height);
+    time_frames(state, backend, width, height, std::size_t(width) * std::size_t(height) * 2,
+                [&](Segmenter& segmenter, Result& result) { segmenter.segment(frame.view, result); });
 }
 
 void stage(benchmark::State& state, const std::string& backend, int width, int height) {
@@ -71,6 +105,17 @@ int register_all() {
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
             }
+        }
+        benchmark::RegisterBenchmark(("memcpy/" + px + "/depth_u16").c_str(),
+                                     [=](benchmark::State& st) { copy_bytes(st, 2 * pixels); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        for (const BackendInfo& b : list_backends()) {
+            if (!b.available) continue;
+            benchmark::RegisterBenchmark(("pipeline_depth/" + b.name + "/" + px + "/u16").c_str(),
+                                         [=](benchmark::State& st) { depth_pipeline(st, b.name, w, h); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
         }
         benchmark::RegisterBenchmark(("memcpy/" + px + "/mask").c_str(),
                                      [=](benchmark::State& st) { copy_bytes(st, pixels); })
