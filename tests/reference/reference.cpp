@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <numbers>
 #include <queue>
@@ -833,6 +834,98 @@ Output failure(std::string why) {
     return out;
 }
 
+// Section 1b: float32 bit fields.
+std::uint32_t exponent_field(float f) {
+    return (std::bit_cast<std::uint32_t>(f) >> 23) & 0xFFu;
+}
+
+// Section 1b: a result whose exponent field is 0 becomes a zero of its sign (its bits AND 0x80000000).
+float zero_if_subnormal(float f) {
+    return exponent_field(f) == 0 ? std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) & 0x80000000u) : f;
+}
+
+// Section 1b: the sample's zs, or false when the pixel has no data. Bytes are read with memcpy (rows may be at any
+// alignment); a u16 sample is in the host's byte order.
+bool depth_sample(const unsigned char* at, DepthFormat format, float& zs) {
+    if (format == DepthFormat::u16) {
+        std::uint16_t d = 0;
+        std::memcpy(&d, at, sizeof d);
+        zs = static_cast<float>(d);  // exact
+        return d != 0;
+    }
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, at, sizeof bits);
+    const std::uint32_t exponent = (bits >> 23) & 0xFFu;
+    zs = std::bit_cast<float>(bits);
+    return (bits & 0x80000000u) == 0 && exponent != 0 && exponent != 255;
+}
+
+}  // namespace
+
+DepthPoints depth_to_points(const DepthInput& depth, double unit_mm) {
+    DepthPoints out;
+    auto fail = [&out](std::string why) {
+        out.ok = false;
+        out.error = std::move(why);
+        return out;
+    };
+    if (depth.width < 1 || depth.height < 1) return fail("depth width and height must be >= 1");
+    if (depth.format != DepthFormat::u16 && depth.format != DepthFormat::f32) {
+        return fail("depth format must be u16 or f32");
+    }
+    if (depth.samples == nullptr) return fail("depth samples must not be null");
+    const std::size_t sample_bytes = depth.format == DepthFormat::u16 ? 2 : 4;
+    const std::size_t packed = static_cast<std::size_t>(depth.width) * sample_bytes;
+    const std::size_t step = depth.row_step_bytes == 0 ? packed : depth.row_step_bytes;
+    if (step < packed) {
+        return fail("row_step_bytes must be 0 or >= width * sample size (" + std::to_string(packed) + ")");
+    }
+    if (!std::isfinite(unit_mm) || unit_mm <= 0.0) return fail("unit_mm must be finite and > 0");
+    // The rejections of section 1b, in its order.
+    const double m = depth.metres_per_unit;
+    if (!std::isfinite(m) || m <= 0.0) return fail("metres_per_unit must be finite and > 0");
+    if (!std::isfinite(depth.fx) || depth.fx <= 0.0) return fail("fx must be finite and > 0");
+    if (!std::isfinite(depth.fy) || depth.fy <= 0.0) return fail("fy must be finite and > 0");
+    if (!std::isfinite(depth.cx)) return fail("cx must be finite");
+    if (!std::isfinite(depth.cy)) return fail("cy must be finite");
+    // Host constants: double, in the order written, then float32.
+    const float s = static_cast<float>((m * 1000.0) / unit_mm);
+    // s a finite float32 > 0 and >= 2^-126: sign clear, exponent field neither 0 nor 255.
+    if ((std::bit_cast<std::uint32_t>(s) & 0x80000000u) != 0 || exponent_field(s) == 0 || exponent_field(s) == 255) {
+        return fail("scale s = (float)((m * 1000) / unit_mm) must be a finite float32 >= 2^-126 (a normal)");
+    }
+    std::vector<float> ku(static_cast<std::size_t>(depth.width));
+    std::vector<float> kv(static_cast<std::size_t>(depth.height));
+    for (int u = 0; u < depth.width; ++u) {
+        ku[static_cast<std::size_t>(u)] = static_cast<float>((static_cast<double>(u) - depth.cx) / depth.fx);
+    }
+    for (int v = 0; v < depth.height; ++v) {
+        kv[static_cast<std::size_t>(v)] = static_cast<float>((static_cast<double>(v) - depth.cy) / depth.fy);
+    }
+
+    const float no_data = std::bit_cast<float>(std::uint32_t{0x7fc00000u});
+    const auto* base = static_cast<const unsigned char*>(depth.samples);
+    const auto w = static_cast<std::size_t>(depth.width);
+    const auto h = static_cast<std::size_t>(depth.height);
+    out.points.assign(3 * w * h, no_data);
+    for (std::size_t v = 0; v < h; ++v) {
+        const unsigned char* row = base + v * step;
+        for (std::size_t u = 0; u < w; ++u) {
+            float zs = 0.0f;
+            if (!depth_sample(row + u * sample_bytes, depth.format, zs)) continue;
+            const float z = zs * s;
+            if (exponent_field(z) == 0 || exponent_field(z) == 255) continue;  // underflow or overflow: no data
+            float* p = out.points.data() + 3 * (v * w + u);
+            p[0] = zero_if_subnormal(z * ku[u]);
+            p[1] = zero_if_subnormal(z * kv[v]);
+            p[2] = z;
+        }
+    }
+    return out;
+}
+
+namespace {
+
 Output label_from_mask(std::vector<std::uint8_t> fillable, const std::vector<std::uint8_t>& valid, int width,
                        int height, const Params& p, const Plan& plan) {
     Output out;
@@ -915,6 +1008,21 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
     Output out = label_from_mask(std::move(mask), valid_mask, width, height, params, plan);
     out.segments = segment_statistics(out, nullptr, nullptr, width, params);
     return out;
+}
+
+Output segment_depth(const DepthInput& depth, int width, int height, const Params& params) {
+    if (depth.width != width || depth.height != height) {
+        return failure("the depth image is " + std::to_string(depth.width) + " x " + std::to_string(depth.height) +
+                       " but width x height is " + std::to_string(width) + " x " + std::to_string(height));
+    }
+    // Everything that segment() would reject is rejected before the points are made.
+    if (std::string why = check_params(width, height, params); !why.empty()) return failure(std::move(why));
+    if (params.normal_radius < 1) return failure("normal_radius must be >= 1");
+    Plan plan;
+    if (std::string why = make_plan(width, height, params, plan); !why.empty()) return failure(std::move(why));
+    DepthPoints points = depth_to_points(depth, params.unit_mm);
+    if (!points.ok) return failure(std::move(points.error));
+    return segment(points.points.data(), nullptr, width, height, params);
 }
 
 }  // namespace pyrseg_ref

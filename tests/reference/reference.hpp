@@ -1,8 +1,9 @@
 #pragma once
 // The independent oracle for pyrseg: a plain, slow-but-linear implementation of the algorithm contract
-// (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals)
-// and 8 (the normals pass), written from that text only. The conformance suite compares every backend with it bit for
-// bit.
+// (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals),
+// 8 (the normals pass) and 1b (depth images), written from that text only. The conformance suite compares every backend
+// with it bit for bit.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -74,5 +75,30 @@ std::vector<float> estimate_normals(const float* points, int width, int height, 
 // radius is < 1, window is outside 1..7, or unit_mm is not finite and > 0.
 std::vector<float> estimate_robust_normals(const float* points, int width, int height, int radius, int window,
                                            double unit_mm);
+
+// Depth images (docs/algorithm.md section 1b).
+enum class DepthFormat { u16, f32 };
+
+struct DepthInput {
+    const void* samples = nullptr;  // row-major, rows row_step_bytes apart (any alignment: read with memcpy)
+    DepthFormat format = DepthFormat::u16;
+    int width = 0, height = 0;
+    std::size_t row_step_bytes = 0;  // 0: width * sample size; otherwise at least that
+    double metres_per_unit = 0.001;  // m
+    double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+
+// Section 1b: the points (3*W*H floats, the quiet NaN 0x7fc00000 where no data), or ok = false with the reason in
+// `error` (naming the parameter). unit_mm is the Segmenter's, the unit the points are in.
+struct DepthPoints {
+    bool ok = true;
+    std::string error;
+    std::vector<float> points;
+};
+DepthPoints depth_to_points(const DepthInput& depth, double unit_mm);
+
+// The whole algorithm from a depth image: section 1b with params.unit_mm, then segment() with normals estimated.
+// ok = false when depth.width / depth.height differ from width / height, or for any error of either step.
+Output segment_depth(const DepthInput& depth, int width, int height, const Params& params);
 
 }  // namespace pyrseg_ref

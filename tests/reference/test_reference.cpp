@@ -3,9 +3,11 @@
 // oracle, so a mistake in the oracle cannot hide behind itself.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -1755,6 +1757,408 @@ TEST(ReferenceRobustMetric, ParameterErrors) {
     const Params r0 = with(robust, [](Params& p) { p.normal_radius = 0; });
     EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, r0).ok);
     EXPECT_FALSE(pyrseg_ref::segment(pts.data(), nullptr, 16, 16, r0).ok);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Depth images (docs/algorithm.md section 1b).
+
+using pyrseg_ref::DepthFormat;
+using pyrseg_ref::DepthInput;
+using pyrseg_ref::DepthPoints;
+
+constexpr std::uint32_t kNoData = 0x7fc00000u;
+
+std::uint32_t bits(float f) {
+    return std::bit_cast<std::uint32_t>(f);
+}
+
+float from_bits(std::uint32_t b) {
+    return std::bit_cast<float>(b);
+}
+
+DepthInput depth_of(const void* samples, DepthFormat format, int w, int h, double m) {
+    DepthInput in;
+    in.samples = samples;
+    in.format = format;
+    in.width = w;
+    in.height = h;
+    in.metres_per_unit = m;
+    in.fx = 1.0;
+    in.fy = 1.0;
+    in.cx = 0.0;
+    in.cy = 0.0;
+    return in;
+}
+
+// Pixel (u, v) of the points is (x, y, z), compared by bits.
+::testing::AssertionResult point_is(const DepthPoints& p, int w, int u, int v, float x, float y, float z) {
+    const auto i = static_cast<std::size_t>(3 * (v * w + u));
+    if (p.points.size() < i + 3) return ::testing::AssertionFailure() << "no point " << u << "," << v;
+    const std::uint32_t got[3] = {bits(p.points[i]), bits(p.points[i + 1]), bits(p.points[i + 2])};
+    const std::uint32_t want[3] = {bits(x), bits(y), bits(z)};
+    for (int c = 0; c < 3; ++c) {
+        if (got[c] != want[c]) {
+            return ::testing::AssertionFailure() << "pixel " << u << "," << v << " component " << c << ": got "
+                                                 << p.points[i + c] << " (0x" << std::hex << got[c] << "), want "
+                                                 << (c == 0   ? x
+                                                     : c == 1 ? y
+                                                              : z)
+                                                 << " (0x" << want[c] << ")";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+::testing::AssertionResult no_data(const DepthPoints& p, int w, int u, int v) {
+    return point_is(p, w, u, v, from_bits(kNoData), from_bits(kNoData), from_bits(kNoData));
+}
+
+TEST(ReferenceDepth, U16ZeroIsMissingAndZIsDTimesS) {
+    // fx = fy = 1, cx = cy = 0: ku[u] = u, kv[v] = v exactly.
+    const std::vector<std::uint16_t> d = {0, 1234, 65535, 1000, 0, 7};
+    const DepthInput in = depth_of(d.data(), DepthFormat::u16, 3, 2, 0.001);
+    // m = 0.001, unit_mm = 1: 0.001 * 1000 rounds to 1.0 in double, s = 1.0f, so z = d and x = z * u, y = z * v.
+    DepthPoints p = pyrseg_ref::depth_to_points(in, 1.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    ASSERT_EQ(p.points.size(), 18u);
+    EXPECT_TRUE(no_data(p, 3, 0, 0));
+    EXPECT_TRUE(point_is(p, 3, 1, 0, 1234.0f, 0.0f, 1234.0f));
+    EXPECT_TRUE(point_is(p, 3, 2, 0, 131070.0f, 0.0f, 65535.0f));
+    EXPECT_TRUE(point_is(p, 3, 0, 1, 0.0f, 1000.0f, 1000.0f));
+    EXPECT_TRUE(no_data(p, 3, 1, 1));
+    EXPECT_TRUE(point_is(p, 3, 2, 1, 14.0f, 7.0f, 7.0f));
+
+    // unit_mm = 1000: s = (float)(1.0 / 1000) = 0.001f = 1.00000004749745e-3. z = 1000 * s = 1.0000000475 -> 1.0f;
+    // z = 1234 * s = 1.2340000586 -> 0x3f9df3b7, one ulp above 1.234f (0x3f9df3b6), which computing d * m in
+    // double would give.
+    p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    const float s = 0.001f;
+    EXPECT_EQ(bits(1234.0f * s), 0x3f9df3b7u);
+    EXPECT_TRUE(no_data(p, 3, 0, 0));
+    EXPECT_TRUE(point_is(p, 3, 1, 0, from_bits(0x3f9df3b7u), 0.0f, from_bits(0x3f9df3b7u)));
+    EXPECT_TRUE(point_is(p, 3, 2, 0, (65535.0f * s) * 2.0f, 0.0f, 65535.0f * s));
+    EXPECT_TRUE(point_is(p, 3, 0, 1, 0.0f, 1.0f, 1.0f));
+    EXPECT_TRUE(no_data(p, 3, 1, 1));
+    EXPECT_TRUE(point_is(p, 3, 2, 1, (7.0f * s) * 2.0f, 7.0f * s, 7.0f * s));
+}
+
+TEST(ReferenceDepth, F32MissingByBits) {
+    // m = 1, unit_mm = 1000: s = (1 * 1000) / 1000 = 1. Missing: sign set (-1.5, -0, -inf, a negative NaN),
+    // exponent 0 (+0 and subnormals) or 255 (infinities and NaNs). The smallest normal 2^-126 is data.
+    const std::vector<std::uint32_t> d = {
+        0x7fc00000u,  // quiet NaN
+        0xffc00000u,  // negative quiet NaN
+        0x7f800001u,  // signalling NaN
+        0x7f800000u,  // +inf
+        0xff800000u,  // -inf
+        0xbfc00000u,  // -1.5
+        0x80000000u,  // -0
+        0x00000000u,  // +0
+        0x00000001u,  // smallest subnormal
+        0x007fffffu,  // largest subnormal
+        0x00800000u,  // 2^-126, the smallest normal
+        0x40200000u,  // 2.5
+    };
+    const DepthInput in = depth_of(d.data(), DepthFormat::f32, 12, 1, 1.0);
+    DepthPoints p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    ASSERT_EQ(p.points.size(), 36u);
+    for (int u = 0; u < 10; ++u) EXPECT_TRUE(no_data(p, 12, u, 0)) << u;
+    // ku[10] = 10: x = 10 * 2^-126, exact and normal. kv[0] = +0: y = +0.
+    EXPECT_TRUE(point_is(p, 12, 10, 0, std::ldexp(10.0f, -126), 0.0f, from_bits(0x00800000u)));
+    EXPECT_TRUE(point_is(p, 12, 11, 0, 27.5f, 0.0f, 2.5f));
+
+    // unit_mm = 1: s = 1000. z = 2.5 * 1000 = 2500, x = 11 * 2500.
+    p = pyrseg_ref::depth_to_points(in, 1.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    for (int u = 0; u < 10; ++u) EXPECT_TRUE(no_data(p, 12, u, 0)) << u;
+    EXPECT_TRUE(point_is(p, 12, 11, 0, 27500.0f, 0.0f, 2500.0f));
+    EXPECT_TRUE(
+        point_is(p, 12, 10, 0, (from_bits(0x00800000u) * 1000.0f) * 10.0f, 0.0f, from_bits(0x00800000u) * 1000.0f));
+}
+
+TEST(ReferenceDepth, ProductOutsideTheNormalRangeIsMissing) {
+    // u16 overflow. m = 1, unit_mm = 1000 * 2^-113: s = 1000 / (1000 * 2^-113) = 2^113 exactly. fx = 2^120, cx = 0:
+    // ku[u] = u * 2^-120. d = 1: z = 2^113. d = 32767: z = 32767 * 2^113 < 2^128, exact, x = 32767 * 2^-7.
+    // d = 32768: z = 2^128 overflows to +inf; d = 65535 likewise: no data.
+    const std::vector<std::uint16_t> d16 = {1, 32767, 32768, 65535};
+    DepthInput in = depth_of(d16.data(), DepthFormat::u16, 4, 1, 1.0);
+    in.fx = std::ldexp(1.0, 120);
+    DepthPoints p = pyrseg_ref::depth_to_points(in, std::ldexp(1000.0, -113));
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_TRUE(point_is(p, 4, 0, 0, 0.0f, 0.0f, std::ldexp(1.0f, 113)));
+    EXPECT_TRUE(point_is(p, 4, 1, 0, 255.9921875f, 0.0f, std::ldexp(32767.0f, 113)));
+    EXPECT_TRUE(no_data(p, 4, 2, 0));
+    EXPECT_TRUE(no_data(p, 4, 3, 0));
+
+    // f32 underflow. m = 0.5, unit_mm = 1000: s = 0.5. d = 2^-126: z = 2^-127, exponent 0: no data (even though
+    // 2^-126 itself is data and the product is exact). d = 2^-125: z = 2^-126, data. d = 1.5 * 2^-126:
+    // z = 3 * 2^-128, exact but subnormal: no data. d = 1: z = 0.5, x = 0.5 * 3.
+    const std::vector<float> dlow = {std::ldexp(1.0f, -126), std::ldexp(1.0f, -125), std::ldexp(1.5f, -126), 1.0f};
+    in = depth_of(dlow.data(), DepthFormat::f32, 4, 1, 0.5);
+    p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_TRUE(no_data(p, 4, 0, 0));
+    EXPECT_TRUE(point_is(p, 4, 1, 0, std::ldexp(1.0f, -126), 0.0f, std::ldexp(1.0f, -126)));
+    EXPECT_TRUE(no_data(p, 4, 2, 0));
+    EXPECT_TRUE(point_is(p, 4, 3, 0, 1.5f, 0.0f, 0.5f));
+
+    // f32 overflow. m = 2, unit_mm = 1000: s = 2. FLT_MAX * 2 and 2^127 * 2 overflow: no data. d = 2^126:
+    // z = 2^127, data. fx = 1, cx = 0: ku[2] = 2, so x = 2^128 overflows to +inf, and the text keeps it (only z's
+    // exponent decides whether a pixel has data; only an exponent 0 changes x).
+    const std::vector<float> dhigh = {std::numeric_limits<float>::max(), std::ldexp(1.0f, 127), std::ldexp(1.0f, 126),
+                                      1.0f};
+    in = depth_of(dhigh.data(), DepthFormat::f32, 4, 1, 2.0);
+    p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_TRUE(no_data(p, 4, 0, 0));
+    EXPECT_TRUE(no_data(p, 4, 1, 0));
+    EXPECT_TRUE(point_is(p, 4, 2, 0, std::numeric_limits<float>::infinity(), 0.0f, std::ldexp(1.0f, 127)));
+    EXPECT_TRUE(point_is(p, 4, 3, 0, 6.0f, 0.0f, 2.0f));
+}
+
+TEST(ReferenceDepth, XIsZTimesKuInFloat) {
+    // cx = 2.3, fx = 0.7, cy = 0.5, fy = 0.7: ku[u] = (float)((u - 2.3) / 0.7), kv[0] = (float)(-0.5 / 0.7); d = 1717
+    // everywhere, s = 1. The bits below were worked out with float32 multiplications of those constants.
+    const std::vector<std::uint16_t> d(5, 1717);
+    DepthInput in = depth_of(d.data(), DepthFormat::u16, 5, 1, 0.001);
+    in.cx = 2.3;
+    in.fx = 0.7;
+    in.cy = 0.5;
+    in.fy = 0.7;
+    const DepthPoints p = pyrseg_ref::depth_to_points(in, 1.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    const std::uint32_t expected_x[5] = {0xc5b04c93u, 0xc5474b6du, 0xc437f6dcu, 0x44d6a000u, 0x45824edcu};
+    const float z = 1717.0f;
+    const float y = z * static_cast<float>((0.0 - 0.5) / 0.7);
+    for (int u = 0; u < 5; ++u) {
+        const float ku = static_cast<float>((static_cast<double>(u) - 2.3) / 0.7);
+        EXPECT_EQ(bits(z * ku), expected_x[u]) << u;
+        EXPECT_TRUE(point_is(p, 5, u, 0, from_bits(expected_x[u]), y, z)) << u;
+    }
+    // The test tells the text's x from the alternatives: per-point double (u - cx) * z / fx at u = 0, 1, 2, 4, and
+    // ku computed in float arithmetic at u = 2, 3 (at u = 3 the double constant is exactly 1, the float one is not).
+    for (int u : {0, 1, 2, 4}) {
+        const float per_point = static_cast<float>((static_cast<double>(u) - 2.3) * 1717.0 / 0.7);
+        EXPECT_NE(bits(per_point), expected_x[u]) << u;
+    }
+    for (int u : {2, 3}) {
+        const float in_float = z * ((static_cast<float>(u) - 2.3f) / 0.7f);
+        EXPECT_NE(bits(in_float), expected_x[u]) << u;
+    }
+}
+
+TEST(ReferenceDepth, SubnormalXAndYBecomeSignedZeros) {
+    // f32, s = 1. fx = fy = 2^100, cx = 2, cy = 0: ku = {-2^-99, -2^-100, +0, 2^-100}, kv = {+0, 2^-100}, all exact.
+    const std::vector<float> d = {
+        std::ldexp(1.0f, -27), std::ldexp(1.0f, -30), 1.0f, std::ldexp(1.0f, -28), std::ldexp(1.0f, -20),
+        std::ldexp(1.0f, -27), std::ldexp(1.0f, -26), 1.0f};
+    DepthInput in = depth_of(d.data(), DepthFormat::f32, 4, 2, 1.0);
+    in.fx = std::ldexp(1.0, 100);
+    in.fy = std::ldexp(1.0, 100);
+    in.cx = 2.0;
+    const DepthPoints p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    const float neg0 = from_bits(0x80000000u);
+    // Row 0, y = z * +0 = +0. x: -2^-126 (normal, kept), -2^-130 -> -0, +0 * 1 = +0, 2^-128 -> +0.
+    EXPECT_TRUE(point_is(p, 4, 0, 0, from_bits(0x80800000u), 0.0f, d[0]));
+    EXPECT_TRUE(point_is(p, 4, 1, 0, neg0, 0.0f, d[1]));
+    EXPECT_TRUE(point_is(p, 4, 2, 0, 0.0f, 0.0f, 1.0f));
+    EXPECT_TRUE(point_is(p, 4, 3, 0, 0.0f, 0.0f, d[3]));
+    // Row 1. x: -2^-119 kept, -2^-127 -> -0, +0, 2^-100. y: 2^-120 kept, 2^-127 -> +0, 2^-126 kept, 2^-100.
+    EXPECT_TRUE(point_is(p, 4, 0, 1, -std::ldexp(1.0f, -119), std::ldexp(1.0f, -120), d[4]));
+    EXPECT_TRUE(point_is(p, 4, 1, 1, neg0, 0.0f, d[5]));
+    EXPECT_TRUE(point_is(p, 4, 2, 1, 0.0f, std::ldexp(1.0f, -126), d[6]));
+    EXPECT_TRUE(point_is(p, 4, 3, 1, std::ldexp(1.0f, -100), std::ldexp(1.0f, -100), 1.0f));
+}
+
+TEST(ReferenceDepth, RowStepAnyByteCount) {
+    // u16, 3 x 3, rows 7 bytes apart (odd), from an odd address; the padding bytes 0xAB would read as 43947.
+    // The buffer ends right after the last row's 6 bytes. d(u, v) = 100 * (v + 1) + u + 1, s = 1, ku = u, kv = v.
+    std::vector<unsigned char> buf(1 + 2 * 7 + 6, 0xAB);
+    for (int v = 0; v < 3; ++v) {
+        for (int u = 0; u < 3; ++u) {
+            const auto value = static_cast<std::uint16_t>(100 * (v + 1) + u + 1);
+            std::memcpy(buf.data() + 1 + v * 7 + 2 * u, &value, sizeof value);
+        }
+    }
+    DepthInput in = depth_of(buf.data() + 1, DepthFormat::u16, 3, 3, 0.001);
+    in.row_step_bytes = 7;
+    DepthPoints p = pyrseg_ref::depth_to_points(in, 1.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    for (int v = 0; v < 3; ++v) {
+        for (int u = 0; u < 3; ++u) {
+            const auto z = static_cast<float>(100 * (v + 1) + u + 1);
+            EXPECT_TRUE(point_is(p, 3, u, v, z * static_cast<float>(u), z * static_cast<float>(v), z));
+        }
+    }
+    // Fewer bytes than a row holds is rejected; exactly a row's worth is the packed layout, as is 0.
+    in.row_step_bytes = 5;
+    p = pyrseg_ref::depth_to_points(in, 1.0);
+    EXPECT_FALSE(p.ok);
+    EXPECT_EQ(p.error.rfind("row_step_bytes ", 0), 0u) << p.error;
+    const std::vector<std::uint16_t> packed = {1, 2, 3, 4, 5, 6};
+    for (std::size_t step : {std::size_t{0}, std::size_t{6}}) {
+        DepthInput tight = depth_of(packed.data(), DepthFormat::u16, 3, 2, 0.001);
+        tight.row_step_bytes = step;
+        p = pyrseg_ref::depth_to_points(tight, 1.0);
+        ASSERT_TRUE(p.ok) << p.error;
+        EXPECT_TRUE(point_is(p, 3, 2, 1, 12.0f, 6.0f, 6.0f)) << step;
+    }
+
+    // f32, 2 x 2, rows 11 bytes apart, from an odd address.
+    std::vector<unsigned char> fbuf(1 + 11 + 8, 0xAB);
+    const float fd[4] = {1.5f, 2.5f, 3.5f, 4.5f};
+    for (int v = 0; v < 2; ++v) {
+        std::memcpy(fbuf.data() + 1 + v * 11, fd + 2 * v, 2 * sizeof(float));
+    }
+    in = depth_of(fbuf.data() + 1, DepthFormat::f32, 2, 2, 1.0);
+    in.row_step_bytes = 11;
+    p = pyrseg_ref::depth_to_points(in, 1000.0);
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_TRUE(point_is(p, 2, 0, 0, 0.0f, 0.0f, 1.5f));
+    EXPECT_TRUE(point_is(p, 2, 1, 0, 2.5f, 0.0f, 2.5f));
+    EXPECT_TRUE(point_is(p, 2, 0, 1, 0.0f, 3.5f, 3.5f));
+    EXPECT_TRUE(point_is(p, 2, 1, 1, 4.5f, 4.5f, 4.5f));
+    in.row_step_bytes = 7;
+    EXPECT_FALSE(pyrseg_ref::depth_to_points(in, 1000.0).ok);
+}
+
+TEST(ReferenceDepth, RejectedParameters) {
+    const std::vector<std::uint16_t> d(4, 1000);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    auto base = [&] {
+        DepthInput in = depth_of(d.data(), DepthFormat::u16, 2, 2, 0.001);
+        in.cx = 0.5;
+        in.cy = 0.5;
+        return in;
+    };
+    auto with = [&](auto change) {
+        DepthInput in = base();
+        change(in);
+        return in;
+    };
+    // Rejected by depth_to_points and by segment_depth, with a message that starts with the parameter's name.
+    auto rejected_for = [&](const DepthInput& in, double unit_mm, const std::string& name) {
+        const DepthPoints p = pyrseg_ref::depth_to_points(in, unit_mm);
+        Params params;
+        params.unit_mm = unit_mm;
+        const Output o = pyrseg_ref::segment_depth(in, in.width, in.height, params);
+        return !p.ok && p.points.empty() && p.error.rfind(name + " ", 0) == 0 && !o.ok &&
+               o.error.rfind(name + " ", 0) == 0;
+    };
+    auto accepted = [&](const DepthInput& in, double unit_mm) { return pyrseg_ref::depth_to_points(in, unit_mm).ok; };
+    EXPECT_TRUE(accepted(base(), 1.0));
+    for (double bad : {0.0, -0.0, -0.001, nan, inf, -inf}) {
+        EXPECT_TRUE(rejected_for(with([&](DepthInput& in) { in.metres_per_unit = bad; }), 1.0, "metres_per_unit"))
+            << bad;
+        EXPECT_TRUE(rejected_for(with([&](DepthInput& in) { in.fx = bad; }), 1.0, "fx")) << bad;
+        EXPECT_TRUE(rejected_for(with([&](DepthInput& in) { in.fy = bad; }), 1.0, "fy")) << bad;
+    }
+    EXPECT_TRUE(rejected_for(with([](DepthInput& in) { in.fy = -525.0; }), 1.0, "fy"));
+    for (double bad : {nan, inf, -inf}) {
+        EXPECT_TRUE(rejected_for(with([&](DepthInput& in) { in.cx = bad; }), 1.0, "cx")) << bad;
+        EXPECT_TRUE(rejected_for(with([&](DepthInput& in) { in.cy = bad; }), 1.0, "cy")) << bad;
+    }
+    // Any finite cx, cy is fine, negative or far outside the image.
+    EXPECT_TRUE(accepted(with([](DepthInput& in) { in.cx = -1e6; }), 1.0));
+    EXPECT_TRUE(accepted(with([](DepthInput& in) { in.cy = 1e300; }), 1.0));
+    // The order is m, fx, fy, cx, cy, s: with several bad, the first is named.
+    EXPECT_TRUE(rejected_for(with([&](DepthInput& in) {
+                                 in.fx = 0.0;
+                                 in.cx = nan;
+                             }),
+                             1.0, "fx"));
+
+    // The scale. m = 1e-42, unit_mm = 1: s = (float)1e-39, a subnormal. m = 1e-300: s = +0. m = 1, unit_mm = 1e-36:
+    // s = (float)1e39 = +inf. m = 1e306: m * 1000 = +inf in double.
+    EXPECT_TRUE(rejected_for(with([](DepthInput& in) { in.metres_per_unit = 1e-42; }), 1.0, "scale"));
+    EXPECT_TRUE(rejected_for(with([](DepthInput& in) { in.metres_per_unit = 1e-300; }), 1.0, "scale"));
+    EXPECT_TRUE(rejected_for(with([](DepthInput& in) { in.metres_per_unit = 1.0; }), 1e-36, "scale"));
+    EXPECT_TRUE(rejected_for(with([](DepthInput& in) { in.metres_per_unit = 1e306; }), 1.0, "scale"));
+    // m = 2^-126, unit_mm = 1000: s = 2^-126 exactly, the smallest normal: accepted. m = (1 - 2^-30) * 2^-126: the
+    // double (m * 1000) / 1000 = m is below 2^-126 but rounds to the float 2^-126, and the text tests the float s:
+    // accepted. m = (1 - 2^-22) * 2^-126 is the float 2^-126 - 2^-148 exactly, a subnormal: rejected.
+    EXPECT_TRUE(accepted(with([](DepthInput& in) { in.metres_per_unit = std::ldexp(1.0, -126); }), 1000.0));
+    EXPECT_TRUE(accepted(
+        with([](DepthInput& in) { in.metres_per_unit = std::ldexp(1.0 - std::ldexp(1.0, -30), -126); }), 1000.0));
+    EXPECT_TRUE(
+        rejected_for(with([](DepthInput& in) { in.metres_per_unit = std::ldexp(1.0 - std::ldexp(1.0, -22), -126); }),
+                     1000.0, "scale"));
+    // A valid s: z = 1000 * 2^-126 is data.
+    const DepthPoints tiny =
+        pyrseg_ref::depth_to_points(with([](DepthInput& in) { in.metres_per_unit = std::ldexp(1.0, -126); }), 1000.0);
+    ASSERT_TRUE(tiny.ok) << tiny.error;
+    EXPECT_TRUE(point_is(tiny, 2, 1, 1, std::ldexp(500.0f, -126), std::ldexp(500.0f, -126), std::ldexp(1000.0f, -126)));
+
+    // unit_mm, the sizes and the samples pointer.
+    for (double bad : {0.0, -1.0, nan, inf}) EXPECT_TRUE(rejected_for(base(), bad, "unit_mm")) << bad;
+    EXPECT_FALSE(pyrseg_ref::depth_to_points(with([](DepthInput& in) { in.width = 0; }), 1.0).ok);
+    EXPECT_FALSE(pyrseg_ref::depth_to_points(with([](DepthInput& in) { in.height = -1; }), 1.0).ok);
+    EXPECT_FALSE(pyrseg_ref::depth_to_points(with([](DepthInput& in) { in.samples = nullptr; }), 1.0).ok);
+}
+
+TEST(ReferenceDepth, SegmentDepthIsSegmentOfThePoints) {
+    // 40 x 30 u16 depth: a frontal plane at 1500 units, a box at 1200 over x 10..29, y 6..23, two missing pixels.
+    const int w = 40;
+    const int h = 30;
+    std::vector<std::uint16_t> d;
+    for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+            const bool box = u >= 10 && u <= 29 && v >= 6 && v <= 23;
+            const bool hole = v == 3 && (u == 3 || u == 4);
+            d.push_back(static_cast<std::uint16_t>(hole ? 0 : box ? 1200 : 1500));
+        }
+    }
+    DepthInput in = depth_of(d.data(), DepthFormat::u16, w, h, 0.001);
+    in.fx = 40.0;
+    in.fy = 40.0;
+    in.cx = 19.5;
+    in.cy = 14.5;
+    Params metres;
+    metres.unit_mm = 1000.0;
+    for (const Params& params : {Params{}, robust_params(), metres}) {
+        SCOPED_TRACE("unit_mm " + std::to_string(params.unit_mm) +
+                     (params.metric == pyrseg_ref::Metric::robust ? " robust" : " paper"));
+        const DepthPoints p = pyrseg_ref::depth_to_points(in, params.unit_mm);
+        ASSERT_TRUE(p.ok) << p.error;
+        EXPECT_TRUE(no_data(p, w, 3, 3));
+        const Output want = pyrseg_ref::segment(p.points.data(), nullptr, w, h, params);
+        const Output got = pyrseg_ref::segment_depth(in, w, h, params);
+        ASSERT_TRUE(want.ok) << want.error;
+        ASSERT_TRUE(got.ok) << got.error;
+        EXPECT_LABELS(got.labels, want.labels, w);
+        EXPECT_LABELS(got.raw_labels, want.raw_labels, w);
+        EXPECT_EQ(got.fillable, want.fillable);
+        EXPECT_EQ(got.normals, want.normals);
+        EXPECT_EQ(got.segment_count, want.segment_count);
+        // The box and the plane are separate segments (a 300 mm step, dt = 10 mm); the holes are not labelled. (With
+        // the robust metric this box is too small: its normals are skewed within R + r = 4 pixels of each edge, and
+        // the pairs 4 pixels either side leave only x 18..21 fillable, which level M's 4 x 4 cells do not cover.)
+        if (params.metric == pyrseg_ref::Metric::robust) continue;
+        const std::uint32_t plane = got.labels[0];
+        const std::uint32_t box = got.labels[static_cast<std::size_t>(15 * w + 20)];
+        EXPECT_NE(plane, 0u);
+        EXPECT_NE(box, 0u);
+        EXPECT_NE(plane, box);
+        EXPECT_EQ(got.labels[static_cast<std::size_t>(3 * w + 3)], 0u);
+    }
+    // Sizes that differ from the depth image's, and errors of either step.
+    EXPECT_FALSE(pyrseg_ref::segment_depth(in, w + 1, h, Params{}).ok);
+    EXPECT_FALSE(pyrseg_ref::segment_depth(in, w, h - 1, Params{}).ok);
+    DepthInput bad = in;
+    bad.fx = 0.0;
+    const Output o = pyrseg_ref::segment_depth(bad, w, h, Params{});
+    EXPECT_FALSE(o.ok);
+    EXPECT_EQ(o.error.rfind("fx ", 0), 0u) << o.error;
+    Params bad_params;
+    bad_params.ct = -1.0;
+    EXPECT_FALSE(pyrseg_ref::segment_depth(in, w, h, bad_params).ok);
+    bad_params = Params{};
+    bad_params.normal_radius = 0;
+    EXPECT_FALSE(pyrseg_ref::segment_depth(in, w, h, bad_params).ok);
 }
 
 }  // namespace
