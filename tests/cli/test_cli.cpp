@@ -435,6 +435,45 @@ TEST(Cli, PclPngComparesWithThePeer) {
     fs::remove_all(dir);
 }
 
+// A NumPy depth map (H x W float32, metres) segments like the same samples in a float TIFF: both go through DepthView.
+TEST(Cli, NumpyDepthMapsSegmentLikeDepthImages) {
+    const fs::path dir = temp_dir();
+    pyrseg::synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
+    std::vector<float> metres(std::size_t(o.width) * std::size_t(o.height));
+    for (std::size_t i = 0; i < metres.size(); ++i) metres[i] = scene.points[3 * i + 2] / 1000.0f;  // NaN: no data
+    pyrseg::io::write_npy(dir / "depth.npy", metres.data(), o.height, o.width, 1);
+    pyrseg::io::write_tiff_float(dir / "depth.tif", metres.data(), o.width, o.height);
+    const std::string k = " --intrinsics " + std::to_string(scene.fx) + "," + std::to_string(scene.fy) + "," +
+                          std::to_string(scene.cx) + "," + std::to_string(scene.cy);
+    CliRun r = run("segment " + (dir / "depth.npy").string() + k + " --labels " + (dir / "a.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("NumPy depth map"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "depth.tif").string() + k + " --labels " + (dir / "b.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::NpyArray a = pyrseg::io::read_npy(dir / "a.npy");
+    const pyrseg::io::NpyArray b = pyrseg::io::read_npy(dir / "b.npy");
+    EXPECT_EQ(a.bytes, b.bytes);
+    std::set<std::uint32_t> labels;
+    for (std::size_t i = 0; i + 4 <= a.bytes.size(); i += 4) {
+        std::uint32_t l = 0;
+        std::memcpy(&l, a.bytes.data() + i, 4);
+        labels.insert(l);
+    }
+    EXPECT_GT(labels.size(), 5u);
+    r = run("segment " + (dir / "depth.npy").string() + " --labels " + (dir / "c.npy").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("intrinsics"), std::string::npos) << r.output;
+    std::vector<std::uint32_t> ints(metres.size(), 1000);
+    pyrseg::io::write_npy(dir / "ints.npy", ints.data(), o.height, o.width);
+    r = run("segment " + (dir / "ints.npy").string() + k + " --labels " + (dir / "c.npy").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("uint16 or float32"), std::string::npos) << r.output;
+    fs::remove_all(dir);
+}
+
 TEST(Cli, DemoRunsOnASmallSceneAndWritesPictures) {
     const fs::path dir = temp_dir();
     const CliRun r = run("demo --size 160x120 --runs 1 --data " + (dir / "none").string() + " --out " + dir.string());
