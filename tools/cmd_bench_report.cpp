@@ -308,6 +308,33 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     }
     md += "\n";
 
+    // Depth frames: the same scenes as uint16 depth images (2 bytes a pixel uploaded, back-projected on the device)
+    // beside the float clouds (12 bytes a pixel).
+    md +=
+        "## Depth images (DepthView)\n\nThe same scenes as uint16 depth images in millimetres "
+        "(pipeline_depth/: 2 bytes a pixel uploaded, back-projected on the device by the depth pass) beside the float "
+        "clouds (pipeline/, 12 bytes a pixel), normals estimated. Ratio: depth ÷ cloud.\n\n";
+    md += header(
+        {"frame", "backend", "cloud", "depth image", "depth ÷ cloud", "upload: cloud", "upload: depth", "depth pass"});
+    for (const Size& s : sizes) {
+        for (const std::string& b : backends) {
+            const Entry* cloud = find(entries, "pipeline/" + b + "/" + s.name + "/estimated_normals");
+            const Entry* depth = find(entries, "pipeline_depth/" + b + "/" + s.name + "/u16");
+            if (depth == nullptr) continue;
+            const auto counter = [](const Entry* e, const char* pass) {
+                if (e == nullptr) return std::string("—");
+                const auto it = e->counters.find(pass);
+                if (it == e->counters.end()) return std::string("—");
+                char text[32];
+                std::snprintf(text, sizeof text, "%.2f ms", it->second);
+                return std::string(text);
+            };
+            md += table_row({s.name, b, ms_cell(cloud), ms_cell(depth), ratio_cell(ratio(depth, cloud)),
+                             counter(cloud, "upload_ms"), counter(depth, "upload_ms"), counter(depth, "depth_ms")});
+        }
+    }
+    md += "\n";
+
     // What the robust metric costs: the same frames with the kinect-v1 preset, pass by pass.
     md +=
         "## The robust metric's cost\n\nThe same frames, normals estimated, with the paper's metric (pipeline/) and "
