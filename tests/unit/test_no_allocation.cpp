@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <new>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "pyrseg/backend.hpp"
+#include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -90,6 +92,43 @@ TEST_P(NoAllocation, WarmFramesAllocateNothing) {
                   }),
                   0);
     }
+}
+
+// The same for the robust metric (texels, edge rounds) and for depth frames (their tables and packed samples).
+TEST_P(NoAllocation, WarmRobustAndDepthFramesAllocateNothing) {
+    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
+        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
+                        "no_allocation_without_validation_layer runs this test without it";
+    }
+    synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene a = synthetic::generate(o);
+    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = a.points[3 * i + 2];
+        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+    }
+    const DepthView dv{depth.data(), DepthFormat::u16, o.width, o.height, 0, 0.001, a.fx, a.fy, a.cx, a.cy};
+    const CloudView cv{a.points.data(), nullptr, o.width, o.height};
+    Outputs outputs;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    Segmenter segmenter(o.width, o.height, sensor_preset(SensorKind::kinect_v1), GetParam(), outputs);
+    Result result;
+    segmenter.segment(cv, result);
+    segmenter.segment(dv, result);
+    EXPECT_EQ(allocations_during([&] {
+                  for (int frame = 0; frame < 4; ++frame) {
+                      if (frame % 2 != 0) {
+                          segmenter.segment(cv, result);
+                      } else {
+                          segmenter.segment(dv, result);
+                      }
+                  }
+              }),
+              0);
+    EXPECT_GT(result.segment_count, 1u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, NoAllocation, ::testing::ValuesIn(available()),
