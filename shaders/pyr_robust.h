@@ -111,6 +111,18 @@ PYR_FN PyrRobustTexel pyr_robust_texel_load(PYR_CTX_PARAM, pyr_u32 i) {
 #error "define PYR_ROBUST_TEXEL (the CPU) or PYR_TEXEL_WORD and PYR_STORE_TEXEL_WORD (a GPU dialect)"
 #endif
 
+/* The normal from a window's tangent sums U and V (section 8b, from "If U or V is (0, 0, 0)"). */
+PYR_FN PyrIVec3 pyr_robust_normal_from_sums(PyrIVec3 u, PyrIVec3 v, pyr_f32 px, pyr_f32 py, pyr_f32 pz) {
+    if (pyr_robust_is_zero(u) != 0u || pyr_robust_is_zero(v) != 0u) {
+        PyrIVec3 none;
+        none.x = 0;
+        none.y = 0;
+        none.z = 0;
+        return none;
+    }
+    return pyr_unit_normal_from_tangents(pyr_robust_to_15_bits(u), pyr_robust_to_15_bits(v), px, py, pz);
+}
+
 PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 window,
                                     pyr_f32 scale) {
     PyrIVec3 none;
@@ -146,8 +158,7 @@ PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32
             }
         }
     }
-    if (pyr_robust_is_zero(u) != 0u || pyr_robust_is_zero(v) != 0u) return none;
-    return pyr_unit_normal_from_tangents(pyr_robust_to_15_bits(u), pyr_robust_to_15_bits(v), px, py, pz);
+    return pyr_robust_normal_from_sums(u, v, px, py, pz);
 }
 
 /* min(A + Bc * z^2, 2^28) as an int32, per section 2b; growth == 0 means A alone. */

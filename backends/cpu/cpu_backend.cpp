@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/robust_windows.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
 #include "core/cloud_layout.hpp"
@@ -147,12 +148,13 @@ public:
                 }
             });
             c.robust_texels = robust_texels_.data();
+            windows_.build(robust_texels_.data(), w, size_t(h), window,
+                           [&](size_t n, const auto& body) { rows(n, body); });
         }
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
-                const PyrIVec3 q =
-                    robust ? kernels::pyr_robust_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), window, scale)
-                           : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
+                const PyrIVec3 q = robust ? robust_normal(c, x, y)
+                                          : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
                 float* n = normals_.data() + 3 * (y * w + x);
                 n[0] = float(q.x) * PYR_NORMAL_UNIT;
                 n[1] = float(q.y) * PYR_NORMAL_UNIT;
@@ -351,6 +353,24 @@ public:
     }
 
 private:
+    // Section 8b's normal of pixel (x, y): from the box sums when its whole window is members, else the window
+    // pixel by pixel (the shared function); the same words either way (backends/cpu/robust_windows.hpp).
+    PyrIVec3 robust_normal(const PassContext& c, size_t x, size_t y) const {
+        const float scale = plan_.thresholds.point_scale;
+        const float* p = point(x, y);
+        if (kernels::pyr_point_valid(p[0], p[1], p[2]) != 0u) {
+            const std::int32_t zi = kernels::pyr_robust_fixed(p[2], scale);
+            if (windows_.all_members(x, y, zi, zi >> 4)) {
+                PyrIVec3 u{};
+                PyrIVec3 v{};
+                windows_.sums(x, y, u, v);
+                return kernels::pyr_robust_normal_from_sums(u, v, p[0], p[1], p[2]);
+            }
+        }
+        return kernels::pyr_robust_normal_q(c, uint32_t(plan_.width), uint32_t(plan_.height), uint32_t(x), uint32_t(y),
+                                            uint32_t(plan_.params.normal_window), scale);
+    }
+
     template <class RowBody>
     void rows(size_t count, const RowBody& body) {
         const size_t grain = std::max<size_t>(1, count / (size_t(pool_.size()) * 8));
@@ -498,6 +518,7 @@ private:
     core::CloudLayout layout_{};
     std::vector<float> normals_;                 // estimated, packed
     std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
+    RobustWindows windows_;                      // their box sums and window depth ranges
     std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)
     DepthView depth_{};                          // a depth frame, as the caller has it
     const core::DepthTables* depth_tables_ = nullptr;
