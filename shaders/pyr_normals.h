@@ -64,10 +64,7 @@ PYR_FN pyr_i32 pyr_unit_component(pyr_i32 d, pyr_u32 len) {
  * unit normal q (|q_c| <= 2^13) toward the camera at the origin, seen from the point P, or (0, 0, 0). Shared by the
  * robust normals (section 8b). */
 PYR_FN PyrIVec3 pyr_unit_normal_from_tangents(PyrIVec3 u, PyrIVec3 v, pyr_f32 px, pyr_f32 py, pyr_f32 pz) {
-    PyrIVec3 none;
-    none.x = 0;
-    none.y = 0;
-    none.z = 0;
+    PyrIVec3 none = pyr_ivec3_zero();
     /* Each product < 2^30, each difference < 2^31. */
     PyrIVec3 c;
     c.x = u.y * v.z - u.z * v.y;
@@ -100,10 +97,7 @@ PYR_FN PyrIVec3 pyr_unit_normal_from_tangents(PyrIVec3 u, PyrIVec3 v, pyr_f32 px
 }
 
 PYR_FN PyrIVec3 pyr_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 r) {
-    PyrIVec3 none;
-    none.x = 0;
-    none.y = 0;
-    none.z = 0;
+    PyrIVec3 none = pyr_ivec3_zero();
     pyr_f32 px = PYR_PT(x, y, 0);
     pyr_f32 py = PYR_PT(x, y, 1);
     pyr_f32 pz = PYR_PT(x, y, 2);

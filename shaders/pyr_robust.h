@@ -52,9 +52,7 @@ PYR_FN PyrRobustTexel pyr_robust_texel(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_
     PyrRobustTexel t;
     t.gz = -1;
     t.tangents = 0u;
-    t.th.x = 0;
-    t.th.y = 0;
-    t.th.z = 0;
+    t.th = pyr_ivec3_zero();
     t.tv = t.th;
     if (pyr_robust_point_valid(PYR_CTX_ARG, x, y) == 0u) return t;
     t.gz = pyr_robust_fixed(PYR_PT(x, y, 2), scale);
@@ -113,22 +111,13 @@ PYR_FN PyrRobustTexel pyr_robust_texel_load(PYR_CTX_PARAM, pyr_u32 i) {
 
 /* The normal from a window's tangent sums U and V (section 8b, from "If U or V is (0, 0, 0)"). */
 PYR_FN PyrIVec3 pyr_robust_normal_from_sums(PyrIVec3 u, PyrIVec3 v, pyr_f32 px, pyr_f32 py, pyr_f32 pz) {
-    if (pyr_robust_is_zero(u) != 0u || pyr_robust_is_zero(v) != 0u) {
-        PyrIVec3 none;
-        none.x = 0;
-        none.y = 0;
-        none.z = 0;
-        return none;
-    }
+    if (pyr_robust_is_zero(u) != 0u || pyr_robust_is_zero(v) != 0u) return pyr_ivec3_zero();
     return pyr_unit_normal_from_tangents(pyr_robust_to_15_bits(u), pyr_robust_to_15_bits(v), px, py, pz);
 }
 
 PYR_FN PyrIVec3 pyr_robust_normal_q(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 window,
                                     pyr_f32 scale) {
-    PyrIVec3 none;
-    none.x = 0;
-    none.y = 0;
-    none.z = 0;
+    PyrIVec3 none = pyr_ivec3_zero();
     pyr_f32 px = PYR_PT(x, y, 0);
     pyr_f32 py = PYR_PT(x, y, 1);
     pyr_f32 pz = PYR_PT(x, y, 2);

@@ -35,6 +35,14 @@ struct PyrIVec3 {
     pyr_i32 z;
 };
 
+PYR_FN PyrIVec3 pyr_ivec3_zero() {
+    PyrIVec3 v;
+    v.x = 0;
+    v.y = 0;
+    v.z = 0;
+    return v;
+}
+
 /* One pixel's share of the robust normals' windows (docs/algorithm.md section 8b): its fixed-point depth G(z) (-1
  * when the point is not point-valid) and its tangents, bit 0 of `tangents` when t_h exists, bit 1 when t_v does. */
 /* The words of a texel in a GPU buffer (shaders/pyr_robust.h: pyr_robust_texel_store). */

@@ -103,6 +103,16 @@ double ratio(const Entry* num, const Entry* den) {
     return num->ms / den->ms;
 }
 
+// A pass's time from a benchmark's counters ("normals_ms", ...), or a dash.
+std::string pass_cell(const Entry* e, const char* pass) {
+    if (e == nullptr) return "—";
+    const auto it = e->counters.find(pass);
+    if (it == e->counters.end()) return "—";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f ms", it->second);
+    return text;
+}
+
 std::string ratio_cell(double r) {
     return std::isfinite(r) ? sig3(r) + "×" : "—";
 }
@@ -321,16 +331,9 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
             const Entry* cloud = find(entries, "pipeline/" + b + "/" + s.name + "/estimated_normals");
             const Entry* depth = find(entries, "pipeline_depth/" + b + "/" + s.name + "/u16");
             if (depth == nullptr) continue;
-            const auto counter = [](const Entry* e, const char* pass) {
-                if (e == nullptr) return std::string("—");
-                const auto it = e->counters.find(pass);
-                if (it == e->counters.end()) return std::string("—");
-                char text[32];
-                std::snprintf(text, sizeof text, "%.2f ms", it->second);
-                return std::string(text);
-            };
-            md += table_row({s.name, b, ms_cell(cloud), ms_cell(depth), ratio_cell(ratio(depth, cloud)),
-                             counter(cloud, "upload_ms"), counter(depth, "upload_ms"), counter(depth, "depth_ms")});
+            md +=
+                table_row({s.name, b, ms_cell(cloud), ms_cell(depth), ratio_cell(ratio(depth, cloud)),
+                           pass_cell(cloud, "upload_ms"), pass_cell(depth, "upload_ms"), pass_cell(depth, "depth_ms")});
         }
     }
     md += "\n";
@@ -347,17 +350,9 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
             const Entry* paper = find(entries, "pipeline/" + b + "/" + s.name + "/estimated_normals");
             const Entry* robust = find(entries, "pipeline_robust/" + b + "/" + s.name + "/estimated_normals");
             if (robust == nullptr) continue;
-            const auto counter = [](const Entry* e, const char* pass) {
-                if (e == nullptr) return std::string("—");
-                const auto it = e->counters.find(pass);
-                if (it == e->counters.end()) return std::string("—");
-                char text[32];
-                std::snprintf(text, sizeof text, "%.2f ms", it->second);
-                return std::string(text);
-            };
             md += table_row({s.name, b, ms_cell(paper), ms_cell(robust), ratio_cell(ratio(robust, paper)),
-                             counter(paper, "normals_ms"), counter(robust, "normals_ms"), counter(paper, "metric_ms"),
-                             counter(robust, "metric_ms")});
+                             pass_cell(paper, "normals_ms"), pass_cell(robust, "normals_ms"),
+                             pass_cell(paper, "metric_ms"), pass_cell(robust, "metric_ms")});
         }
     }
     md += "\n";

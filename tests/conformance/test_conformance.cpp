@@ -20,15 +20,6 @@
 namespace pyrseg::test {
 namespace {
 
-Outputs everything() {
-    Outputs o;
-    o.raw_labels = true;
-    o.fillable_mask = true;
-    o.normals = true;
-    o.segment_stats = true;
-    return o;
-}
-
 // Segments `points` with `backend` and compares every output with the reference.
 void expect_conformance(const std::string& backend, const float* points, const float* normals, int width, int height,
                         const Params& params, const float* warmup_points = nullptr) {

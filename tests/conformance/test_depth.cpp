@@ -80,15 +80,6 @@ pyrseg_ref::DepthInput to_reference(const DepthView& v) {
     return r;
 }
 
-Outputs everything() {
-    Outputs o;
-    o.raw_labels = true;
-    o.fillable_mask = true;
-    o.normals = true;
-    o.segment_stats = true;
-    return o;
-}
-
 class DepthImages : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(DepthImages, MatchTheReference) {

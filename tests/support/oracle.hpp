@@ -17,6 +17,16 @@
 
 namespace pyrseg::test {
 
+// Every output a backend can give, so that conformance compares all of them.
+inline Outputs everything() {
+    Outputs o;
+    o.raw_labels = true;
+    o.fillable_mask = true;
+    o.normals = true;
+    o.segment_stats = true;
+    return o;
+}
+
 inline pyrseg_ref::Params to_reference(const Params& p) {
     pyrseg_ref::Params r;
     r.ct = p.ct;
