@@ -237,17 +237,9 @@ private:
 
     void pixel(int u, int v, const std::vector<Entry>& list, Rng& rng) const {
         const Vec3 d = ray(u, v);
-        double best = kInf;
         std::size_t k = 0;
-        Hit nearest, hit;
-        for (const Entry& e : list) {
-            if (e.zmin >= best) break;
-            if (ray_entry(solids_[e.index], {0, 0, 0}, d, best, hit)) {
-                best = hit.t;
-                nearest = hit;
-                k = e.index;
-            }
-        }
+        Hit nearest;
+        const double best = cast(d, list, nearest, k);
         const std::size_t at =
             static_cast<std::size_t>(v) * static_cast<std::size_t>(scene_.width) + static_cast<std::size_t>(u);
         float* point = scene_.points.data() + 3 * at;
