@@ -84,6 +84,12 @@ struct Scene {
 // 300..6000, an unknown sensor, or threads negative.
 Scene generate(const SceneOptions& options);
 
+// Pairs of objects (ids a < b, sorted) that no depth data can tell apart: two upright boxes whose top faces lie in
+// one plane (within 0.05 mm) and touch along a side (within 0.05 mm), as identical parts packed side by side in a
+// bin. Their visible surfaces meet with no depth step and no crease, so any segmentation from depth alone sees one
+// surface there; `pyrseg eval` reports its merge rates with and without these pairs (docs/quality.md).
+std::vector<std::array<std::uint32_t, 2>> flush_pairs(const Scene& scene);
+
 // "structured-light", "kinect-v1", "realsense-d435", "azure-kinect"; nullptr for a value outside the enum.
 const char* sensor_name(Sensor sensor);
 // The sensor of that name (as sensor_name writes it); nullopt for any other string.

@@ -2,6 +2,7 @@
 // the adjusted Rand index against a brute-force count over all pixel pairs.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <random>
 #include <stdexcept>
@@ -102,6 +103,27 @@ TEST(EvalMetrics, AClaimNeedsMoreThanHalf) {
     s = score(truth, Labels{7, 7, 7, 8, 7, 7, 7, 7}, 4);
     EXPECT_EQ(s.merged, 2u);
     EXPECT_EQ(s.split, 1u);  // 3 of 4 = 75% < 80%
+}
+
+TEST(EvalMetrics, SeparableMergesLeaveFlushGroupsAside) {
+    // Objects 1, 2, 3, 4 of 2 pixels each; 1-2 and 2-3 are flush pairs (a chain), 4 is flush with none.
+    const Labels truth{1, 1, 2, 2, 3, 3, 4, 4};
+    const std::vector<std::array<std::uint32_t, 2>> flush{{1, 2}, {2, 3}, {7, 9}};  // 7, 9: not in the frame
+    // One segment over the flush chain only: merged, but not a separable merge.
+    auto s = score(truth, Labels{5, 5, 5, 5, 5, 5, 6, 6}, 2, 0.8, flush);
+    EXPECT_EQ(s.merged, 3u);
+    EXPECT_EQ(s.merged_separable, 0u);
+    // The chain and object 4 together: every one of them is merged with an object it is not flush with.
+    s = score(truth, Labels{5, 5, 5, 5, 5, 5, 5, 5}, 2, 0.8, flush);
+    EXPECT_EQ(s.merged, 4u);
+    EXPECT_EQ(s.merged_separable, 4u);
+    // 1 with 4 (separable), 2 with 3 (flush): two separable merges.
+    s = score(truth, Labels{5, 5, 6, 6, 6, 6, 5, 5}, 2, 0.8, flush);
+    EXPECT_EQ(s.merged, 4u);
+    EXPECT_EQ(s.merged_separable, 2u);
+    // Without flush pairs the two counts are the same.
+    s = score(truth, Labels{5, 5, 5, 5, 5, 5, 6, 6}, 2);
+    EXPECT_EQ(s.merged_separable, s.merged);
 }
 
 TEST(EvalMetrics, SmallObjectsAreNotEvaluated) {

@@ -69,6 +69,17 @@ TEST(EvalSummary, ChecksFailAndMissingMeasurementsAreNotJudged) {
     EXPECT_TRUE(std::isnan(s.pcl0.ari()));
     EXPECT_TRUE(std::isnan(s.merge[0].ratio()));
     EXPECT_EQ(s.labels_enough, true);
+    // The separable check judges the separable counts alone: here 2 of CC's 10 raw merges were separable and the
+    // pyramid's 2 raw merges were flush pairs only.
+    cells = {cell(800, 0, 0, 0), cell(800, 1, 2, 10)};
+    cells[1].pyramid.merged_separable = 0;
+    cells[1].cc.merged_separable = 2;
+    s = summarize(cells);
+    EXPECT_EQ(s.merges_fifth_of_cc, true);
+    EXPECT_EQ(s.separable_merges_fifth_of_cc, true);
+    EXPECT_DOUBLE_EQ(s.merge[0].separable_ratio(), 0.0);
+    cells[1].pyramid.merged_separable = 1;  // 1 > 2/5
+    EXPECT_EQ(summarize(cells).separable_merges_fifth_of_cc, false);
     // Bridges that merged nothing for CC do not test the pyramid.
     cells = {cell(800, 0, 0, 0), cell(800, 1, 0, 0), cell(800, 2, 0, 0)};
     EXPECT_FALSE(summarize(cells).merges_fifth_of_cc.has_value());

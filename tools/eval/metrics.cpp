@@ -1,5 +1,7 @@
 #include "tools/eval/metrics.hpp"
 
+#include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -24,6 +26,11 @@ public:
         return it->second;
     }
     [[nodiscard]] std::size_t size() const { return counts_.size(); }
+    [[nodiscard]] std::optional<std::uint32_t> find(std::uint32_t label) const {
+        const auto it = map_.find(label);
+        if (it == map_.end()) return std::nullopt;
+        return it->second;
+    }
     std::vector<std::uint64_t>& counts() { return counts_; }
 
 private:
@@ -96,7 +103,8 @@ double adjusted_rand_index(std::span<const std::uint32_t> truth, std::span<const
 }
 
 Scores score(std::span<const std::uint32_t> truth, std::span<const std::uint32_t> predicted,
-             std::uint32_t min_object_pixels, double split_share) {
+             std::uint32_t min_object_pixels, double split_share,
+             std::span<const std::array<std::uint32_t, 2>> flush_pairs) {
     Contingency c = tabulate(truth, predicted);
     Scores s;
     s.pixels = c.pixels;
@@ -128,6 +136,39 @@ Scores score(std::span<const std::uint32_t> truth, std::span<const std::uint32_t
     }
     for (std::size_t t = 0; t < objects; ++t) {
         if (size[t] >= min_object_pixels && claimed_by[t] != kNone && claims[claimed_by[t]] >= 2) ++s.merged;
+    }
+
+    // Flush groups over the truth indices (union-find, smallest index as the root), then the separable merges:
+    // the objects whose claiming segment also claims an evaluated object of another group.
+    std::vector<std::size_t> group(objects);
+    for (std::size_t t = 0; t < objects; ++t) group[t] = t;
+    const auto root = [&](std::size_t t) {
+        while (group[t] != t) t = group[t] = group[group[t]];
+        return t;
+    };
+    for (const auto& [a, b] : flush_pairs) {
+        const auto ia = c.truth.find(a);
+        const auto ib = c.truth.find(b);
+        if (!ia || !ib) continue;
+        const std::size_t ra = root(*ia);
+        const std::size_t rb = root(*ib);
+        group[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    // Per segment: the group of the first evaluated object it claims, and whether it claims another group too.
+    std::vector<std::size_t> first_group(c.predicted.size(), objects);
+    std::vector<std::uint8_t> mixed(c.predicted.size(), 0);
+    for (std::size_t t = 0; t < objects; ++t) {
+        if (size[t] < min_object_pixels || claimed_by[t] == kNone) continue;
+        const std::size_t g = root(t);
+        std::size_t& first = first_group[claimed_by[t]];
+        if (first == objects) {
+            first = g;
+        } else if (first != g) {
+            mixed[claimed_by[t]] = 1;
+        }
+    }
+    for (std::size_t t = 0; t < objects; ++t) {
+        if (size[t] >= min_object_pixels && claimed_by[t] != kNone && mixed[claimed_by[t]] != 0) ++s.merged_separable;
     }
     return s;
 }

@@ -6,6 +6,7 @@ namespace pyrseg::eval {
 
 void Totals::add(const Scores& s) {
     merged += s.merged;
+    merged_separable += s.merged_separable;
     split += s.split;
     labelled += s.labelled;
     pixels += s.pixels;
@@ -16,6 +17,7 @@ void Totals::add(const Scores& s) {
 
 void Totals::add(const Totals& t) {
     merged += t.merged;
+    merged_separable += t.merged_separable;
     split += t.split;
     labelled += t.labelled;
     pixels += t.pixels;
@@ -51,6 +53,8 @@ SensorSummary summarize(std::span<const Cell> cells) {
             m.objects += c.objects;
             m.pyramid += c.pyramid.merged;
             m.cc += c.cc.merged;
+            m.pyramid_separable += c.pyramid.merged_separable;
+            m.cc_separable += c.cc.merged_separable;
         }
     }
     if (s.pyramid0.frames > 0 && s.pcl0.frames > 0) s.ari_at_least_pcl = s.pyramid0.ari() >= s.pcl0.ari();
@@ -58,6 +62,11 @@ SensorSummary summarize(std::span<const Cell> cells) {
         if (!m.present || m.cc == 0) continue;  // CC merged nothing: the bridges did not test the pyramid
         const bool ok = double(m.pyramid) <= kMaxMergeRatio * double(m.cc);
         s.merges_fifth_of_cc = s.merges_fifth_of_cc.value_or(true) && ok;
+    }
+    for (const MergeAtWidth& m : s.merge) {
+        if (!m.present || m.cc_separable == 0) continue;
+        const bool ok = double(m.pyramid_separable) <= kMaxMergeRatio * double(m.cc_separable);
+        s.separable_merges_fifth_of_cc = s.separable_merges_fifth_of_cc.value_or(true) && ok;
     }
     if (s.pyramid0.pixels > 0) s.labels_enough = s.pyramid0.labelled_share() >= kMinLabelledShare;
     return s;

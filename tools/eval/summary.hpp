@@ -16,7 +16,7 @@ inline constexpr int kCheckedBridgeWidths[2] = {1, 2};
 
 // One method's scores summed over the frames of a cell (or of several cells).
 struct Totals {
-    std::uint64_t merged = 0, split = 0, labelled = 0, pixels = 0, segments = 0;
+    std::uint64_t merged = 0, merged_separable = 0, split = 0, labelled = 0, pixels = 0, segments = 0;
     double ari_sum = 0;
     int frames = 0;
     void add(const Scores& s);
@@ -42,9 +42,11 @@ struct MergeAtWidth {
     int bridge = 0;
     bool present = false;  // the sweep had that width
     std::uint64_t objects = 0, pyramid = 0, cc = 0;
+    std::uint64_t pyramid_separable = 0, cc_separable = 0;  // merges with objects that are not flush
     [[nodiscard]] double pyramid_rate() const { return rate(pyramid, objects); }
     [[nodiscard]] double cc_rate() const { return rate(cc, objects); }
     [[nodiscard]] double ratio() const { return rate(pyramid, cc); }  // pyramid / CC merged; NaN when CC merged none
+    [[nodiscard]] double separable_ratio() const { return rate(pyramid_separable, cc_separable); }
 };
 
 // One sensor model's cells (every distance and bridge width), pooled over the distances.
@@ -55,7 +57,9 @@ struct SensorSummary {
     std::optional<bool> ari_at_least_pcl;  // pyramid ARI >= PCL ARI at width 0
     // Judged at the checked widths the sweep had where CC merged something.
     std::optional<bool> merges_fifth_of_cc;  // 5 * pyramid merged <= CC merged at each checked width present
-    std::optional<bool> labels_enough;       // pyramid labelled share >= kMinLabelledShare at width 0
+    // The same for the separable merges (flush pairs aside): the merges a labelling of the mask can avoid.
+    std::optional<bool> separable_merges_fifth_of_cc;
+    std::optional<bool> labels_enough;  // pyramid labelled share >= kMinLabelledShare at width 0
 };
 
 [[nodiscard]] SensorSummary summarize(std::span<const Cell> cells);
