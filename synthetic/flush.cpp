@@ -8,8 +8,12 @@ namespace {
 
 using Vec = std::array<double, 3>;
 
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec& a, const Vec& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+Vec minus(const Vec& a, const Vec& b) {
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
 
 // Placement leaves touching solids at most 0.01 mm apart; this allows for the rounding of the camera transform.
 constexpr double kTolerance = 0.05;
