@@ -17,8 +17,11 @@ namespace {
 
 }  // namespace
 
-void make_depth_tables(const DepthView& depth, double unit_mm, DepthTables& tables) {
-    if (depth.depth == nullptr) bad(ErrorCode::invalid_argument, "depth pointer is null");
+void make_depth_tables(const DepthView& depth, double unit_mm, DepthTables& tables, bool samples_on_device) {
+    if (samples_on_device && depth.depth != nullptr) {
+        bad(ErrorCode::invalid_argument, "depth pointer must be null: the samples are in the device buffer");
+    }
+    if (!samples_on_device && depth.depth == nullptr) bad(ErrorCode::invalid_argument, "depth pointer is null");
     if (depth.format != DepthFormat::u16 && depth.format != DepthFormat::f32) {
         bad(ErrorCode::invalid_argument, "format is neither u16 nor f32");
     }

@@ -20,7 +20,9 @@ struct DepthTables {
 
 // Validates the view (pointer, row step, metres_per_unit, intrinsics) and computes its tables for points in unit_mm.
 // Throws pyrseg::Error naming the problem. `tables` is reused, so a frame allocates nothing once sized.
-void make_depth_tables(const DepthView& depth, double unit_mm, DepthTables& tables);
+// samples_on_device: the samples are in a device buffer of the caller's (core/device_frame.hpp), and the view's
+// pointer must be null.
+void make_depth_tables(const DepthView& depth, double unit_mm, DepthTables& tables, bool samples_on_device = false);
 
 // Copies the samples into `words` (W*H samples, packed as DepthTables describes), row after row.
 void pack_depth(const DepthView& depth, std::vector<std::uint32_t>& words);

@@ -12,6 +12,9 @@ namespace pyrseg::core {
 
 struct Plan;
 struct DepthTables;
+struct DeviceCloud;
+struct DeviceDepth;
+struct DeviceLabels;
 
 class PassExecutor {
 public:
@@ -44,6 +47,13 @@ public:
     virtual void segment_stats() = 0;
     // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
+    // Device-resident frames (core/device_frame.hpp), on a GPU backend made on the caller's context: the input
+    // copied from the caller's buffers on the device, then the passes as for a host frame, then, instead of
+    // read_back, the labels and K copied into the caller's buffers and the frame submitted without a host wait.
+    // The CPU backend (and any executor without a device) throws pyrseg::Error.
+    virtual void bind_device_cloud(const DeviceCloud& cloud);
+    virtual void bind_device_depth(const DeviceDepth& depth, const DepthTables& tables);
+    virtual void write_device_labels(const DeviceLabels& labels);
 
     // Called before each pass the pipeline times, with the pass's name ("normals", ..., "compact").
     virtual void begin_pass(const char* /*pass*/) {}

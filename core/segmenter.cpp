@@ -3,12 +3,14 @@
 #include <chrono>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "core/backend_registry.hpp"
 #include "core/cloud_layout.hpp"
 #include "core/depth_tables.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
+#include "core/segmenter_impl.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 
@@ -39,15 +41,6 @@ void check_layout(const char* what, std::size_t row_stride, int point_stride, in
 }
 
 }  // namespace
-
-struct Segmenter::Impl {
-    core::Plan plan;
-    std::string backend;
-    Outputs outputs;
-    std::unique_ptr<core::PassExecutor> executor;
-    std::vector<PassTiming> timings;
-    core::DepthTables depth_tables;  // a depth frame's constants, reused
-};
 
 namespace {
 
@@ -80,6 +73,8 @@ Segmenter::Segmenter(int width, int height, const Params& params, std::string_vi
     impl_->executor = core::make_executor(impl_->backend, impl_->plan);
     impl_->timings.reserve(16);
 }
+
+Segmenter::Segmenter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Segmenter::~Segmenter() = default;
 Segmenter::Segmenter(Segmenter&&) noexcept = default;

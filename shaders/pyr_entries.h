@@ -38,8 +38,9 @@ PYR_KERNEL_2D(normals) {
 }
 #endif
 
-/* depth_points (2D, w x h): h, format (PYR_DEPTH_U16 or _F32), scale (float). The samples arrive in the quant
- * buffer (u16 two to a word, lower half first; f32 one to a word), ku then kv (float bits) in the labels buffer. */
+/* depth_points (2D, w x h): h, format (PYR_DEPTH_U16 or _F32), scale (float), rays (a word index). The samples
+ * arrive in the quant buffer (u16 two to a word, lower half first; f32 one to a word); ku then kv (float bits) lie in
+ * the sums buffer from word `rays` on, after the scan's sums, where they stay from one frame to the next. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_DEPTH_POINTS)
 PYR_KERNEL_2D(depth_points) {
     pyr_u32 h = PYR_ARG(0);
@@ -49,8 +50,9 @@ PYR_KERNEL_2D(depth_points) {
     pyr_u32 i = y * PYR_W + x;
     pyr_u32 format = PYR_ARG(1);
     pyr_u32 word = format == PYR_DEPTH_U16 ? (pyr_buf_quant[i >> 1u] >> ((i & 1u) * 16u)) & 0xffffu : pyr_buf_quant[i];
-    PyrFVec3 p = pyr_depth_point(word, format, PYR_ARG_F32(2), PYR_BITS_FLOAT(pyr_buf_labels[x]),
-                                 PYR_BITS_FLOAT(pyr_buf_labels[PYR_W + y]));
+    pyr_u32 rays = PYR_ARG(3);
+    PyrFVec3 p = pyr_depth_point(word, format, PYR_ARG_F32(2), PYR_BITS_FLOAT(pyr_buf_sums[rays + x]),
+                                 PYR_BITS_FLOAT(pyr_buf_sums[rays + PYR_W + y]));
     PYR_STORE_POINT(i * 3u + 0u, p.x);
     PYR_STORE_POINT(i * 3u + 1u, p.y);
     PYR_STORE_POINT(i * 3u + 2u, p.z);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/device_frame.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "shaders/pyr_kernels.h"
 
@@ -77,6 +78,22 @@ public:
     virtual bool pass_times(std::vector<PassTiming>& timings) = 0;
     // A new frame starts: forget the last frame's marks.
     virtual void begin_frame() = 0;
+
+    // Device-resident frames (core/device_frame.hpp), on a device made on the caller's context. The defaults throw
+    // pyrseg::Error: the device has no caller's buffers.
+    //
+    // `rows` rows of `row_bytes` bytes between one of the caller's buffers, rows `pitch` bytes apart from its
+    // offset on, and one of pyrseg's, packed from `offset` on; queued in order with the dispatches.
+    virtual void copy_in(Buffer dst, std::size_t offset, const core::ExternalBuffer& src, std::size_t pitch,
+                         std::size_t row_bytes, std::size_t rows);
+    virtual void copy_out(const core::ExternalBuffer& dst, std::size_t pitch, Buffer src, std::size_t offset,
+                          std::size_t row_bytes, std::size_t rows);
+    // A small upload (at most 64 KiB at a time: the device's constant tables) queued in order with the
+    // dispatches of a device-resident frame, `src` read before it returns: the frame may run long after.
+    virtual void upload_inline(Buffer b, std::size_t offset, const void* src, std::size_t bytes);
+    // Ends a device-resident frame: what is queued goes to the device in the API's own order (the caller's queue,
+    // stream, command buffer or semaphores), with no host wait.
+    virtual void submit();
 };
 
 }  // namespace pyrseg::gpu

@@ -67,34 +67,61 @@ public:
     }
 
     void bind_cloud(const CloudView& cloud) override {
-        start_frame();
+        start_frame(false);
         upload_xyz(cloud, cloud.points, Buffer::points, host_points_);
         if (cloud.normals != nullptr) upload_xyz(cloud, cloud.normals, Buffer::normals, host_normals_);
         from_mask_ = false;
     }
 
-    // The samples travel in the quant buffer and the ray slopes in the labels buffer, which the passes before the
-    // quantize pass (depth, normals) do not otherwise use: 2 (u16) or 4 (f32) bytes a pixel instead of 12.
+    // The samples travel in the quant buffer, which the passes before the quantize pass (depth, normals) do not
+    // otherwise use: 2 (u16) or 4 (f32) bytes a pixel instead of 12. The ray slopes stay in the sums buffer's tail
+    // from one frame to the next and travel only when they change.
     void bind_depth(const DepthView& depth, const core::DepthTables& tables) override {
-        start_frame();
+        start_frame(false);
         core::pack_depth(depth, host_depth_);
         device_->upload(Buffer::quant, 0, host_depth_.data(), 4 * host_depth_.size());
-        host_rays_.assign(tables.ku.begin(), tables.ku.end());
-        host_rays_.insert(host_rays_.end(), tables.kv.begin(), tables.kv.end());
-        device_->upload(Buffer::labels, 0, host_rays_.data(), 4 * host_rays_.size());
-        depth_format_ = depth.format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;
-        depth_scale_ = tables.scale;
-        from_mask_ = false;
+        set_depth(depth.format, tables);
+    }
+
+    // A device-resident depth frame: the samples copied on the device from the caller's buffer, packed as
+    // core::pack_depth packs them.
+    void bind_device_depth(const core::DeviceDepth& depth, const core::DepthTables& tables) override {
+        start_frame(true);
+        const size_t row = core::DepthTables::sample_bytes(depth.view.format) * size_t(width());
+        const size_t pitch = depth.view.row_step_bytes == 0 ? row : depth.view.row_step_bytes;
+        device_->copy_in(Buffer::quant, 0, depth.samples, pitch, row, height());
+        set_depth(depth.view.format, tables);
     }
 
     void depth_to_points() override {
-        dispatch(Kernel::depth_points, width(), height(), args({height(), depth_format_, bits(depth_scale_)}));
+        dispatch(Kernel::depth_points, width(), height(),
+                 args({height(), depth_format_, bits(depth_scale_), rays_word()}));
+    }
+
+    // A device-resident cloud: copied on the device into the points (and normals) buffers, packed.
+    void bind_device_cloud(const core::DeviceCloud& cloud) override {
+        start_frame(true);
+        const size_t row = 12 * size_t(width());
+        const size_t pitch = cloud.row_step_bytes == 0 ? row : cloud.row_step_bytes;
+        device_->copy_in(Buffer::points, 0, cloud.points, pitch, row, height());
+        if (cloud.normals.handle != 0) device_->copy_in(Buffer::normals, 0, cloud.normals, pitch, row, height());
+        from_mask_ = false;
+    }
+
+    // The labels (and K) into the caller's buffers, then the frame goes to the device; nothing waits.
+    void write_device_labels(const core::DeviceLabels& labels) override {
+        const size_t row = 4 * size_t(width());
+        const size_t pitch = labels.row_step_bytes == 0 ? row : labels.row_step_bytes;
+        device_->copy_out(labels.labels, pitch, Buffer::out, 0, row, height());
+        if (labels.count.handle != 0) device_->copy_out(labels.count, 4, Buffer::sums, 4 * size_t(plan_.scan_chunks()), 4, 1);
+        device_->submit();
+        frame_done();
     }
 
     // The caller's mask travels in the points buffer, which a mask frame does not otherwise use: one word per pixel,
     // bit 0 fillable, bit 1 valid.
     void bind_mask(const MaskView& mask) override {
-        start_frame();
+        start_frame(false);
         const size_t w = size_t(plan_.width);
         const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
         host_mask_.resize(plan_.pixel_count());
@@ -109,7 +136,10 @@ public:
         from_mask_ = true;
     }
 
-    void begin_pass(const char* pass) override { device_->mark(pass); }
+    // A device-resident frame keeps no marks: its times are the caller's to take.
+    void begin_pass(const char* pass) override {
+        if (!device_frame_) device_->mark(pass);
+    }
 
     void estimate_normals() override {
         if (plan_.params.metric == Metric::robust) {
@@ -190,11 +220,12 @@ public:
         dispatch(Kernel::scan_sums, 1, 1, args({chunks}));
         dispatch(Kernel::scan_number, chunks, 1, args({count, PYR_SCAN_CHUNK, chunks}));
         dispatch(Kernel::compact, pixels(), 1, args({pixels(), plan_.full().offset, apply ? 1u : 0u}));
-        device_->download(Buffer::sums, 4 * size_t(chunks), &segment_count_, 4);
+        if (!device_frame_) device_->download(Buffer::sums, 4 * size_t(chunks), &segment_count_, 4);
     }
 
     // K is known on the device only: every slot is cleared, and read_back fetches the K used.
     void segment_stats() override {
+        if (device_frame_) return;  // a host result
         device_->zero(Buffer::lut, 4 * size_t(plan_.lut_size()), 4 * plan_.stats_words());
         const uint32_t runs = plan_.stats_runs_per_row() * height();
         dispatch(Kernel::stats, runs, 1,
@@ -215,6 +246,7 @@ public:
         if (outputs.normals && !from_mask_) device_->download(Buffer::normals, 0, staged + S::kNormals * px, 12 * px);
         device_->mark(nullptr);
         finish();
+        frame_done();
         out.width = plan_.width;
         out.height = plan_.height;
         out.segment_count = segment_count_;
@@ -235,12 +267,47 @@ public:
     [[nodiscard]] uint32_t host_syncs() const override { return host_syncs_; }
 
 private:
-    void start_frame() {
+    void start_frame(bool device_frame) {
+        // A frame abandoned by an error may or may not have written new rays: forget what the device holds.
+        if (rays_pending_) rays_on_device_.clear();
+        rays_pending_ = false;
+        device_frame_ = device_frame;
         dispatches_ = 0;
         host_syncs_ = 0;
         device_->begin_frame();
-        device_->mark("upload");
+        if (!device_frame_) device_->mark("upload");
     }
+
+    // The frame is on its way (device frames) or done (host frames): what it uploaded is what the device holds.
+    void frame_done() {
+        if (rays_pending_) rays_on_device_ = host_rays_;
+        rays_pending_ = false;
+    }
+
+    void set_depth(DepthFormat format, const core::DepthTables& tables) {
+        host_rays_.assign(tables.ku.begin(), tables.ku.end());
+        host_rays_.insert(host_rays_.end(), tables.kv.begin(), tables.kv.end());
+        if (host_rays_ != rays_on_device_) {
+            const size_t offset = 4 * size_t(rays_word());
+            const size_t bytes = 4 * host_rays_.size();
+            if (!device_frame_) {
+                device_->upload(Buffer::sums, offset, host_rays_.data(), bytes);
+            } else {
+                // The frame may run after this call returns and after the next one changed host_rays_.
+                constexpr size_t kChunk = 65536;
+                const auto* src = reinterpret_cast<const unsigned char*>(host_rays_.data());
+                for (size_t done = 0; done < bytes; done += kChunk)
+                    device_->upload_inline(Buffer::sums, offset + done, src + done, std::min(kChunk, bytes - done));
+            }
+            rays_pending_ = true;
+        }
+        depth_format_ = format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;
+        depth_scale_ = tables.scale;
+        from_mask_ = false;
+    }
+
+    // Where the ray slopes start in the sums buffer: after the scan's chunk sums and K.
+    [[nodiscard]] uint32_t rays_word() const { return plan_.scan_chunks() + 1; }
 
     void dispatch(Kernel k, uint32_t nx, uint32_t ny, const Args& a) {
         if (nx == 0 || ny == 0) return;
@@ -274,6 +341,9 @@ private:
     std::vector<float> host_points_, host_normals_;  // staging for strided clouds
     std::vector<std::uint32_t> host_depth_;          // a depth frame's samples, packed
     std::vector<float> host_rays_;                   // its ku then kv
+    std::vector<float> rays_on_device_;              // the ku and kv the sums buffer holds (empty: unknown)
+    bool rays_pending_ = false;                      // the frame being queued uploads new ones
+    bool device_frame_ = false;                      // the frame reads and writes the caller's buffers
     uint32_t depth_format_ = PYR_DEPTH_U16;
     float depth_scale_ = 0;
     std::vector<uint32_t> host_mask_;
@@ -310,7 +380,8 @@ BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     s[size_t(Buffer::mask)] = limits.mask_texel_bytes * texels;
     s[size_t(Buffer::labels)] = 4 * texels;
     s[size_t(Buffer::lut)] = 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
-    s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1);               // K last
+    // The scan's chunk sums, K, then the depth frames' ray slopes (W + H floats).
+    s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1 + size_t(plan.width) + size_t(plan.height));
     // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
     const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
     s[size_t(Buffer::fill)] = size_t(8) * fill_level.width * fill_level.height;
@@ -346,6 +417,29 @@ void check_fits(const core::Plan& plan, const BufferSizes& sizes, const DeviceLi
 
 std::unique_ptr<core::PassExecutor> make_gpu_executor(const core::Plan& plan, std::unique_ptr<Device> device) {
     return std::make_unique<GpuExecutor>(plan, std::move(device));
+}
+
+namespace {
+[[noreturn]] void no_device_buffers(const Device& device) {
+    throw Error(ErrorCode::invalid_argument, device.description() +
+                                                 " was not made on a caller's context: it takes no device buffers "
+                                                 "(make the Segmenter with pyrseg/opencl.hpp, vulkan.hpp or cuda.hpp)");
+}
+}  // namespace
+
+void Device::copy_in(Buffer /*dst*/, size_t /*offset*/, const core::ExternalBuffer& /*src*/, size_t /*pitch*/,
+                     size_t /*row_bytes*/, size_t /*rows*/) {
+    no_device_buffers(*this);
+}
+void Device::copy_out(const core::ExternalBuffer& /*dst*/, size_t /*pitch*/, Buffer /*src*/, size_t /*offset*/,
+                      size_t /*row_bytes*/, size_t /*rows*/) {
+    no_device_buffers(*this);
+}
+void Device::upload_inline(Buffer /*b*/, size_t /*offset*/, const void* /*src*/, size_t /*bytes*/) {
+    no_device_buffers(*this);
+}
+void Device::submit() {
+    no_device_buffers(*this);
 }
 
 }  // namespace pyrseg::gpu

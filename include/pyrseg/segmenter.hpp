@@ -13,6 +13,10 @@
 
 namespace pyrseg {
 
+namespace core {
+struct SegmenterAccess;  // the library's own access to a Segmenter's insides (core/segmenter_impl.hpp)
+}
+
 struct PassTiming {
     // "depth" (a DepthView's back-projection), "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill",
     // "edges", "compact", "stats", then "upload" (the frame to the backend) and "download" (the results back).
@@ -26,6 +30,10 @@ public:
     // Throws pyrseg::Error for invalid parameters, sizes that do not fit, or an unavailable backend.
     Segmenter(int width, int height, const Params& params = {}, std::string_view backend = {},
               const Outputs& outputs = {});
+    // A Segmenter on the caller's own GPU context: made by the interop functions (pyrseg/opencl.hpp,
+    // pyrseg/vulkan.hpp, pyrseg/cuda.hpp), not directly.
+    struct Impl;
+    explicit Segmenter(std::unique_ptr<Impl> impl);
     ~Segmenter();
     Segmenter(Segmenter&&) noexcept;
     Segmenter& operator=(Segmenter&&) noexcept;
@@ -57,9 +65,8 @@ public:
     [[nodiscard]] std::uint32_t last_dispatches() const;
     [[nodiscard]] std::uint32_t last_host_syncs() const;
 
-    struct Impl;
-
 private:
+    friend struct core::SegmenterAccess;
     std::unique_ptr<Impl> impl_;
 };
 

@@ -125,6 +125,37 @@ TEST_P(DepthImages, MatchTheReference) {
     }
 }
 
+TEST_P(DepthImages, IntrinsicsThatChangeBetweenFramesAreUsed) {
+    // GPU backends keep the ray slopes on the device and send them only when they change: frames alternating two
+    // calibrations (and the frame size's both tables), with a refused frame between, each match the reference.
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    synthetic::SceneOptions o;
+    o.width = 67;
+    o.height = 45;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const DepthImage a = make_depth(scene, DepthFormat::u16, 0, 0.001);
+    DepthView b = a.view;
+    b.fx *= 1.25;
+    b.cy += 3.5;
+    Segmenter segmenter(o.width, o.height, {}, GetParam(), everything());
+    const auto check = [&](const DepthView& v, const char* what) {
+        SCOPED_TRACE(what);
+        const pyrseg_ref::Output ref = pyrseg_ref::segment_depth(to_reference(v), o.width, o.height, pyrseg::test::to_reference(Params{}));
+        ASSERT_TRUE(ref.ok) << ref.error;
+        const Result r = segmenter.segment(v);
+        EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, o.width, 3));  // the points' x and y show here
+        EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, o.width));
+    };
+    check(a.view, "calibration A");
+    check(b, "calibration B");
+    check(a.view, "A again");
+    DepthView refused = b;
+    refused.fy = -1;
+    EXPECT_THROW((void)segmenter.segment(refused), Error);
+    check(b, "B after a refused frame");
+    check(b, "B twice");
+}
+
 TEST_P(DepthImages, BadViewsAreErrorsNamingTheProblem) {
     PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
     std::vector<std::uint16_t> samples(32 * 24, 1000);
