@@ -61,7 +61,8 @@ void check_device_cloud(const DeviceCloud& cloud, int width, int height) {
     const std::size_t row = 12 * std::size_t(width);
     const std::size_t pitch = cloud.row_step_bytes == 0 ? row : cloud.row_step_bytes;
     check_rows("points", cloud.points, pitch, row, std::size_t(height), 4, width, height);
-    if (cloud.normals.handle != 0) check_rows("normals", cloud.normals, pitch, row, std::size_t(height), 4, width, height);
+    if (cloud.normals.handle != 0)
+        check_rows("normals", cloud.normals, pitch, row, std::size_t(height), 4, width, height);
 }
 
 void check_device_depth(const DeviceDepth& depth, int width, int height) {
@@ -99,15 +100,20 @@ PassExecutor& executor_of(Segmenter& segmenter) {
     return *impl_of(segmenter).executor;
 }
 
-void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels) {
+void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels,
+                      const std::function<void()>& checked) {
     Segmenter::Impl& impl = impl_of(segmenter);
     check_device_cloud(cloud, impl.plan.width, impl.plan.height);
     check_device_labels(labels, impl.plan.width, impl.plan.height);
-    const InputKind input = cloud.normals.handle != 0 ? InputKind::cloud_with_normals : InputKind::cloud_without_normals;
-    run(impl, input, [&] { impl.executor->bind_device_cloud(cloud); }, labels);
+    const InputKind input =
+        cloud.normals.handle != 0 ? InputKind::cloud_with_normals : InputKind::cloud_without_normals;
+    if (checked) checked();
+    run(
+        impl, input, [&] { impl.executor->bind_device_cloud(cloud); }, labels);
 }
 
-void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels) {
+void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels,
+                      const std::function<void()>& checked) {
     Segmenter::Impl& impl = impl_of(segmenter);
     if (depth.view.width != impl.plan.width || depth.view.height != impl.plan.height) {
         throw Error(ErrorCode::size_mismatch, "the depth image is " + frame_name(depth.view.width, depth.view.height) +
@@ -117,7 +123,9 @@ void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const Devi
     make_depth_tables(depth.view, impl.plan.params.unit_mm, impl.depth_tables, true);
     check_device_depth(depth, impl.plan.width, impl.plan.height);
     check_device_labels(labels, impl.plan.width, impl.plan.height);
-    run(impl, InputKind::depth, [&] { impl.executor->bind_device_depth(depth, impl.depth_tables); }, labels);
+    if (checked) checked();
+    run(
+        impl, InputKind::depth, [&] { impl.executor->bind_device_depth(depth, impl.depth_tables); }, labels);
 }
 
 void PassExecutor::bind_device_cloud(const DeviceCloud& /*cloud*/) {

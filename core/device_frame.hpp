@@ -67,10 +67,13 @@ void check_device_labels(const DeviceLabels& labels, int width, int height);
 // The Segmenter's executor, for a backend's interop functions to reach their device.
 [[nodiscard]] PassExecutor& executor_of(Segmenter& segmenter);
 
-// One device-resident frame: the checks, the input bound, every pass, the labels (and K) written to the caller's
+// One device-resident frame: the checks, then `checked` (where an API queues what the frame waits for: nothing is
+// queued before every check passed), the input bound, every pass, the labels (and K) written to the caller's
 // buffers; then the executor submits without waiting. The results of Outputs other than the labels and K are not
 // produced (they are host results); Segmenter::last_timings() is empty after such a frame.
-void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels);
-void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels);
+void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels,
+                      const std::function<void()>& checked = {});
+void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels,
+                      const std::function<void()>& checked = {});
 
 }  // namespace pyrseg::core

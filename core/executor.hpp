@@ -8,6 +8,10 @@
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
 
+namespace pyrseg::gpu {
+class Device;
+}
+
 namespace pyrseg::core {
 
 struct Plan;
@@ -54,6 +58,8 @@ public:
     virtual void bind_device_cloud(const DeviceCloud& cloud);
     virtual void bind_device_depth(const DeviceDepth& depth, const DepthTables& tables);
     virtual void write_device_labels(const DeviceLabels& labels);
+    // The GPU device the executor runs on (for the interop functions); nullptr on the CPU.
+    [[nodiscard]] virtual gpu::Device* gpu_device() { return nullptr; }
 
     // Called before each pass the pipeline times, with the pass's name ("normals", ..., "compact").
     virtual void begin_pass(const char* /*pass*/) {}

@@ -3,6 +3,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "core/device_choice.hpp"
 #include "pyrseg/error.hpp"
@@ -167,6 +168,33 @@ Runtime::~Runtime() {
     if (context != nullptr) clReleaseContext(context);
 }
 
+namespace {
+
+// The program for `device` in rt.context; a failed build throws with the device's build log.
+void build_program(Runtime& rt) {
+    const char* source = kOpenclKernelSource;
+    cl_int err = CL_SUCCESS;
+    rt.program = clCreateProgramWithSource(rt.context, 1, &source, nullptr, &err);
+    check(err, "clCreateProgramWithSource");
+    // No fast-math options: the kernels' float operations must be IEEE (contraction is off in the source).
+    err = clBuildProgram(rt.program, 1, &rt.device, "-cl-std=CL1.2", nullptr, nullptr);
+    if (err != CL_SUCCESS) {
+        size_t size = 0;
+        clGetProgramBuildInfo(rt.program, rt.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+        std::string log(size, '\0');
+        clGetProgramBuildInfo(rt.program, rt.device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+        throw Error(ErrorCode::internal, "OpenCL: building the pyrseg kernels for " + rt.description + " failed (" +
+                                             error_name(err) + "); build log:\n" + log);
+    }
+}
+
+void read_limits(Runtime& rt) {
+    clGetDeviceInfo(rt.device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(rt.max_alloc), &rt.max_alloc, nullptr);
+    clGetDeviceInfo(rt.device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(rt.global_mem), &rt.global_mem, nullptr);
+}
+
+}  // namespace
+
 std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device) {
     static std::mutex mutex;
     static std::map<cl_device_id, std::shared_ptr<const Runtime>> cache;
@@ -176,27 +204,39 @@ std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device) {
     auto rt = std::make_shared<Runtime>();
     rt->device = device.device;
     rt->description = device.description;
-    clGetDeviceInfo(device.device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(rt->max_alloc), &rt->max_alloc, nullptr);
-    clGetDeviceInfo(device.device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(rt->global_mem), &rt->global_mem, nullptr);
+    read_limits(*rt);
     const cl_context_properties properties[] = {CL_CONTEXT_PLATFORM,
                                                 reinterpret_cast<cl_context_properties>(device.platform), 0};
     cl_int err = CL_SUCCESS;
     rt->context = clCreateContext(properties, 1, &device.device, nullptr, nullptr, &err);
     check(err, "clCreateContext");
-    const char* source = kOpenclKernelSource;
-    rt->program = clCreateProgramWithSource(rt->context, 1, &source, nullptr, &err);
-    check(err, "clCreateProgramWithSource");
-    // No fast-math options: the kernels' float operations must be IEEE (contraction is off in the source).
-    err = clBuildProgram(rt->program, 1, &device.device, "-cl-std=CL1.2", nullptr, nullptr);
-    if (err != CL_SUCCESS) {
-        size_t size = 0;
-        clGetProgramBuildInfo(rt->program, device.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
-        std::string log(size, '\0');
-        clGetProgramBuildInfo(rt->program, device.device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
-        throw Error(ErrorCode::internal, "OpenCL: building the pyrseg kernels for " + device.description + " failed (" +
-                                             error_name(err) + "); build log:\n" + log);
-    }
+    build_program(*rt);
     cache.emplace(device.device, rt);
+    return rt;
+}
+
+std::shared_ptr<const Runtime> runtime_for(cl_context context, cl_device_id device) {
+    // Shared while a Segmenter uses it, and released with the last one: the caller's context is retained only
+    // that long.
+    static std::mutex mutex;
+    static std::map<std::pair<cl_context, cl_device_id>, std::weak_ptr<const Runtime>> cache;
+    const std::lock_guard lock(mutex);
+    const auto key = std::make_pair(context, device);
+    if (auto it = cache.find(key); it != cache.end()) {
+        if (auto rt = it->second.lock()) return rt;
+    }
+    auto rt = std::make_shared<Runtime>();
+    check(clRetainContext(context), "clRetainContext");
+    rt->context = context;
+    rt->device = device;
+    cl_platform_id platform = nullptr;
+    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof(platform), &platform, nullptr);
+    rt->description = "the caller's context: " + platform_name(platform) + ": " +
+                      device_string(device, CL_DEVICE_NAME) + " (" + device_string(device, CL_DEVICE_VERSION) + ", " +
+                      type_name(device) + ")";
+    read_limits(*rt);
+    build_program(*rt);
+    cache[key] = rt;
     return rt;
 }
 

@@ -38,6 +38,9 @@ struct Runtime {
 // The shared runtime of a device, created and compiled on first use. A failed build throws pyrseg::Error with the
 // device's build log.
 [[nodiscard]] std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device);
+// The runtime on a caller's context and device (pyrseg/opencl.hpp), shared by the Segmenters on it while any lives;
+// the context is retained as long.
+[[nodiscard]] std::shared_ptr<const Runtime> runtime_for(cl_context context, cl_device_id device);
 
 [[nodiscard]] const char* error_name(cl_int code);
 [[noreturn]] void fail(cl_int code, const char* what);

@@ -113,7 +113,8 @@ public:
         const size_t row = 4 * size_t(width());
         const size_t pitch = labels.row_step_bytes == 0 ? row : labels.row_step_bytes;
         device_->copy_out(labels.labels, pitch, Buffer::out, 0, row, height());
-        if (labels.count.handle != 0) device_->copy_out(labels.count, 4, Buffer::sums, 4 * size_t(plan_.scan_chunks()), 4, 1);
+        if (labels.count.handle != 0)
+            device_->copy_out(labels.count, 4, Buffer::sums, 4 * size_t(plan_.scan_chunks()), 4, 1);
         device_->submit();
         frame_done();
     }
@@ -263,6 +264,7 @@ public:
     }
 
     bool device_timings(std::vector<PassTiming>& timings) override { return device_->pass_times(timings); }
+    [[nodiscard]] Device* gpu_device() override { return device_.get(); }
     [[nodiscard]] uint32_t dispatches() const override { return dispatches_; }
     [[nodiscard]] uint32_t host_syncs() const override { return host_syncs_; }
 

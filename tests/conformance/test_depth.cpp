@@ -140,7 +140,8 @@ TEST_P(DepthImages, IntrinsicsThatChangeBetweenFramesAreUsed) {
     Segmenter segmenter(o.width, o.height, {}, GetParam(), everything());
     const auto check = [&](const DepthView& v, const char* what) {
         SCOPED_TRACE(what);
-        const pyrseg_ref::Output ref = pyrseg_ref::segment_depth(to_reference(v), o.width, o.height, pyrseg::test::to_reference(Params{}));
+        const pyrseg_ref::Output ref =
+            pyrseg_ref::segment_depth(to_reference(v), o.width, o.height, pyrseg::test::to_reference(Params{}));
         ASSERT_TRUE(ref.ok) << ref.error;
         const Result r = segmenter.segment(v);
         EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, o.width, 3));  // the points' x and y show here
