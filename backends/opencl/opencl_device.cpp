@@ -142,8 +142,7 @@ void OpenclDevice::finish() {
 bool OpenclDevice::pass_times(std::vector<PassTiming>& timings) {
     if (marks_.size() < 2) return false;
     for (Mark& m : marks_) {
-        if (clGetEventProfilingInfo(m.event, CL_PROFILING_COMMAND_END, sizeof(cl_ulong), &m.end, nullptr) !=
-            CL_SUCCESS)
+        if (clGetEventProfilingInfo(m.event, CL_PROFILING_COMMAND_END, sizeof(cl_ulong), &m.end, nullptr) != CL_SUCCESS)
             return false;
     }
     for (PassTiming& t : timings) t.milliseconds = 0.0;

@@ -26,7 +26,8 @@ template <class T>
 T queue_info(cl_command_queue queue, cl_command_queue_info what, const char* name) {
     T value{};
     const cl_int err = clGetCommandQueueInfo(queue, what, sizeof(value), &value, nullptr);
-    if (err != CL_SUCCESS) bad(std::string("the queue is not a valid command queue (") + name + ": " + error_name(err) + ")");
+    if (err != CL_SUCCESS)
+        bad(std::string("the queue is not a valid command queue (") + name + ": " + error_name(err) + ")");
     return value;
 }
 
@@ -100,12 +101,13 @@ core::DeviceLabels labels_of(const OpenclDevice& device, const LabelBuffers& out
 Segmenter make_segmenter(int width, int height, const Queue& queue, const Params& params, const Outputs& outputs) {
     check_queue(queue);
     return core::make_segmenter(width, height, params, outputs, "opencl", [&](const core::Plan& plan) {
-        return gpu::make_gpu_executor(plan,
-                                      std::make_unique<OpenclDevice>(runtime_for(queue.context, queue.device), queue.queue));
+        return gpu::make_gpu_executor(
+            plan, std::make_unique<OpenclDevice>(runtime_for(queue.context, queue.device), queue.queue));
     });
 }
 
-cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out, std::span<const cl_event> wait) {
+cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
+                 std::span<const cl_event> wait) {
     OpenclDevice& device = device_of(segmenter);
     core::DeviceCloud c;
     c.points = external(device, cloud.points, cloud.points_offset, "points");
@@ -117,7 +119,8 @@ cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuf
     return device.take_done_event();
 }
 
-cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out, std::span<const cl_event> wait) {
+cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,
+                 std::span<const cl_event> wait) {
     OpenclDevice& device = device_of(segmenter);
     core::DeviceDepth d;
     d.samples = external(device, depth.samples, depth.offset, "depth samples");

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <map>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "backends/vulkan/vulkan_modules.hpp"
 #include "core/device_choice.hpp"
@@ -168,7 +170,8 @@ int compute_family(VkPhysicalDevice physical) {
     return -1;
 }
 
-// What pyrseg needs of a device that not every Vulkan device has; empty when it has all of it.
+}  // namespace
+
 std::string missing_features(VkPhysicalDevice physical, const VkPhysicalDeviceProperties& p) {
     std::string missing;
     const auto need = [&](bool ok, const std::string& what) {
@@ -185,8 +188,6 @@ std::string missing_features(VkPhysicalDevice physical, const VkPhysicalDevicePr
          std::to_string(kBindingCount) + " storage buffers per stage");
     return missing;
 }
-
-}  // namespace
 
 const char* result_name(VkResult result) {
     switch (result) {
@@ -306,15 +307,17 @@ DeviceRef choose_device() {
     return *best;
 }
 
+// The caller's device is left as it is: its Segmenters waited for their own submissions, and the caller's
+// command buffers that used the pipelines must have completed before (pyrseg/vulkan.hpp).
 Runtime::~Runtime() {
     if (device == VK_NULL_HANDLE) return;
-    vkDeviceWaitIdle(device);
+    if (owns_device) vkDeviceWaitIdle(device);
     for (VkPipeline p : pipelines) {
         if (p != VK_NULL_HANDLE) vkDestroyPipeline(device, p, nullptr);
     }
     if (pipeline_layout != VK_NULL_HANDLE) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
     if (set_layout != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
-    vkDestroyDevice(device, nullptr);
+    if (owns_device) vkDestroyDevice(device, nullptr);
 }
 
 namespace {
@@ -367,6 +370,26 @@ void create_pipelines(Runtime& rt) {
     }
 }
 
+// The physical device's properties and limits, and whether `family` writes timestamps.
+void read_properties(Runtime& rt, VkPhysicalDevice physical, std::uint32_t family) {
+    rt.physical = physical;
+    rt.queue_family = family;
+    vkGetPhysicalDeviceProperties(physical, &rt.properties);
+    vkGetPhysicalDeviceMemoryProperties(physical, &rt.memory);
+    auto maintenance3 =
+        make_info<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
+    auto properties2 = make_info<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    properties2.pNext = &maintenance3;
+    vkGetPhysicalDeviceProperties2(physical, &properties2);
+    rt.max_allocation = maintenance3.maxMemoryAllocationSize;
+    std::uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &family_count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(family_count);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &family_count, families.data());
+    rt.timestamps =
+        family < family_count && families[family].timestampValidBits > 0 && rt.properties.limits.timestampPeriod > 0;
+}
+
 }  // namespace
 
 std::shared_ptr<Runtime> runtime_for(const DeviceRef& device) {
@@ -376,22 +399,8 @@ std::shared_ptr<Runtime> runtime_for(const DeviceRef& device) {
     if (auto it = cache.find(device.physical); it != cache.end()) return it->second;
 
     auto rt = std::make_shared<Runtime>();
-    rt->physical = device.physical;
     rt->description = device.description;
-    vkGetPhysicalDeviceProperties(device.physical, &rt->properties);
-    vkGetPhysicalDeviceMemoryProperties(device.physical, &rt->memory);
-    auto maintenance3 =
-        make_info<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
-    auto properties2 = make_info<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
-    properties2.pNext = &maintenance3;
-    vkGetPhysicalDeviceProperties2(device.physical, &properties2);
-    rt->max_allocation = maintenance3.maxMemoryAllocationSize;
-    rt->queue_family = std::uint32_t(compute_family(device.physical));
-    std::uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(device.physical, &family_count, nullptr);
-    std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(device.physical, &family_count, families.data());
-    rt->timestamps = families[rt->queue_family].timestampValidBits > 0 && rt->properties.limits.timestampPeriod > 0;
+    read_properties(*rt, device.physical, std::uint32_t(compute_family(device.physical)));
 
     const float priority = 1.0f;
     auto queue_info = make_info<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
@@ -406,6 +415,30 @@ std::shared_ptr<Runtime> runtime_for(const DeviceRef& device) {
     create_pipelines(*rt);
     throw_on_validation_messages("the creation of the Vulkan device and pipelines");
     cache.emplace(device.physical, rt);
+    return rt;
+}
+
+std::shared_ptr<Runtime> runtime_for(const Device& device) {
+    // Shared while a Segmenter uses it, and destroyed with the last one: a later device of the caller's with the
+    // same handle value gets a runtime of its own.
+    static std::mutex mutex;
+    static std::map<std::tuple<VkDevice, std::uint32_t, VkQueue>, std::weak_ptr<Runtime>> cache;
+    const std::lock_guard lock(mutex);
+    const auto key = std::make_tuple(device.device, device.queue_family, device.queue);
+    if (auto it = cache.find(key); it != cache.end()) {
+        if (auto rt = it->second.lock()) return rt;
+    }
+    auto rt = std::make_shared<Runtime>();
+    rt->owns_device = false;
+    read_properties(*rt, device.physical, device.queue_family);
+    rt->device = device.device;
+    rt->queue = device.queue;
+    rt->description = std::string("the caller's Vulkan device: ") + rt->properties.deviceName + " (" +
+                      type_name(rt->properties.deviceType) + ", Vulkan " + version_text(rt->properties.apiVersion) +
+                      ")";
+    create_pipelines(*rt);
+    std::erase_if(cache, [](const auto& entry) { return entry.second.expired(); });
+    cache[key] = rt;
     return rt;
 }
 

@@ -2,6 +2,8 @@
 // The Vulkan instance, physical devices and the device choice, and per device the logical device, queue,
 // descriptor set layout, pipeline layout and one compute pipeline per entry point, shared by every Segmenter of the
 // process. With PYRSEG_VULKAN_VALIDATION=1 the Khronos validation layer is on and its messages are collected.
+// A runtime may also sit on the caller's device and queue (pyrseg/vulkan.hpp): the same layouts and pipelines,
+// on a device pyrseg does not own.
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "core/gpu/device.hpp"
+#include "pyrseg/vulkan.hpp"
 
 namespace pyrseg::vulkan {
 
@@ -34,6 +37,10 @@ struct DeviceRef {
 // Every physical device; when none is usable, *why_none says why. Never throws.
 [[nodiscard]] std::vector<DeviceRef> enumerate_devices(std::string* why_none);
 
+// What pyrseg needs of a device that not every Vulkan device has ("Vulkan 1.1; a compute queue"); empty when it
+// has all of it.
+[[nodiscard]] std::string missing_features(VkPhysicalDevice physical, const VkPhysicalDeviceProperties& properties);
+
 // $PYRSEG_VULKAN_DEVICE (an index, or text found in the description), else the most preferred usable device.
 // Throws pyrseg::Error(backend_unavailable) naming the reason.
 [[nodiscard]] DeviceRef choose_device();
@@ -48,6 +55,7 @@ struct Runtime {
     VkPhysicalDeviceMemoryProperties memory{};
     VkDeviceSize max_allocation = 0;  // maxMemoryAllocationSize (Vulkan 1.1)
     bool timestamps = false;          // the queue family writes timestamps
+    bool owns_device = true;          // false: the caller's device, which pyrseg never destroys
     std::string description;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
@@ -61,6 +69,9 @@ struct Runtime {
 
 // The shared runtime of a device, created on first use.
 [[nodiscard]] std::shared_ptr<Runtime> runtime_for(const DeviceRef& device);
+// The runtime on the caller's device and queue (checked by the caller of this function), shared by the Segmenters
+// on them while any lives; its destruction destroys the pipelines and layouts, never the device.
+[[nodiscard]] std::shared_ptr<Runtime> runtime_for(const Device& device);
 
 // With PYRSEG_VULKAN_VALIDATION=1: throws pyrseg::Error quoting the validation messages reported since the last
 // call (each is also printed to stderr as it arrives). Without validation it does nothing.

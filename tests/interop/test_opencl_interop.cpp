@@ -109,7 +109,8 @@ struct Scene {
 
 TEST_F(OpenclApp, CloudFramesMatchTheHostPath) {
     const Scene scenes[] = {
-        {"paper metric, estimated normals, packed", 131, 97, synthetic::Sensor::structured_light, false, Params{}, 0, 0},
+        {"paper metric, estimated normals, packed", 131, 97, synthetic::Sensor::structured_light, false, Params{}, 0,
+         0},
         {"given normals, padded rows", 67, 45, synthetic::Sensor::structured_light, true, Params{}, 20, 12},
         {"kinect-v1 preset (robust metric), padded", 101, 77, synthetic::Sensor::kinect_v1, false,
          sensor_preset(SensorKind::kinect_v1), 4, 4},
@@ -139,8 +140,9 @@ TEST_F(OpenclApp, CloudFramesMatchTheHostPath) {
         EXPECT_EQ(segmenter.backend_name(), "opencl");
         opencl::CloudBuffers in;
         in.points = buffer(points.size() + 16, nullptr);
-        ASSERT_EQ(clEnqueueWriteBuffer(queue_, in.points, CL_TRUE, 16, points.size(), points.data(), 0, nullptr, nullptr),
-                  CL_SUCCESS);
+        ASSERT_EQ(
+            clEnqueueWriteBuffer(queue_, in.points, CL_TRUE, 16, points.size(), points.data(), 0, nullptr, nullptr),
+            CL_SUCCESS);
         in.points_offset = 16;  // data need not start at the buffer's start
         if (s.normals) in.normals = buffer(normals.size(), normals.data());
         in.row_step_bytes = s.cloud_pad == 0 ? 0 : cloud_pitch;
@@ -168,7 +170,8 @@ TEST_F(OpenclApp, CloudFramesMatchTheHostPath) {
 
         for (cl_mem labels : {out.labels, out2.labels}) {
             const auto bytes = read<unsigned char>(labels, labels_pitch * std::size_t(s.height));
-            EXPECT_TRUE(same_bytes("labels", unpitch(bytes, s.width, s.height, labels_pitch), expected.labels, s.width));
+            EXPECT_TRUE(
+                same_bytes("labels", unpitch(bytes, s.width, s.height, labels_pitch), expected.labels, s.width));
         }
         EXPECT_EQ(read<std::uint32_t>(out.count, 1, 8)[0], expected.segment_count);
         // The same Segmenter's host path, on the caller's queue.
@@ -214,7 +217,7 @@ TEST_F(OpenclApp, DepthFramesMatchTheHostPath) {
         SCOPED_TRACE(c.what);
         const std::size_t pitch = c.sample * std::size_t(w) + c.pad;
         const auto bytes = pitched(c.samples, w, h, c.sample, pitch);
-        DepthView view{bytes.data(), c.format, w, h, pitch, c.metres_per_unit, scene.fx * c.fx_scale, scene.fy,
+        DepthView view{bytes.data(),   c.format,      w, h, pitch, c.metres_per_unit, scene.fx * c.fx_scale, scene.fy,
                        scene.cx + 0.3, scene.cy - 0.2};
         const Result expected = cpu.segment(view);
         ASSERT_GT(expected.segment_count, 1u);
