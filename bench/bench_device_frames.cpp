@@ -7,8 +7,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/bench_scenes.hpp"
@@ -16,6 +18,9 @@
 
 #ifdef PYRSEG_BENCH_OPENCL
 #include "pyrseg/opencl.hpp"
+#endif
+#ifdef PYRSEG_BENCH_VULKAN
+#include "pyrseg/vulkan.hpp"
 #endif
 
 namespace pyrseg::bench {
@@ -117,6 +122,161 @@ void opencl_frames(benchmark::State& state, int width, int height, bool depth) {
 }
 #endif
 
+#ifdef PYRSEG_BENCH_VULKAN
+// The application's Vulkan objects: the first device with a compute queue, device-local buffers (filled once
+// through a host-visible staging buffer, as an application's own upload would).
+struct VulkanApp {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkPhysicalDevice physical = VK_NULL_HANDLE;
+    std::uint32_t family = 0;
+    VkDevice device = VK_NULL_HANDLE;
+    VkQueue queue = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    std::vector<std::pair<VkBuffer, VkDeviceMemory>> buffers;
+
+    VulkanApp() {
+        VkApplicationInfo app{};
+        app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+        app.apiVersion = VK_API_VERSION_1_1;
+        VkInstanceCreateInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+        info.pApplicationInfo = &app;
+        if (vkCreateInstance(&info, nullptr, &instance) != VK_SUCCESS) return;
+        std::uint32_t count = 0;
+        vkEnumeratePhysicalDevices(instance, &count, nullptr);
+        std::vector<VkPhysicalDevice> physicals(count);
+        if (count > 0) vkEnumeratePhysicalDevices(instance, &count, physicals.data());
+        for (VkPhysicalDevice p : physicals) {
+            std::uint32_t n = 0;
+            vkGetPhysicalDeviceQueueFamilyProperties(p, &n, nullptr);
+            std::vector<VkQueueFamilyProperties> families(n);
+            vkGetPhysicalDeviceQueueFamilyProperties(p, &n, families.data());
+            for (std::uint32_t f = 0; f < n && physical == VK_NULL_HANDLE; ++f) {
+                if ((families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0) {
+                    physical = p;
+                    family = f;
+                }
+            }
+        }
+        if (physical == VK_NULL_HANDLE) return;
+        const float priority = 1.0f;
+        VkDeviceQueueCreateInfo queue_info{};
+        queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+        queue_info.queueFamilyIndex = family;
+        queue_info.queueCount = 1;
+        queue_info.pQueuePriorities = &priority;
+        VkDeviceCreateInfo device_info{};
+        device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+        device_info.queueCreateInfoCount = 1;
+        device_info.pQueueCreateInfos = &queue_info;
+        if (vkCreateDevice(physical, &device_info, nullptr, &device) != VK_SUCCESS) return;
+        vkGetDeviceQueue(device, family, 0, &queue);
+        VkFenceCreateInfo fence_info{};
+        fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+        vkCreateFence(device, &fence_info, nullptr, &fence);
+    }
+    ~VulkanApp() {
+        for (const auto& [b, m] : buffers) {
+            vkDestroyBuffer(device, b, nullptr);
+            vkFreeMemory(device, m, nullptr);
+        }
+        if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
+        if (device != VK_NULL_HANDLE) vkDestroyDevice(device, nullptr);
+        if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+    }
+    VulkanApp(const VulkanApp&) = delete;
+    VulkanApp& operator=(const VulkanApp&) = delete;
+
+    // A buffer with the transfer usages, in memory with `flags` (host-visible ones are filled from `data`).
+    VkBuffer buffer(VkDeviceSize bytes, VkMemoryPropertyFlags flags, const void* data = nullptr) {
+        VkBufferCreateInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+        info.size = bytes;
+        info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        VkBuffer b = VK_NULL_HANDLE;
+        if (vkCreateBuffer(device, &info, nullptr, &b) != VK_SUCCESS) return VK_NULL_HANDLE;
+        VkMemoryRequirements req{};
+        vkGetBufferMemoryRequirements(device, b, &req);
+        VkPhysicalDeviceMemoryProperties types{};
+        vkGetPhysicalDeviceMemoryProperties(physical, &types);
+        VkMemoryAllocateInfo alloc{};
+        alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+        alloc.allocationSize = req.size;
+        alloc.memoryTypeIndex = types.memoryTypeCount;
+        for (std::uint32_t t = 0; t < types.memoryTypeCount && alloc.memoryTypeIndex == types.memoryTypeCount; ++t) {
+            if ((req.memoryTypeBits & (1u << t)) != 0 && (types.memoryTypes[t].propertyFlags & flags) == flags)
+                alloc.memoryTypeIndex = t;
+        }
+        VkDeviceMemory m = VK_NULL_HANDLE;
+        if (alloc.memoryTypeIndex == types.memoryTypeCount ||
+            vkAllocateMemory(device, &alloc, nullptr, &m) != VK_SUCCESS) {
+            vkDestroyBuffer(device, b, nullptr);
+            return VK_NULL_HANDLE;
+        }
+        vkBindBufferMemory(device, b, m, 0);
+        if (data != nullptr) {
+            void* mapped = nullptr;
+            vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &mapped);
+            std::memcpy(mapped, data, bytes);
+            vkUnmapMemory(device, m);
+        }
+        buffers.emplace_back(b, m);
+        return b;
+    }
+};
+
+VulkanApp& vulkan_app() {
+    static VulkanApp app;
+    return app;
+}
+
+void vulkan_frames(benchmark::State& state, int width, int height, bool depth) {
+    VulkanApp& app = vulkan_app();
+    if (app.fence == VK_NULL_HANDLE) {
+        state.SkipWithError("no Vulkan device");
+        return;
+    }
+    const synthetic::Scene& s = scene(width, height);
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
+    const std::vector<std::uint16_t> samples = depth ? depth_samples(s) : std::vector<std::uint16_t>();
+    const VkDeviceSize input_bytes = depth ? 2 * pixels : 12 * pixels;
+    // Host-visible input (written once); device-local labels, as an application keeps them for its next pass.
+    constexpr VkMemoryPropertyFlags kHost = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const VkBuffer input =
+        app.buffer(input_bytes, kHost, depth ? static_cast<const void*>(samples.data()) : s.points.data());
+    const VkBuffer labels = app.buffer(4 * pixels, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    const VkBuffer count = app.buffer(4, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (input == VK_NULL_HANDLE || labels == VK_NULL_HANDLE || count == VK_NULL_HANDLE) {
+        state.SkipWithError("could not allocate the buffers");
+        return;
+    }
+    Segmenter segmenter =
+        vulkan::make_segmenter(width, height, {app.instance, app.physical, app.device, app.family, app.queue});
+    vulkan::LabelBuffers out;
+    out.labels = labels;
+    out.labels_bytes = 4 * pixels;
+    out.count = count;
+    out.count_bytes = 4;
+    vulkan::CloudBuffers cloud;
+    cloud.points = input;
+    cloud.points_bytes = input_bytes;
+    vulkan::DepthBuffer image;
+    image.samples = input;
+    image.bytes = input_bytes;
+    image.view = DepthView{nullptr, DepthFormat::u16, width, height, 0, 0.001, s.fx, s.fy, s.cx, s.cy};
+    time_device_frames(state, width, height, [&] {
+        if (depth) {
+            vulkan::submit(segmenter, image, out, {}, {}, {}, app.fence);
+        } else {
+            vulkan::submit(segmenter, cloud, out, {}, {}, {}, app.fence);
+        }
+        vkWaitForFences(app.device, 1, &app.fence, VK_TRUE, UINT64_MAX);
+        vkResetFences(app.device, 1, &app.fence);
+    });
+    state.counters["dispatches"] = segmenter.last_dispatches();
+}
+#endif
+
 int register_all() {
     for (const auto& size : kSizes) {
         const int w = size[0];
@@ -129,6 +289,16 @@ int register_all() {
             ->UseRealTime();
         benchmark::RegisterBenchmark(("pipeline_depth_device/opencl/" + px + "/u16").c_str(),
                                      [=](benchmark::State& st) { opencl_frames(st, w, h, true); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+#endif
+#ifdef PYRSEG_BENCH_VULKAN
+        benchmark::RegisterBenchmark(("pipeline_device/vulkan/" + px + "/estimated_normals").c_str(),
+                                     [=](benchmark::State& st) { vulkan_frames(st, w, h, false); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        benchmark::RegisterBenchmark(("pipeline_depth_device/vulkan/" + px + "/u16").c_str(),
+                                     [=](benchmark::State& st) { vulkan_frames(st, w, h, true); })
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
 #endif
