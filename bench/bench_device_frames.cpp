@@ -22,6 +22,11 @@
 #ifdef PYRSEG_BENCH_VULKAN
 #include "pyrseg/vulkan.hpp"
 #endif
+#ifdef PYRSEG_BENCH_CUDA
+#include <cuda_runtime_api.h>
+
+#include "pyrseg/cuda.hpp"
+#endif
 
 namespace pyrseg::bench {
 namespace {
@@ -277,6 +282,73 @@ void vulkan_frames(benchmark::State& state, int width, int height, bool depth) {
 }
 #endif
 
+#ifdef PYRSEG_BENCH_CUDA
+// The application's stream and device memory; each frame is timed by the wall clock around segment() and a
+// cudaStreamSynchronize (the application's one wait), and by CUDA events around the frame on the stream
+// (device_ms: the frame on the GPU alone).
+void cuda_frames(benchmark::State& state, int width, int height, bool depth) {
+    int devices = 0;
+    if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
+        cudaGetLastError();
+        state.SkipWithError("no CUDA device");
+        return;
+    }
+    const synthetic::Scene& s = scene(width, height);
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
+    const std::vector<std::uint16_t> samples = depth ? depth_samples(s) : std::vector<std::uint16_t>();
+    const std::size_t input_bytes = depth ? 2 * pixels : 12 * pixels;
+    cudaStream_t stream = nullptr;
+    void* input = nullptr;
+    void* labels = nullptr;
+    void* count = nullptr;
+    cudaEvent_t start = nullptr;
+    cudaEvent_t stop = nullptr;
+    if (cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking) != cudaSuccess ||
+        cudaMalloc(&input, input_bytes) != cudaSuccess || cudaMalloc(&labels, 4 * pixels) != cudaSuccess ||
+        cudaMalloc(&count, 4) != cudaSuccess || cudaEventCreate(&start) != cudaSuccess ||
+        cudaEventCreate(&stop) != cudaSuccess ||
+        cudaMemcpy(input, depth ? static_cast<const void*>(samples.data()) : s.points.data(), input_bytes,
+                   cudaMemcpyHostToDevice) != cudaSuccess) {
+        state.SkipWithError("CUDA setup failed");
+    } else {
+        Segmenter segmenter = cuda::make_segmenter(width, height, stream);
+        cuda::LabelPointers out;
+        out.labels = static_cast<std::uint32_t*>(labels);
+        out.labels_bytes = 4 * pixels;
+        out.count = static_cast<std::uint32_t*>(count);
+        cuda::CloudPointers cloud;
+        cloud.points = static_cast<const float*>(input);
+        cloud.points_bytes = input_bytes;
+        cuda::DepthPointers image;
+        image.samples = input;
+        image.bytes = input_bytes;
+        image.view = DepthView{nullptr, DepthFormat::u16, width, height, 0, 0.001, s.fx, s.fy, s.cx, s.cy};
+        double device_ms = 0;
+        time_device_frames(state, width, height, [&] {
+            cudaEventRecord(start, stream);
+            if (depth) {
+                cuda::segment(segmenter, image, out);
+            } else {
+                cuda::segment(segmenter, cloud, out);
+            }
+            cudaEventRecord(stop, stream);
+            cudaStreamSynchronize(stream);
+            float ms = 0;
+            cudaEventElapsedTime(&ms, start, stop);
+            device_ms += double(ms);
+        });
+        state.counters["device_ms"] = benchmark::Counter(device_ms / double(state.iterations() + 1));
+        state.counters["dispatches"] = segmenter.last_dispatches();
+    }
+    if (stop != nullptr) cudaEventDestroy(stop);
+    if (start != nullptr) cudaEventDestroy(start);
+    cudaFree(count);
+    cudaFree(labels);
+    cudaFree(input);
+    if (stream != nullptr) cudaStreamDestroy(stream);
+}
+#endif
+
 int register_all() {
     for (const auto& size : kSizes) {
         const int w = size[0];
@@ -299,6 +371,16 @@ int register_all() {
             ->UseRealTime();
         benchmark::RegisterBenchmark(("pipeline_depth_device/vulkan/" + px + "/u16").c_str(),
                                      [=](benchmark::State& st) { vulkan_frames(st, w, h, true); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+#endif
+#ifdef PYRSEG_BENCH_CUDA
+        benchmark::RegisterBenchmark(("pipeline_device/cuda/" + px + "/estimated_normals").c_str(),
+                                     [=](benchmark::State& st) { cuda_frames(st, w, h, false); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        benchmark::RegisterBenchmark(("pipeline_depth_device/cuda/" + px + "/u16").c_str(),
+                                     [=](benchmark::State& st) { cuda_frames(st, w, h, true); })
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
 #endif

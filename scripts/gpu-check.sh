@@ -3,8 +3,9 @@
 # beforehand, on a machine without a GPU, into a self-contained folder that travels with the checkout:
 #
 #   scripts/gpu-check.sh prepare            here: builds build/gpu/ (binaries, the .so files they need, test data)
-#   scripts/gpu-check.sh run [REPORT_DIR]   there: versions, conformance, compute-sanitizer, bench, CuPy's label,
-#                                           Vulkan and OpenCL on the NVIDIA driver; summary.md and logs in
+#   scripts/gpu-check.sh run [REPORT_DIR]   there: versions, conformance, the CUDA interop (device pointers on an
+#                                           application's stream, graph capture), compute-sanitizer, bench, CuPy's
+#                                           label, Vulkan and OpenCL on the NVIDIA driver; summary.md and logs in
 #                                           REPORT_DIR ($PYRSEG_GPU_REPORT, default build/gpu-report/)
 #   scripts/gpu-check.sh run --rehearse [REPORT_DIR]
 #                                           the same steps with the cpu backend standing in for the GPU ones, to
@@ -19,6 +20,10 @@ bundle_limit_mib=48
 data_files=(table_scene_mug_stereo_textured.pcd milk_cartoon_all_small_clorox.pcd cape_depth_0.png
             cape_calib_params.xml README.md LICENSE-PCL.txt LICENSE-CAPE.txt)
 binaries=(tests/pyrseg_test_conformance tests/pyrseg_test_unit bench/pyrseg_bench tools/pyrseg)
+# Built beside the preset's own targets: the GPU APIs' interop tests (pyrseg/cuda.hpp's among them) and the CUDA
+# application (examples/cuda_app.cpp).
+extra_targets=(pyrseg_test_interop pyrseg_example_cuda_app)
+binaries+=(tests/pyrseg_test_interop examples/pyrseg_example_cuda_app)
 fallback_libs=(libstdc++.so.6 libgcc_s.so.1 libGLX.so.0 libGLdispatch.so.0 libX11.so.6 libxcb.so.1 libXau.so.6
                libXdmcp.so.6 libbsd.so.0 libmd.so.0)
 
@@ -26,7 +31,7 @@ say() { printf 'gpu-check: %s\n' "$*"; }
 die() { printf 'gpu-check: %s\n' "$1" >&2; exit "${2:-1}"; }
 
 usage() {
-  sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
 }
 
 # The newest glibc symbol version any of the given ELF files asks for (e.g. 2.34).
@@ -45,6 +50,7 @@ prepare() {
   fi
   grep -E "^-- pyrseg" <<<"$log" || true
   (cd "$root" && cmake --build --preset gpu-check)
+  (cd "$root" && cmake --build --preset gpu-check --target "${extra_targets[@]}")
 
   rm -rf "$bundle"
   mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/data"
@@ -282,9 +288,105 @@ run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S [VAR=V
     return
   fi
   env "$@" PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
-    --benchmark_filter="^(pipeline|pipeline_robust|pipeline_depth|stage|fills/maze|fills/spiral)/($backends)/($sizes)" --benchmark_min_time="$min_time" \
+    --benchmark_filter="^(pipeline|pipeline_robust|pipeline_depth|pipeline_device|pipeline_depth_device|stage|fills/maze|fills/spiral)/($backends)/($sizes)" --benchmark_min_time="$min_time" \
     --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
   say "bench $name: $((SECONDS - start)) s, exit $rc"
+}
+
+# One test case as Google Test XML, for the summary: run_case_xml FILE NAME STATUS MESSAGE, STATUS passed, failed or
+# skipped.
+run_case_xml() {
+  local file="$1" name="$2" status="$3" message="${4//[<>&\"]/ }" inner=""
+  if [ "$status" = failed ]; then inner="<failure message=\"$message\"/>"; fi
+  if [ "$status" = skipped ]; then inner="<skipped message=\"$message\"/>"; fi
+  printf '<?xml version="1.0" encoding="UTF-8"?>\n<testsuites><testsuite name="gpu-check">' >"$file"
+  printf '<testcase classname="gpu-check" name="%s">%s</testcase></testsuite></testsuites>\n' "$name" "$inner" >>"$file"
+}
+
+# The CUDA interop (pyrseg/cuda.hpp): the tests of device pointers on the test's own stream (frames byte-identical
+# to the host path, stream order, a frame captured into the test's CUDA graph and replayed, bad input), the
+# application example (examples/cuda_app.cpp: a depth loop, then a captured frame replayed), and the graph-capture
+# tests again under compute-sanitizer memcheck. One summary row, "conformance, interop"; in a rehearsal they run
+# when the bundle has them (the CUDA tests then skip) but count for nothing.
+run_interop() {
+  local rehearse="$1" start=$SECONDS limit rc=0 xml="$work/xml" name=conformance_interop
+  if [ ! -x "$bundle/bin/pyrseg_test_interop" ] || [ ! -x "$bundle/bin/pyrseg_example_cuda_app" ]; then
+    say "CUDA interop: not run, the bundle has no pyrseg_test_interop or pyrseg_example_cuda_app"
+    if [ "$rehearse" = 0 ]; then
+      echo "$name" >>"$work/suites"
+      echo "not run: not in the bundle" >"$work/time_$name"
+    fi
+    return 0
+  fi
+  if [ "$rehearse" = 1 ]; then
+    xml="$work/rehearsal-xml"  # not read by the summary
+    mkdir -p "$xml"
+  else
+    echo "$name" >>"$work/suites"
+  fi
+  limit=$(step_limit 60)
+  if ((limit < 20)); then
+    say "CUDA interop: not run, out of time"
+    if [ "$rehearse" = 0 ]; then echo "not run: out of time" >"$work/time_$name"; fi
+    return 0
+  fi
+  timeout "$limit" "$bundle/bin/pyrseg_test_interop" --gtest_filter='Cuda*' --gtest_brief=1 \
+    --gtest_output="xml:$xml/${name}_tests.xml" >"$work/logs/interop.log" 2>&1 || rc=$?
+  local tests_rc=$rc
+  # A crash or a timeout leaves no results, and a run where every test skipped checked nothing: both fail.
+  if [ ! -s "$xml/${name}_tests.xml" ]; then
+    run_case_xml "$xml/${name}_tests.xml" pyrseg_test_interop failed "exit $tests_rc and no results (crashed or timed out?)"
+  elif [ "$rehearse" = 0 ] && ! grep -q 'result="completed"' "$xml/${name}_tests.xml"; then
+    run_case_xml "$xml/${name}_ran.xml" pyrseg_test_interop failed "no CUDA interop test ran: every one skipped"
+  fi
+  rc=0
+  timeout "$(step_limit 60)" "$bundle/bin/pyrseg_example_cuda_app" >"$work/logs/example_cuda_app.log" 2>&1 || rc=$?
+  case "$rc" in
+    0) run_case_xml "$xml/${name}_example.xml" example_cuda_app passed "" ;;
+    77) run_case_xml "$xml/${name}_example.xml" example_cuda_app skipped "$(tail -n 1 "$work/logs/example_cuda_app.log")" ;;
+    *) run_case_xml "$xml/${name}_example.xml" example_cuda_app failed "exit $rc: $(tail -n 1 "$work/logs/example_cuda_app.log")" ;;
+  esac
+  local example_rc=$rc memcheck="not run: compute-sanitizer is not on the PATH"
+  if [ "$rehearse" = 1 ]; then
+    memcheck="not run: rehearsal"
+  elif command -v compute-sanitizer >/dev/null; then
+    limit=$(step_limit 90)
+    if ((limit < 20)); then
+      memcheck="not run: out of time"
+    else
+      rc=0
+      timeout "$limit" compute-sanitizer --tool memcheck --error-exitcode 99 --print-limit 20 \
+        "$bundle/bin/pyrseg_test_interop" --gtest_filter='Cuda*Captur*' --gtest_brief=1 \
+        >"$work/logs/interop_memcheck.log" 2>&1 || rc=$?
+      case "$rc" in
+        0) memcheck="clean" ;;
+        99) memcheck="errors" ;;
+        124) memcheck="timed out after $limit s" ;;
+        *) memcheck="failed (exit $rc)" ;;
+      esac
+    fi
+  fi
+  case "$memcheck" in
+    clean) run_case_xml "$xml/${name}_memcheck.xml" graph_capture_memcheck passed "" ;;
+    "not run"*) run_case_xml "$xml/${name}_memcheck.xml" graph_capture_memcheck skipped "$memcheck" ;;
+    *) run_case_xml "$xml/${name}_memcheck.xml" graph_capture_memcheck failed "compute-sanitizer memcheck: $memcheck" ;;
+  esac
+  local counted=""
+  if [ "$rehearse" = 0 ]; then
+    echo "$((SECONDS - start))" >"$work/time_$name"
+  else
+    counted=" (rehearsal: not counted)"
+  fi
+  {
+    echo "=== CUDA interop: pyrseg_test_interop --gtest_filter='Cuda*' (exit $tests_rc) ==="
+    cat "$work/logs/interop.log"
+    echo "=== examples/cuda_app.cpp (exit $example_rc) ==="
+    cat "$work/logs/example_cuda_app.log"
+    echo "=== the graph-capture tests under compute-sanitizer memcheck: $memcheck ==="
+    if [ -f "$work/logs/interop_memcheck.log" ]; then cat "$work/logs/interop_memcheck.log"; fi
+  } >>"$report/conformance.log"
+  say "CUDA interop: $((SECONDS - start)) s; tests exit $tests_rc, example exit $example_rc, graph capture under" \
+    "memcheck: $memcheck$counted"
 }
 
 # A report must come back whole from a machine that returns files of at most 16 MiB: a log over 8 MiB (a backend
@@ -411,6 +513,7 @@ run() {
     >"$work/logs/unit.log" 2>&1 || true
   { echo "=== unit tests, every available backend ($((SECONDS - start)) s) ==="; cat "$work/logs/unit.log"; } \
     >>"$report/conformance.log"
+  run_interop "$rehearse"
   if [ "$rehearse" = 1 ]; then
     run_bench bench_rehearsal cpu 640x480 0.01 60
   else

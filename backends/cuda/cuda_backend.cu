@@ -1,12 +1,15 @@
-// The CUDA backend: gpu::Device over one non-blocking stream per Segmenter. The passes are core/gpu/gpu_executor.cpp;
-// the kernels are shaders/pyr_cuda.cuh (the entry points of shaders/pyr_entries.h), launched through the kernel
-// table. Transfers go through pinned staging memory; per-pass times come from CUDA events.
+// The CUDA backend: gpu::Device over one stream per Segmenter, a non-blocking one of its own or the application's
+// (pyrseg/cuda.hpp, cuda_interop.cpp). The passes are core/gpu/gpu_executor.cpp; the kernels are shaders/pyr_cuda.cuh
+// (the entry points of shaders/pyr_entries.h), launched through the kernel table. Host transfers go through pinned
+// staging memory; per-pass times come from CUDA events.
 #include "backends/cuda/cuda_backend.hpp"
+#include "backends/cuda/cuda_device.hpp"
 
 #include <cuda_runtime.h>
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
@@ -91,34 +94,78 @@ private:
     size_t bytes_ = 0;
 };
 
-class CudaDevice final : public gpu::Device {
+// An upload_inline's bytes travel as a kernel's parameter (at most 4 KiB of them, with the other two): copied when the
+// launch is queued, so the frame may run long after the call, and the next frame may change the source at once,
+// with no staging memory to keep alive.
+constexpr size_t kInlineBytes = 4000;
+struct InlineBytes {
+    unsigned char b[kInlineBytes];
+};
+
+__global__ void pyr_cuda_put_bytes(unsigned char* dst, unsigned n, InlineBytes bytes) {
+    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < n) dst[i] = bytes.b[i];
+}
+
+// gpu::Device over one stream: a non-blocking one of pyrseg's own, or the caller's (pyrseg/cuda.hpp).
+//
+// On pyrseg's own stream, commands are issued as they come (or, with PYRSEG_CUDA_GRAPHS=1, queued and run as a
+// CUDA graph at finish()). On the caller's stream, every command of a frame is queued and issued at the frame's
+// end: finish() for host frames (which then wait for the stream), submit() for device frames, which are issued
+// directly on the caller's stream, never wrapped in a graph of pyrseg's own (the caller may be capturing the
+// stream into its graph), and record no events. A frame refused half-way (by a check, or a capture it cannot be
+// part of) thus leaves nothing on the stream.
+class StreamDevice final : public CudaDevice {
 public:
-    explicit CudaDevice(int device) : device_(device) {
+    // pyrseg's own non-blocking stream on `device`.
+    explicit StreamDevice(int device) : device_(device) {
         select();
-        cudaDeviceProp p{};
-        check(cudaGetDeviceProperties(&p, device_), "cudaGetDeviceProperties");
-        description_ = "CUDA device " + std::to_string(device_) + " (" + p.name + ")";
+        describe_device();
         check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate");
-        for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
+        create_events();
         const char* graphs = std::getenv("PYRSEG_CUDA_GRAPHS");
         graphs_ = graphs != nullptr && std::strcmp(graphs, "1") == 0;
-        ops_.reserve(256);
     }
 
-    ~CudaDevice() override {
-        if (stream_ != nullptr) {
-            cudaStreamSynchronize(stream_);
-            cudaStreamDestroy(stream_);
+    // The caller's stream of `device`. The legacy default stream (0, cudaStreamLegacy) cannot be captured, so
+    // PYRSEG_CUDA_GRAPHS leaves host frames on it as they are.
+    StreamDevice(int device, cudaStream_t stream) : device_(device), stream_(stream), external_(true) {
+        select();
+        describe_device();
+        description_ += " on the application's stream";
+        create_events();
+        const char* graphs = std::getenv("PYRSEG_CUDA_GRAPHS");
+        const bool legacy = stream == nullptr || stream == cudaStreamLegacy;
+        graphs_ = graphs != nullptr && std::strcmp(graphs, "1") == 0 && !legacy;
+    }
+
+    // Waits for the stream (the caller's too: work queued there reads pyrseg's buffers) unless it is being
+    // captured, then frees everything with the device current, and makes the caller's current device current again.
+    ~StreamDevice() override {
+        int previous = -1;
+        if (cudaGetDevice(&previous) == cudaSuccess && previous != device_) cudaSetDevice(device_);
+        if (stream_ != nullptr || external_) {
+            cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+            if (cudaStreamIsCapturing(stream_, &status) == cudaSuccess && status == cudaStreamCaptureStatusNone)
+                cudaStreamSynchronize(stream_);
+            if (!external_) cudaStreamDestroy(stream_);
         }
         for (const Graph& g : graphs_cache_) cudaGraphExecDestroy(g.exec);
         for (cudaEvent_t e : events_) {
             if (e != nullptr) cudaEventDestroy(e);
         }
+        for (Memory<false>& m : buffers_) m = Memory<false>();
+        upload_ = Memory<true>();
+        download_ = Memory<true>();
+        if (previous >= 0 && previous != device_) cudaSetDevice(previous);
     }
-    CudaDevice(const CudaDevice&) = delete;
-    CudaDevice& operator=(const CudaDevice&) = delete;
+    StreamDevice(const StreamDevice&) = delete;
+    StreamDevice& operator=(const StreamDevice&) = delete;
 
     [[nodiscard]] std::string description() const override { return description_; }
+    [[nodiscard]] int ordinal() const override { return device_; }
+    [[nodiscard]] cudaStream_t stream() const override { return stream_; }
+    [[nodiscard]] bool callers_stream() const override { return external_; }
 
     [[nodiscard]] gpu::DeviceLimits limits() const override {
         select();
@@ -143,6 +190,8 @@ public:
         upload_ = Memory<true>(staging.upload, "cudaMallocHost(upload staging)");
         download_ = Memory<true>(staging.download, "cudaMallocHost(download staging)");
         staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
+        // The ray tables, the only inline uploads, live in the sums buffer: no allocation when they change.
+        inline_.reserve(std::max<size_t>(sizes[size_t(gpu::Buffer::sums)], size_t(64) << 10));
         ctx_ = PyrCudaCtx{buffer<float>(gpu::Buffer::points),
                           buffer<float>(gpu::Buffer::normals),
                           buffer<unsigned>(gpu::Buffer::quant),
@@ -214,6 +263,12 @@ public:
     // stream the first time this exact sequence comes (a frame's commands, their arguments and addresses depend only
     // on the plan and the input kind, so a Segmenter sees a handful), then replayed with one launch.
     void finish() override {
+        if (external_) {
+            refuse_if_capturing(
+                "a host frame (Segmenter::segment) waits for the Segmenter's stream, which is being captured into a "
+                "CUDA graph: give the graph device frames (pyrseg::cuda::segment), and host frames outside the "
+                "capture");
+        }
         if (!ops_.empty()) run_queued();
         check(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
         staging_.complete();
@@ -239,19 +294,81 @@ public:
         select();
         event_count_ = 0;
         ops_.clear();
+        inline_.clear();
         staging_.restart();
+    }
+
+    // Device-resident frames, on the caller's stream only: device-to-device copies between the caller's memory and
+    // pyrseg's buffers (cudaMemcpy2DAsync where rows are padded).
+    void copy_in(gpu::Buffer dst, size_t offset, const core::ExternalBuffer& src, size_t pitch, size_t row_bytes,
+                 size_t rows) override {
+        if (!external_) gpu::Device::copy_in(dst, offset, src, pitch, row_bytes, rows);  // throws
+        Op op{Op::d2d};
+        op.dst = buffer<unsigned char>(dst) + offset;
+        op.dst_pitch = row_bytes;
+        op.src = callers(src);
+        op.src_pitch = pitch;
+        op.bytes = row_bytes;
+        op.rows = rows;
+        enqueue(op);
+    }
+
+    void copy_out(const core::ExternalBuffer& dst, size_t pitch, gpu::Buffer src, size_t offset, size_t row_bytes,
+                  size_t rows) override {
+        if (!external_) gpu::Device::copy_out(dst, pitch, src, offset, row_bytes, rows);  // throws
+        Op op{Op::d2d};
+        op.dst = const_cast<unsigned char*>(callers(dst));
+        op.dst_pitch = pitch;
+        op.src = buffer<unsigned char>(src) + offset;
+        op.src_pitch = row_bytes;
+        op.bytes = row_bytes;
+        op.rows = rows;
+        enqueue(op);
+    }
+
+    // The ray tables of a depth frame whose intrinsics changed, as kernel parameters (kInlineBytes a launch). Not
+    // while the stream is captured: the executor takes the table as sent once this frame is queued, but a captured
+    // frame does not run until the graph is launched, so the frames after it would read a table the device does not
+    // hold yet. Refused before anything of the frame is issued.
+    void upload_inline(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
+        if (!external_) gpu::Device::upload_inline(b, offset, src, bytes);  // throws
+        refuse_if_capturing(
+            "this depth frame's intrinsics (fx, fy, cx, cy, or its size) differ from the Segmenter's last depth "
+            "frame's, and the stream is being captured into a CUDA graph: pyrseg sends a new ray table only outside "
+            "a capture. Queue one frame with these intrinsics before cudaStreamBeginCapture (the graph then uses the "
+            "ray table the Segmenter holds when it runs), or use one Segmenter per camera");
+        const auto* from = static_cast<const unsigned char*>(src);
+        for (size_t done = 0; done < bytes; done += kInlineBytes) {
+            Op op{Op::put};
+            op.dst = buffer<unsigned char>(b) + offset + done;
+            op.bytes = std::min(kInlineBytes, bytes - done);
+            op.inline_at = inline_.size();
+            inline_.insert(inline_.end(), from + done, from + done + op.bytes);
+            enqueue(op);
+        }
+    }
+
+    // The device frame's commands, in order, on the caller's stream; nothing waits.
+    void submit() override {
+        if (!external_) gpu::Device::submit();  // throws
+        for (const Op& op : ops_) issue(op, false);
+        ops_.clear();
     }
 
 private:
     // A command of the stream, issued at once, or queued for a graph.
     struct Op {
-        enum Kind : std::uint8_t { h2d, d2h, memset, launch, record };
+        enum Kind : std::uint8_t { h2d, d2h, memset, launch, record, d2d, put };
         explicit Op(Kind k) : kind(k) {}
         Kind kind;
-        void* dst = nullptr;  // copies and memset
+        void* dst = nullptr;  // copies, memset, put
         const void* src = nullptr;
-        size_t bytes = 0;
-        uint32_t kernel = 0;  // launch
+        size_t bytes = 0;      // d2d: bytes a row
+        size_t dst_pitch = 0;  // d2d
+        size_t src_pitch = 0;
+        size_t rows = 0;
+        size_t inline_at = 0;  // put: where its bytes are in inline_
+        uint32_t kernel = 0;   // launch
         dim3 grid;
         dim3 block;
         PyrArgs args{};
@@ -259,7 +376,8 @@ private:
 
         [[nodiscard]] bool same(const Op& o) const {
             const auto same_dim = [](dim3 a, dim3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
-            return kind == o.kind && dst == o.dst && src == o.src && bytes == o.bytes && kernel == o.kernel &&
+            return kind == o.kind && dst == o.dst && src == o.src && bytes == o.bytes && dst_pitch == o.dst_pitch &&
+                   src_pitch == o.src_pitch && rows == o.rows && inline_at == o.inline_at && kernel == o.kernel &&
                    same_dim(grid, o.grid) && same_dim(block, o.block) &&
                    std::equal(std::begin(args.a), std::end(args.a), std::begin(o.args.a)) && event == o.event;
         }
@@ -272,15 +390,37 @@ private:
 
     static constexpr size_t kMinGraphLaunches = 4;  // fewer (the statistics' download) run as they are
 
+    void describe_device() {
+        cudaDeviceProp p{};
+        check(cudaGetDeviceProperties(&p, device_), "cudaGetDeviceProperties");
+        description_ = "CUDA device " + std::to_string(device_) + " (" + p.name + ")";
+    }
+
+    void create_events() {
+        for (cudaEvent_t& e : events_) check(cudaEventCreate(&e), "cudaEventCreate");
+        ops_.reserve(256);
+    }
+
+    static const unsigned char* callers(const core::ExternalBuffer& b) {
+        return reinterpret_cast<const unsigned char*>(static_cast<std::uintptr_t>(b.handle)) + b.offset;
+    }
+
+    void refuse_if_capturing(const char* why) const {
+        cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+        check(cudaStreamIsCapturing(stream_, &status), "cudaStreamIsCapturing");
+        if (status != cudaStreamCaptureStatusNone) throw Error(ErrorCode::invalid_argument, why);
+    }
+
+    // pyrseg's own stream issues at once unless graphs are on; the caller's queues the whole frame.
     void enqueue(const Op& op) {
-        if (graphs_) {
+        if (graphs_ || external_) {
             ops_.push_back(op);
         } else {
             issue(op, false);
         }
     }
 
-    void issue(Op op, bool capturing) {
+    void issue(const Op& op, bool capturing) {
         switch (op.kind) {
             case Op::h2d:
                 check(cudaMemcpyAsync(op.dst, op.src, op.bytes, cudaMemcpyHostToDevice, stream_),
@@ -290,14 +430,36 @@ private:
                 check(cudaMemcpyAsync(op.dst, op.src, op.bytes, cudaMemcpyDeviceToHost, stream_),
                       "cudaMemcpyAsync(download)");
                 break;
+            case Op::d2d:
+                if (op.rows == 1 || (op.src_pitch == op.bytes && op.dst_pitch == op.bytes)) {
+                    check(cudaMemcpyAsync(op.dst, op.src, op.bytes * op.rows, cudaMemcpyDeviceToDevice, stream_),
+                          "cudaMemcpyAsync(device to device)");
+                } else {
+                    check(cudaMemcpy2DAsync(op.dst, op.dst_pitch, op.src, op.src_pitch, op.bytes, op.rows,
+                                            cudaMemcpyDeviceToDevice, stream_),
+                          "cudaMemcpy2DAsync(device to device)");
+                }
+                break;
             case Op::memset:
                 check(cudaMemsetAsync(op.dst, 0, op.bytes, stream_), "cudaMemsetAsync");
                 break;
             case Op::launch: {
-                void* params[] = {&ctx_, &op.args};
+                PyrArgs args = op.args;
+                void* params[] = {&ctx_, &args};
                 check(cudaLaunchKernel(reinterpret_cast<const void*>(kKernelFns[op.kernel]), op.grid, op.block, params,
                                        0, stream_),
                       gpu::kernel_entry_name(gpu::Kernel(op.kernel)));
+                break;
+            }
+            case Op::put: {
+                auto* dst = static_cast<unsigned char*>(op.dst);
+                auto n = unsigned(op.bytes);
+                InlineBytes bytes{};
+                std::memcpy(bytes.b, inline_.data() + op.inline_at, op.bytes);
+                void* params[] = {&dst, &n, &bytes};
+                check(cudaLaunchKernel(reinterpret_cast<const void*>(&pyr_cuda_put_bytes), dim3((n + 255) / 256),
+                                       dim3(256), params, 0, stream_),
+                      "pyr_cuda_put_bytes");
                 break;
             }
             case Op::record:
@@ -312,7 +474,7 @@ private:
     void run_queued() {
         const size_t launches =
             size_t(std::count_if(ops_.begin(), ops_.end(), [](const Op& op) { return op.kind == Op::launch; }));
-        if (launches < kMinGraphLaunches) {
+        if (!graphs_ || launches < kMinGraphLaunches) {
             for (const Op& op : ops_) issue(op, false);
             ops_.clear();
             return;
@@ -347,7 +509,12 @@ private:
         return graphs_cache_.back();
     }
 
-    void select() const { check(cudaSetDevice(device_), "cudaSetDevice"); }
+    // The device current on the calling thread (set only when another one is).
+    void select() const {
+        int current = -1;
+        if (cudaGetDevice(&current) != cudaSuccess || current != device_)
+            check(cudaSetDevice(device_), "cudaSetDevice");
+    }
 
     template <class T>
     [[nodiscard]] T* buffer(gpu::Buffer b) const {
@@ -357,6 +524,7 @@ private:
     int device_;
     std::string description_;
     cudaStream_t stream_ = nullptr;
+    bool external_ = false;  // stream_ is the caller's
     std::array<Memory<false>, gpu::kBufferCount> buffers_;
     Memory<true> upload_, download_;
     gpu::StagingArena staging_;
@@ -364,8 +532,9 @@ private:
     std::array<cudaEvent_t, kMaxEvents> events_{};
     std::array<const char*, kMaxEvents> event_names_{};
     uint32_t event_count_ = 0;
-    bool graphs_ = false;  // PYRSEG_CUDA_GRAPHS=1
-    std::vector<Op> ops_;  // queued since the last finish(), in graph mode
+    bool graphs_ = false;                // PYRSEG_CUDA_GRAPHS=1 (host frames only)
+    std::vector<Op> ops_;                // queued: in graph mode, and every frame on the caller's stream
+    std::vector<unsigned char> inline_;  // the bytes of the queued put commands
     std::vector<Graph> graphs_cache_;
 };
 
@@ -418,7 +587,27 @@ std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
     std::vector<std::string> ids;
     for (size_t d = 0; d < devices.size(); ++d) ids.push_back(std::to_string(d));
     const auto chosen = core::device_from_environment("PYRSEG_CUDA_DEVICE", "CUDA", ids, devices);
-    return gpu::make_gpu_executor(plan, std::make_unique<CudaDevice>(int(chosen.value_or(0))));
+    return gpu::make_gpu_executor(plan, make_device(int(chosen.value_or(0))));
+}
+
+std::unique_ptr<CudaDevice> make_device(int device) {
+    return std::make_unique<StreamDevice>(device);
+}
+
+std::unique_ptr<CudaDevice> make_device(int device, cudaStream_t stream) {
+    return std::make_unique<StreamDevice>(device, stream);
+}
+
+CurrentDevice::CurrentDevice(int device) {
+    int current = -1;
+    check(cudaGetDevice(&current), "cudaGetDevice");
+    if (current == device) return;
+    check(cudaSetDevice(device), "cudaSetDevice");
+    previous_ = current;
+}
+
+CurrentDevice::~CurrentDevice() {
+    if (previous_ >= 0) cudaSetDevice(previous_);
 }
 
 const core::BackendEntry kBackend = {[](std::string* why_none, bool* available) {

@@ -4,6 +4,7 @@
 #include "backends/opencl/opencl_device.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cstring>
 #include <string>
@@ -27,7 +28,7 @@ size_t round_up(size_t v, size_t m) {
 }
 
 cl_mem as_mem(std::uint64_t handle) {
-    return reinterpret_cast<cl_mem>(static_cast<std::uintptr_t>(handle));
+    return std::bit_cast<cl_mem>(static_cast<std::uintptr_t>(handle));
 }
 
 // An inline upload's bytes, freed by the runtime once the write has read them.

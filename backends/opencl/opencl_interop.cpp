@@ -4,6 +4,7 @@
 #include "pyrseg/opencl.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -18,6 +19,10 @@
 namespace pyrseg::opencl {
 namespace {
 
+// OpenCL's objects are pointers to opaque structs; their queries return the pointer itself.
+constexpr std::size_t kHandleBytes = sizeof(void*);
+static_assert(sizeof(cl_context) == kHandleBytes && sizeof(cl_mem) == kHandleBytes);
+
 [[noreturn]] void bad(const std::string& what) {
     throw Error(ErrorCode::invalid_argument, what);
 }
@@ -25,7 +30,9 @@ namespace {
 template <class T>
 T queue_info(cl_command_queue queue, cl_command_queue_info what, const char* name) {
     T value{};
-    const cl_int err = clGetCommandQueueInfo(queue, what, sizeof(value), &value, nullptr);
+    // T is a handle (a pointer to an opaque struct) or a bitfield: the query returns the value itself.
+    const cl_int err =
+        clGetCommandQueueInfo(queue, what, sizeof(T), &value, nullptr);  // NOLINT(bugprone-sizeof-expression)
     if (err != CL_SUCCESS)
         bad(std::string("the queue is not a valid command queue (") + name + ": " + error_name(err) + ")");
     return value;
@@ -40,7 +47,7 @@ void check_queue(const Queue& q) {
         bad("the context is not a valid OpenCL context");
     }
     std::vector<cl_device_id> devices(count);
-    clGetContextInfo(q.context, CL_CONTEXT_DEVICES, sizeof(cl_device_id) * count, devices.data(), nullptr);
+    clGetContextInfo(q.context, CL_CONTEXT_DEVICES, kHandleBytes * count, devices.data(), nullptr);
     if (std::find(devices.begin(), devices.end(), q.device) == devices.end()) bad("the device is not in the context");
     if (queue_info<cl_context>(q.queue, CL_QUEUE_CONTEXT, "CL_QUEUE_CONTEXT") != q.context) {
         bad("the command queue belongs to another context");
@@ -69,14 +76,14 @@ core::ExternalBuffer external(const OpenclDevice& device, cl_mem mem, std::size_
     if (mem == nullptr) return b;
     cl_context context = nullptr;
     std::size_t size = 0;
-    if (clGetMemObjectInfo(mem, CL_MEM_CONTEXT, sizeof(context), &context, nullptr) != CL_SUCCESS ||
+    if (clGetMemObjectInfo(mem, CL_MEM_CONTEXT, kHandleBytes, &context, nullptr) != CL_SUCCESS ||
         clGetMemObjectInfo(mem, CL_MEM_SIZE, sizeof(size), &size, nullptr) != CL_SUCCESS) {
         bad(std::string("the ") + what + " buffer is not a valid cl_mem");
     }
     if (context != device.context()) {
         bad(std::string("the ") + what + " buffer belongs to another context than the Segmenter's queue");
     }
-    b.handle = static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(mem));
+    b.handle = static_cast<std::uint64_t>(std::bit_cast<std::uintptr_t>(mem));
     b.offset = offset;
     b.bytes = offset <= size ? size - offset : 0;
     return b;

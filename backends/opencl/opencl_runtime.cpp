@@ -230,7 +230,7 @@ std::shared_ptr<const Runtime> runtime_for(cl_context context, cl_device_id devi
     rt->context = context;
     rt->device = device;
     cl_platform_id platform = nullptr;
-    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof(platform), &platform, nullptr);
+    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof(void*), &platform, nullptr);  // the handle itself
     rt->description = "the caller's context: " + platform_name(platform) + ": " +
                       device_string(device, CL_DEVICE_NAME) + " (" + device_string(device, CL_DEVICE_VERSION) + ", " +
                       type_name(device) + ")";
