@@ -4,8 +4,8 @@
 #include "backends/opencl/opencl_device.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <array>
+#include <bit>
 #include <cstring>
 #include <string>
 #include <string_view>
