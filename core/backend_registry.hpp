@@ -20,6 +20,10 @@ struct BackendEntry {
     std::vector<std::string> (*describe)(std::string* why_none, bool* available);
     // The executor on the chosen device; throws pyrseg::Error. `plan` must outlive it.
     std::unique_ptr<PassExecutor> (*make_executor)(const Plan& plan);
+    // Whether the device make_executor would use is a CPU running the API in software (lavapipe, PoCL's CPU
+    // device), which 'auto' never prefers to the native CPU backend; sets *device to its description then. nullptr:
+    // the backend's devices are never such (CUDA). Never throws.
+    bool (*emulated)(std::string* device) = nullptr;
 };
 
 struct KnownBackend {

@@ -12,18 +12,21 @@ namespace pyrseg {
 std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;
     for (const core::KnownBackend& k : core::known_backends()) {
-        BackendInfo info{k.name, false, "", {}};
+        BackendInfo info;
+        info.name = k.name;
         if (k.entry == nullptr) {
             info.reason = k.why_not_built;
         } else {
             info.devices = k.entry->describe(&info.reason, &info.available);
+            if (info.available && k.entry->emulated != nullptr)
+                info.emulated = k.entry->emulated(&info.emulated_device);
         }
         all.push_back(std::move(info));
     }
     return all;
 }
 
-std::string resolve_backend_name(std::string_view requested) {
+BackendChoice choose_backend(std::string_view requested) {
     std::string name(requested);
     std::string origin = "requested";
     if (name.empty()) {
@@ -36,8 +39,19 @@ std::string resolve_backend_name(std::string_view requested) {
     }
     const std::vector<BackendInfo> all = list_backends();
     if (name == "auto") {
+        // GPUs first; a GPU API running in software on the CPU is slower than the native CPU backend.
+        std::string passed;
         for (const BackendInfo& b : all) {
-            if (b.available) return b.name;
+            if (!b.available) continue;
+            if (b.emulated) {
+                passed += (passed.empty() ? "" : "; ") + b.name + "'s device " + b.emulated_device;
+                continue;
+            }
+            std::string reason = "auto: ";
+            reason += b.name == "cpu" ? "no GPU backend has a GPU here" : "the first backend with a GPU";
+            if (!passed.empty())
+                reason += " (passed by, as CPU emulations slower than the cpu backend: " + passed + ")";
+            return {b.name, reason};
         }
         throw Error(ErrorCode::internal, "no backend is available, not even the CPU");
     }
@@ -50,12 +64,16 @@ std::string resolve_backend_name(std::string_view requested) {
                 message += b.reason;
                 throw Error(ErrorCode::backend_unavailable, message);
             }
-            return b.name;
+            return {b.name, origin == "requested" ? std::string("requested") : "PYRSEG_BACKEND=" + name};
         }
         known += (known.empty() ? "" : ", ") + b.name;
     }
     throw Error(ErrorCode::backend_unavailable,
                 "unknown backend '" + name + "' (" + origin + "); known backends: " + known + ", auto");
+}
+
+std::string resolve_backend_name(std::string_view requested) {
+    return choose_backend(requested).name;
 }
 
 namespace core {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -267,6 +268,14 @@ int run_batch(const Args& args, const Params& params) {
 
 }  // namespace
 
+// Which backend the frames will run on, and why, once (the per-frame lines name it too): an explicit --backend needs
+// no reason.
+void say_backend_choice(const Args& args) {
+    if (args.value("backend") && *args.value("backend") != "auto") return;
+    const BackendChoice choice = choose_backend(args.value("backend").value_or(""));
+    std::fprintf(stderr, "pyrseg: backend %s (%s)\n", choice.name.c_str(), choice.reason.c_str());
+}
+
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
@@ -288,6 +297,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (auto v = args.value("stats")) out.stats = *v;
     if (auto v = args.value("pcl-png")) out.pcl_png = *v;
     const Params params = parse_params(args);
+    say_backend_choice(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
         if (out.any()) throw UsageError{"in a batch (--out-dir), choose the outputs with --write, not file names"};

@@ -28,6 +28,18 @@ const core::BackendEntry kBackend = {[](std::string* why_none, bool* available) 
                                          *available = !devices.empty();
                                          return devices;
                                      },
-                                     make_executor};
+                                     make_executor,
+                                     [](std::string* device) {
+                                         try {
+                                             const DeviceRef d = choose_device();
+                                             cl_device_type type = 0;
+                                             clGetDeviceInfo(d.device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr);
+                                             if ((type & CL_DEVICE_TYPE_CPU) == 0) return false;
+                                             *device = d.description;
+                                             return true;
+                                         } catch (const Error&) {
+                                             return false;
+                                         }
+                                     }};
 
 }  // namespace pyrseg::opencl

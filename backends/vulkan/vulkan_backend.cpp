@@ -28,6 +28,22 @@ std::vector<std::string> describe_devices(std::string* why_none, bool* any_usabl
     return out;
 }
 
-const core::BackendEntry kBackend = {describe_devices, make_executor};
+namespace {
+
+// The device auto would get is a CPU (lavapipe, SwiftShader): its type, as enumerate_devices ranks it.
+bool emulated(std::string* device) {
+    try {
+        const DeviceRef d = choose_device();
+        if (!d.cpu) return false;
+        *device = d.description;
+        return true;
+    } catch (const Error&) {
+        return false;
+    }
+}
+
+}  // namespace
+
+const core::BackendEntry kBackend = {describe_devices, make_executor, emulated};
 
 }  // namespace pyrseg::vulkan

@@ -262,6 +262,7 @@ std::vector<DeviceRef> enumerate_devices(std::string* why_none) {
         ref.physical = physicals[i];
         ref.index = i;
         ref.preference = preference(p.deviceType);
+        ref.cpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         ref.description = std::to_string(i) + " " + p.deviceName + " (" + type_name(p.deviceType) + ", Vulkan " +
                           version_text(p.apiVersion) + ")";
         ref.unusable = missing_features(physicals[i], p);

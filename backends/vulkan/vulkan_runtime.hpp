@@ -32,6 +32,7 @@ struct DeviceRef {
     std::string description;  // "0 llvmpipe (LLVM 15.0.6, 256 bits) (CPU, Vulkan 1.3.230, Mesa 22.3.6)"
     std::string unusable;     // why pyrseg cannot use it (empty when it can)
     int preference = 0;       // discrete GPU first, then integrated, virtual, CPU
+    bool cpu = false;         // VK_PHYSICAL_DEVICE_TYPE_CPU: the API in software (lavapipe, SwiftShader)
 };
 
 // Every physical device; when none is usable, *why_none says why. Never throws.

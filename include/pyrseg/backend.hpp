@@ -11,13 +11,26 @@ struct BackendInfo {
     bool available = false;            // can run on this machine now
     std::string reason;                // why not, when unavailable
     std::vector<std::string> devices;  // human-readable device descriptions when available
+    // Available, but the device it would use is a CPU running the GPU API in software (Mesa's lavapipe, PoCL's
+    // CPU device): slower than the cpu backend, so "auto" passes it by. It still runs when named.
+    bool emulated = false;
+    std::string emulated_device;  // that device, when emulated
 };
 
-// Every backend pyrseg knows, in preference order (the first available one is "auto").
+// Every backend pyrseg knows, in preference order: GPUs first, the CPU last.
 [[nodiscard]] std::vector<BackendInfo> list_backends();
 
-// Resolves a backend request: an explicit name, else the PYRSEG_BACKEND environment variable, else "auto".
-// Throws pyrseg::Error(backend_unavailable) naming the reason when the chosen backend cannot run.
-[[nodiscard]] std::string resolve_backend_name(std::string_view requested);
+// The backend a request resolves to, and why, in one sentence for users ("auto: vulkan's device llvmpipe ... is a
+// CPU emulation; cpu runs natively").
+struct BackendChoice {
+    std::string name;
+    std::string reason;
+};
+
+// Resolves a backend request: an explicit name, else the PYRSEG_BACKEND environment variable, else "auto" (the
+// first available backend whose device is a real GPU, else cpu). Throws pyrseg::Error(backend_unavailable) naming
+// the reason when the chosen backend cannot run.
+[[nodiscard]] BackendChoice choose_backend(std::string_view requested);
+[[nodiscard]] std::string resolve_backend_name(std::string_view requested);  // choose_backend(requested).name
 
 }  // namespace pyrseg

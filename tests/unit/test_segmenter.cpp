@@ -106,5 +106,32 @@ TEST(Backends, EnvironmentVariableChoosesWhenNoNameIsGiven) {
     EXPECT_FALSE(resolve_backend_name("auto").empty());
 }
 
+TEST(Backends, AutoNeverPicksACpuEmulationOverTheCpuBackend) {
+    // lavapipe and PoCL's CPU device are the API in software on the host: slower than the native backend.
+    const std::vector<BackendInfo> all = list_backends();
+    const BackendChoice choice = choose_backend("auto");
+    std::string first_real;
+    for (const BackendInfo& b : all) {
+        if (b.available && !b.emulated && first_real.empty()) first_real = b.name;
+        if (b.name == "cpu") {
+            EXPECT_FALSE(b.emulated);
+        }
+        if (b.emulated) {
+            EXPECT_TRUE(b.available) << b.name;
+            EXPECT_FALSE(b.emulated_device.empty()) << b.name;
+            EXPECT_NE(choice.reason.find(b.name + "'s device"), std::string::npos) << choice.reason;
+        }
+    }
+    EXPECT_EQ(choice.name, first_real) << choice.reason;
+    EXPECT_EQ(choice.reason.rfind("auto: ", 0), 0u) << choice.reason;
+    // Named, an emulated backend still runs: the choice is only auto's.
+    for (const BackendInfo& b : all) {
+        if (b.emulated) {
+            EXPECT_EQ(choose_backend(b.name).name, b.name);
+        }
+    }
+    EXPECT_EQ(choose_backend("cpu").reason, "requested");
+}
+
 }  // namespace
 }  // namespace pyrseg
