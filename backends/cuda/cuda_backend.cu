@@ -326,17 +326,10 @@ public:
         enqueue(op);
     }
 
-    // The ray tables of a depth frame whose intrinsics changed, as kernel parameters (kInlineBytes a launch). Not
-    // while the stream is captured: the executor takes the table as sent once this frame is queued, but a captured
-    // frame does not run until the graph is launched, so the frames after it would read a table the device does not
-    // hold yet. Refused before anything of the frame is issued.
+    // A device depth frame's ray tables, as kernel parameters (kInlineBytes a launch): part of the frame, so a
+    // captured graph carries its own.
     void upload_inline(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {
         if (!external_) gpu::Device::upload_inline(b, offset, src, bytes);  // throws
-        refuse_if_capturing(
-            "this depth frame's intrinsics (fx, fy, cx, cy, or its size) differ from the Segmenter's last depth "
-            "frame's, and the stream is being captured into a CUDA graph: pyrseg sends a new ray table only outside "
-            "a capture. Queue one frame with these intrinsics before cudaStreamBeginCapture (the graph then uses the "
-            "ray table the Segmenter holds when it runs), or use one Segmenter per camera");
         const auto* from = static_cast<const unsigned char*>(src);
         for (size_t done = 0; done < bytes; done += kInlineBytes) {
             Op op{Op::put};

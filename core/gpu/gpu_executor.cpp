@@ -289,18 +289,19 @@ private:
     void set_depth(DepthFormat format, const core::DepthTables& tables) {
         host_rays_.assign(tables.ku.begin(), tables.ku.end());
         host_rays_.insert(host_rays_.end(), tables.kv.begin(), tables.kv.end());
-        if (host_rays_ != rays_on_device_) {
-            const size_t offset = 4 * size_t(rays_word());
-            const size_t bytes = 4 * host_rays_.size();
-            if (!device_frame_) {
-                device_->upload(Buffer::sums, offset, host_rays_.data(), bytes);
-            } else {
-                // The frame may run after this call returns and after the next one changed host_rays_.
-                constexpr size_t kChunk = 65536;
-                const auto* src = reinterpret_cast<const unsigned char*>(host_rays_.data());
-                for (size_t done = 0; done < bytes; done += kChunk)
-                    device_->upload_inline(Buffer::sums, offset + done, src + done, std::min(kChunk, bytes - done));
-            }
+        const size_t offset = 4 * size_t(rays_word());
+        const size_t bytes = 4 * host_rays_.size();
+        if (device_frame_) {
+            // Every device frame carries its own slopes, inline with its commands (W + H floats): it may run long
+            // after this call (a recorded command buffer, a CUDA graph replayed later), in any order with other
+            // recordings, so it cannot count on what an earlier frame left. It leaves the device state unknown.
+            constexpr size_t kChunk = 65536;
+            const auto* src = reinterpret_cast<const unsigned char*>(host_rays_.data());
+            for (size_t done = 0; done < bytes; done += kChunk)
+                device_->upload_inline(Buffer::sums, offset + done, src + done, std::min(kChunk, bytes - done));
+            rays_on_device_.clear();
+        } else if (host_rays_ != rays_on_device_) {
+            device_->upload(Buffer::sums, offset, host_rays_.data(), bytes);
             rays_pending_ = true;
         }
         depth_format_ = format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;

@@ -99,12 +99,8 @@ struct LabelPointers {
 // synchronisation, no allocation, no host copy, no event query). The graph then holds the addresses of the
 // application's memory and of the Segmenter's buffers: each launch reads the input there as it is then and writes
 // the labels there; launch it on the Segmenter's stream (or keep it ordered with the Segmenter's other frames),
-// while the Segmenter lives. One exception: a depth frame whose intrinsics (fx, fy, cx, cy, or its size) differ
-// from the Segmenter's last depth frame sends a new ray table (W + H floats, as kernel parameters, only then), and
-// that is refused during a capture with a pyrseg::Error before anything is captured: queue one frame with these
-// intrinsics before capturing. A depth frame's graph reads the ray table the Segmenter holds when the graph runs,
-// that of the last depth frame queued outside a graph: launch it only while that frame had the same intrinsics
-// (one Segmenter per camera is the simple way).
+// while the Segmenter lives. A depth frame carries its own ray table (W + H floats, as the parameters of small
+// kernels among its commands), so its graph gives that calibration's points whatever frames ran in between.
 void segment(Segmenter& segmenter, const CloudPointers& cloud, const LabelPointers& out);
 void segment(Segmenter& segmenter, const DepthPointers& depth, const LabelPointers& out);
 
