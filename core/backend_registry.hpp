@@ -17,9 +17,9 @@ namespace pyrseg::core {
 struct BackendEntry {
     // The devices the backend can see (an unusable one says why); sets *available, and *why_none when no device
     // can run pyrseg here. Never throws.
-    std::vector<std::string> (*describe)(std::string* why_none, bool* available);
+    std::vector<std::string> (*describe)(std::string* why_none, bool* available) = nullptr;
     // The executor on the chosen device; throws pyrseg::Error. `plan` must outlive it.
-    std::unique_ptr<PassExecutor> (*make_executor)(const Plan& plan);
+    std::unique_ptr<PassExecutor> (*make_executor)(const Plan& plan) = nullptr;
     // Whether the device make_executor would use is a CPU running the API in software (lavapipe, PoCL's CPU
     // device), which 'auto' never prefers to the native CPU backend; sets *device to its description then. nullptr:
     // the backend's devices are never such (CUDA). Never throws.
