@@ -13,6 +13,7 @@
 
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/robust_windows.hpp"
+#include "backends/cpu/simd/cpu_simd.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
 #include "core/cloud_layout.hpp"
@@ -45,7 +46,7 @@ class CpuExecutor final : public core::PassExecutor {
 public:
     explicit CpuExecutor(const core::Plan& plan)
         : plan_(plan),
-          quant_(plan.pixel_count()),
+          quant_(kQuantWords * plan.pixel_count()),
           mask_valid_(plan.pixel_count()),
           mask_(plan.total_texels),
           labels_(plan.total_texels),
@@ -53,6 +54,7 @@ public:
           parent_(fill_scratch_size(plan)),
           best_(fill_scratch_size(plan)),
           stats_(plan.stats_words()),
+          simd_(simd::kernels_from_environment()),
           sweeps_(use_sweeps_for_fixed_points()) {}
 
     [[nodiscard]] uint32_t fill_rounds() const override { return fill_rounds_; }
@@ -151,6 +153,13 @@ public:
             windows_.build(robust_texels_.data(), w, size_t(h), window,
                            [&](size_t n, const auto& body) { rows(n, body); });
         }
+        if (!robust && simd_ != nullptr) {
+            rows(size_t(plan_.height), [&](size_t y) {
+                simd_->normals_row(c, uint32_t(w), h, uint32_t(y), radius, normals_.data() + 3 * y * w);
+            });
+            normals_estimated_ = true;
+            return;
+        }
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
                 const PyrIVec3 q = robust ? robust_normal(c, x, y)
@@ -166,17 +175,20 @@ public:
 
     void quantize() override {
         const size_t w = size_t(plan_.width);
+        if (simd_ != nullptr) {
+            const size_t normal_floats = normals_estimated_ ? 3 : layout_.point_floats;
+            rows(size_t(plan_.height), [&](size_t y) {
+                simd_->quantize_row(point(0, y), layout_.point_floats, normal(0, y), normal_floats, uint32_t(w),
+                                    quant_.data() + kQuantWords * y * w);
+            });
+            return;
+        }
         rows(size_t(plan_.height), [&](size_t y) {
             for (size_t x = 0; x < w; ++x) {
                 const float* p = point(x, y);
                 const float* n = normal(x, y);
                 const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
-                QuantPixel& out = quant_[y * w + x];
-                out.q[0] = std::int16_t(q.qx);
-                out.q[1] = std::int16_t(q.qy);
-                out.q[2] = std::int16_t(q.qz);
-                out.valid = std::uint16_t(q.valid);
-                out.z = p[2];
+                store_quant(quant_.data() + kQuantWords * (y * w + x), q.qx, q.qy, q.qz, q.valid, p[2]);
             }
         });
     }
@@ -187,6 +199,13 @@ public:
         const core::Thresholds t = plan_.thresholds;
         const bool robust = plan_.params.metric == Metric::robust;
         const auto stride = uint32_t(plan_.params.curvature_stride);
+        if (!robust && simd_ != nullptr) {
+            rows(full.height, [&](size_t y) {
+                simd_->metric_row(c, full.width, full.height, uint32_t(y), t.curvature, t.depth,
+                                  mask_.data() + full.offset + y * full.width);
+            });
+            return;
+        }
         rows(full.height, [&](size_t y) {
             std::uint8_t* out = mask_.data() + full.offset + y * full.width;
             for (uint32_t x = 0; x < full.width; ++x) {
@@ -203,6 +222,15 @@ public:
         const PassContext c = context();
         const PyrLevel parent = plan_.level(parent_level);
         const PyrLevel child = plan_.level(parent_level + 1);
+        if (simd_ != nullptr) {
+            rows(parent.height, [&](size_t y) {
+                const size_t cy = 2 * y;
+                const std::uint8_t* top =
+                    cy + 1 < child.height ? mask_.data() + child.offset + cy * child.width : nullptr;
+                simd_->mip_row(top, child.width, parent.width, mask_.data() + parent.offset + y * parent.width);
+            });
+            return;
+        }
         rows(parent.height, [&](size_t y) {
             std::uint8_t* out = mask_.data() + parent.offset + y * parent.width;
             for (uint32_t x = 0; x < parent.width; ++x)
@@ -522,8 +550,8 @@ private:
     std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)
     DepthView depth_{};                          // a depth frame, as the caller has it
     const core::DepthTables* depth_tables_ = nullptr;
-    std::vector<float> depth_points_;  // its back-projection (depth frames only)
-    std::vector<QuantPixel> quant_;
+    std::vector<float> depth_points_;       // its back-projection (depth frames only)
+    std::vector<uint32_t> quant_;           // kQuantWords per pixel
     std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
     std::vector<std::uint8_t> mask_;        // all levels
     std::vector<uint32_t> labels_;          // all levels
@@ -531,6 +559,9 @@ private:
     std::vector<uint32_t> parent_;          // union-find scratch
     std::vector<uint32_t> best_;
     std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
+    // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
+    // functions pixel by pixel.
+    const simd::RowKernels* simd_;
     bool sweeps_;
     uint32_t segment_count_ = 0;
     uint32_t fill_rounds_ = 0;
@@ -548,7 +579,7 @@ size_t physical_memory_bytes() {
 // Bytes a CpuExecutor allocates (estimated normals counted: they are allocated on the first frame without normals).
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
-    return pixels * (sizeof(QuantPixel) + 1 + 3 * sizeof(float)) +  // quantized pixels, mask validity, normals
+    return pixels * (kQuantWords * sizeof(uint32_t) + 1 + 3 * sizeof(float)) +             // quant, validity, normals
            size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +         // masks, labels
            (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                               // compaction table
            2 * fill_scratch_size(plan) * sizeof(uint32_t) +                                // union-find

@@ -3,6 +3,7 @@
 // the backend's buffers through a PassContext. They live in their own namespace so that another backend's
 // host-compiled copy with other accessors can never collide with them.
 #include <atomic>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 
@@ -10,17 +11,29 @@
 
 namespace pyrseg::cpu {
 
-struct QuantPixel {
-    std::int16_t q[3];  // qn, |q| <= 8192
-    std::uint16_t valid;
-    float z;
-};
+// A quantized pixel (contract section 2) is kQuantWords words of the quant buffer, which the vector passes
+// (backends/cpu/simd/) read and write as they are: qx | qy << 16 and qz | valid << 16 (16-bit two's complement
+// halves: |q| <= 8192, valid is 0 or 1), then the bits of z.
+inline constexpr std::size_t kQuantWords = 3;
+
+inline void store_quant(std::uint32_t* words, std::int32_t qx, std::int32_t qy, std::int32_t qz, std::uint32_t valid,
+                        float z) {
+    words[0] = (static_cast<std::uint32_t>(qx) & 0xffffu) | (static_cast<std::uint32_t>(qy) << 16);
+    words[1] = (static_cast<std::uint32_t>(qz) & 0xffffu) | (valid << 16);
+    words[2] = std::bit_cast<std::uint32_t>(z);
+}
+
+// Component c (0, 1, 2) of qn of pixel i.
+inline std::int32_t quant_component(const std::uint32_t* quant, std::size_t i, int c) {
+    const std::uint32_t word = quant[kQuantWords * i + std::size_t(c >> 1)];
+    return static_cast<std::int16_t>((c & 1) != 0 ? word >> 16 : word & 0xffffu);
+}
 
 struct PassContext {
-    const float* points = nullptr;  // the caller's cloud, strided
-    std::size_t row_floats = 0;     // from one row to the next
-    std::size_t point_floats = 3;   // from one point to the next
-    const QuantPixel* quant = nullptr;
+    const float* points = nullptr;             // the caller's cloud, strided
+    std::size_t row_floats = 0;                // from one row to the next
+    std::size_t point_floats = 3;              // from one point to the next
+    const std::uint32_t* quant = nullptr;      // kQuantWords per pixel
     const std::uint8_t* mask_valid = nullptr;  // a caller's mask's validity, else null (validity is in quant)
     std::uint8_t* mask = nullptr;              // all levels
     std::uint32_t* labels = nullptr;           // all levels
@@ -42,16 +55,16 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_CTX_ARG ctx
 #define PYR_PT(x, y, c) \
     (ctx.points[static_cast<std::size_t>(y) * ctx.row_floats + static_cast<std::size_t>(x) * ctx.point_floats + (c)])
-#define PYR_Q_VALID(i) static_cast<std::uint32_t>(ctx.quant[i].valid)
-#define PYR_QN(i, c) static_cast<std::int32_t>(ctx.quant[i].q[c])
-#define PYR_QZ(i) (ctx.quant[i].z)
+#define PYR_Q_VALID(i) (ctx.quant[::pyrseg::cpu::kQuantWords * static_cast<std::size_t>(i) + 1] >> 16)
+#define PYR_QN(i, c) ::pyrseg::cpu::quant_component(ctx.quant, static_cast<std::size_t>(i), (c))
+#define PYR_QZ(i) std::bit_cast<float>(ctx.quant[::pyrseg::cpu::kQuantWords * static_cast<std::size_t>(i) + 2])
 // The robust normals read the texels estimate_normals computed once per frame (w: the image width, named by the
 // function it expands in).
 #define PYR_ROBUST_TEXEL(jx, jy) (ctx.robust_texels[static_cast<std::size_t>(jy) * (w) + (jx)])
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
-#define PYR_VALID(p) static_cast<std::uint32_t>(ctx.mask_valid != nullptr ? ctx.mask_valid[p] : ctx.quant[p].valid)
+#define PYR_VALID(p) static_cast<std::uint32_t>(ctx.mask_valid != nullptr ? ctx.mask_valid[p] : PYR_Q_VALID(p))
 #define PYR_LUT(l) (ctx.lut[l])
 #define PYR_STATS_ADD(w, v) std::atomic_ref<std::uint32_t>(ctx.stats[w]).fetch_add((v), std::memory_order_relaxed)
 #define PYR_STATS_MAX(w, v) ::pyrseg::cpu::atomic_max(ctx.stats[w], (v))

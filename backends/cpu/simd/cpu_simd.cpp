@@ -1,0 +1,637 @@
+// The CPU backend's vector row passes (cpu_simd.hpp), compiled once per Highway target: foreach_target.h includes
+// this file again for each target, with HWY_NAMESPACE naming that target's namespace, and HWY_EXPORT /
+// HWY_DYNAMIC_DISPATCH pick the best one at run time.
+//
+// Bit-identity with the shared scalar functions (shaders/pyr_*.h), which every backend and the reference match:
+//  - every float operation is the scalar code's: IEEE add, sub, mul, div and sqrt are correctly rounded on every
+//    Highway target; no MulAdd (the project compiles with -ffp-contract=off); Min/Max only where both operands are
+//    finite (they then equal the scalar code's comparisons); Round is round-half-to-even like nearbyint in the
+//    default rounding mode;
+//  - integer arithmetic is the scalar code's, in lanes of the same width; every bound the scalar code states (no
+//    int32 overflow) holds in every lane, including lanes whose result is thrown away (those are kept in range on
+//    purpose, so that Highway's one-lane target, which uses plain C++ integers, has no undefined behaviour);
+//  - the two operations with no exact vector instruction, pyr_isqrt and the division of pyr_unit_component, are
+//    computed as a float estimate proven to be within 1 of the exact integer result, then corrected by one integer
+//    comparison each way: the exact result, which is what the scalar code computes (the proofs are at
+//    isqrt_floor and unit_component below);
+//  - pixels whose neighbour tests differ from the interior's (image borders) call the shared scalar function;
+//  - subnormals are IEEE on every target used (x86 without FTZ/DAZ, AArch64 NEON and SVE with FPCR.FZ clear, as
+//    Linux starts processes); 32-bit Arm NEON, which flushes them, is left out (registry below).
+// tests/unit/test_cpu_simd.cpp checks every target this CPU runs against the scalar functions and the reference.
+#include "backends/cpu/simd/cpu_simd.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "backends/cpu/cpu_kernels.hpp"
+#include "pyrseg/error.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "backends/cpu/simd/cpu_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+// (foreach_target.h must come before highway.h)
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace pyrseg::cpu::simd {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
+using MI = hn::Mask<DI>;
+
+// The most lanes of any vector here; buffers on the stack are sized with it.
+constexpr std::size_t kMaxLanes = hn::MaxLanes(DF());
+
+// ---- Loads
+
+// Components 0, 1, 2 of n = Lanes(df) points, the first at p, each `stride` floats after the one before.
+HWY_INLINE void load_points(DF df, const float* HWY_RESTRICT p, std::size_t stride, VF& x, VF& y, VF& z) {
+    if (stride == 3) {
+        hn::LoadInterleaved3(df, p, x, y, z);
+        return;
+    }
+    // Any other layout (PCL's padded points, interleaved normals, byte steps): lane by lane. Only the three floats
+    // of each point are read, never a padding float past the last point of a row.
+    HWY_ALIGN float buffer[3][kMaxLanes];
+    const std::size_t n = hn::Lanes(df);
+    for (std::size_t i = 0; i < n; ++i) {
+        buffer[0][i] = p[i * stride];
+        buffer[1][i] = p[i * stride + 1];
+        buffer[2][i] = p[i * stride + 2];
+    }
+    x = hn::Load(df, buffer[0]);
+    y = hn::Load(df, buffer[1]);
+    z = hn::Load(df, buffer[2]);
+}
+
+// ---- Validity (shaders/pyr_validity.h), on the float bit patterns
+
+HWY_INLINE MI is_finite(VI bits) {
+    const DI di;
+    const VI exponent_field = hn::Set(di, 0x7f800000);
+    return hn::Ne(hn::And(bits, exponent_field), exponent_field);  // (bits >> 23) & 255 != 255
+}
+
+HWY_INLINE MI point_valid(VF x, VF y, VF z) {
+    const DI di;
+    const VI bz = hn::BitCast(di, z);
+    return hn::And(hn::And(is_finite(hn::BitCast(di, x)), is_finite(hn::BitCast(di, y))),
+                   hn::And(is_finite(bz), hn::Gt(bz, hn::Zero(di))));
+}
+
+HWY_INLINE MI normal_valid(VF x, VF y, VF z) {
+    const DI di;
+    const VI bx = hn::BitCast(di, x);
+    const VI by = hn::BitCast(di, y);
+    const VI bz = hn::BitCast(di, z);
+    const VI magnitudes = hn::And(hn::Or(hn::Or(bx, by), bz), hn::Set(di, 0x7fffffff));
+    return hn::And(hn::And(is_finite(bx), is_finite(by)), hn::And(is_finite(bz), hn::Ne(magnitudes, hn::Zero(di))));
+}
+
+// ---- The normals (shaders/pyr_normals.h)
+// Triples of vectors are out-parameters, not structs: SVE's sizeless vectors cannot be members or array elements.
+
+// pyr_fixed_exponent: the exponent field, 0 for 255.
+HWY_INLINE VI fixed_exponent(VI bits) {
+    const DI di;
+    const VI e = hn::And(hn::ShiftRight<23>(bits), hn::Set(di, 255));
+    return hn::IfThenZeroElse(hn::Eq(e, hn::Set(di, 255)), e);
+}
+
+// pyr_fixed_component. The shift 9 + max_exponent - e is at least 9 where it is used; it is clamped to 0..31
+// (past 31 the 24-bit magnitude shifts to 0, as the scalar code's `shift > 31` returns, and lanes where it is not
+// used must not shift by a negative or too large count).
+HWY_INLINE VI fixed_component(VI bits, VI max_exponent) {
+    const DI di;
+    const DU du;
+    const VI e = hn::And(hn::ShiftRight<23>(bits), hn::Set(di, 255));
+    const MI zero = hn::Or(hn::Eq(e, hn::Zero(di)), hn::Eq(e, hn::Set(di, 255)));
+    const VI shift = hn::Min(hn::Max(hn::Sub(hn::Add(hn::Set(di, 9), max_exponent), e), hn::Zero(di)), hn::Set(di, 31));
+    const VU significand = hn::BitCast(du, hn::Or(hn::And(bits, hn::Set(di, 0x7fffff)), hn::Set(di, 0x800000)));
+    const VI magnitude = hn::BitCast(di, hn::Shr(significand, hn::BitCast(du, shift)));
+    const VI signed_magnitude = hn::IfThenElse(hn::Lt(bits, hn::Zero(di)), hn::Neg(magnitude), magnitude);
+    return hn::IfThenZeroElse(zero, signed_magnitude);
+}
+
+// pyr_to_fixed: each |component| < 2^15, whatever the input.
+HWY_INLINE void to_fixed(VF x, VF y, VF z, VI& fx, VI& fy, VI& fz) {
+    const DI di;
+    const VI bx = hn::BitCast(di, x);
+    const VI by = hn::BitCast(di, y);
+    const VI bz = hn::BitCast(di, z);
+    const VI e = hn::Max(hn::Max(fixed_exponent(bx), fixed_exponent(by)), fixed_exponent(bz));
+    fx = fixed_component(bx, e);
+    fy = fixed_component(by, e);
+    fz = fixed_component(bz, e);
+}
+
+// PYR_MSB(m) for 1 <= m < 2^31: the exponent of float(m), less one where rounding to float carried into the next
+// power of two (m then has no bit at that position).
+HWY_INLINE VI msb(VI m) {
+    const DF df;
+    const DI di;
+    const DU du;
+    const VI e = hn::Sub(hn::ShiftRight<23>(hn::BitCast(di, hn::ConvertTo(df, m))), hn::Set(di, 127));  // 0..31
+    const MI carried = hn::RebindMask(di, hn::Eq(hn::Shr(hn::BitCast(du, m), hn::BitCast(du, e)), hn::Zero(du)));
+    return hn::IfThenElse(carried, hn::Sub(e, hn::Set(di, 1)), e);
+}
+
+// pyr_shift_magnitude for -14 <= s <= 16 and |v| < 2^31 (|v| < 2^14 where s < 0).
+HWY_INLINE VI shift_magnitude(VI v, VI s) {
+    const DI di;
+    const DU du;
+    const VU a = hn::BitCast(du, hn::Abs(v));
+    const VU right = hn::BitCast(du, hn::Max(s, hn::Zero(di)));
+    const VU left = hn::BitCast(du, hn::Max(hn::Neg(s), hn::Zero(di)));
+    const VI m = hn::BitCast(di, hn::Shr(hn::Shl(a, left), right));  // one of the two shifts is by 0
+    return hn::IfThenElse(hn::Lt(v, hn::Zero(di)), hn::Neg(m), m);
+}
+
+// pyr_isqrt(n) = floor(sqrt(n)), for 2^28 <= n < 3 * 2^30 (the range of pyr_unit_normal_from_tangents: the largest
+// |d| has its top bit at 14, so 2^28 <= n <= 3 * (2^15 - 1)^2).
+// Estimate: t = n >> 2 < 3 * 2^28 converts from int32; e = 2 * sqrt(float(t)). float(t) and sqrt each round with
+// relative error <= 2^-24 (the * 2 is exact), so e = 2 sqrt(t) (1 + h) with |h| < 2^-23, and
+// 0 <= sqrt(n) - 2 sqrt(t) = (n - 4t) / (sqrt(n) + 2 sqrt(t)) <= 3 / 2^15. Hence |e - sqrt(n)| < 2^-13 + 2^16 * 2^-23
+// < 1/100, and the truncation r0 of e is floor(sqrt(n)) - 1, floor(sqrt(n)) or floor(sqrt(n)) + 1. One step down
+// where r^2 > n, then one step up where (r + 1)^2 <= n, leave exactly floor(sqrt(n)), the value the scalar loops
+// reach. Every square is below (2^16 - 1)^2 < 2^32 (sqrt(n) < 56756), so the uint32 products and comparisons are exact.
+// (Checked exhaustively too, over every n of the range: r0 is 1 above in 4862366 cases and never below, so the
+// upward step, kept for the argument above, never changes a result.)
+HWY_INLINE VU isqrt_floor(VU n) {
+    const DF df;
+    const DI di;
+    const DU du;
+    const VF t = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<2>(n)));
+    const VF e = hn::Mul(hn::Sqrt(t), hn::Set(df, 2.0f));
+    VU r = hn::BitCast(du, hn::ConvertTo(di, e));  // truncation, e >= 0
+    const VU one = hn::Set(du, 1u);
+    r = hn::IfThenElse(hn::Gt(hn::Mul(r, r), n), hn::Sub(r, one), r);
+    const VU r1 = hn::Add(r, one);
+    return hn::IfThenElse(hn::Gt(hn::Mul(r1, r1), n), r, r1);  // (integer <= is not in every target)
+}
+
+// pyr_unit_component: q = floor(a / b) with a = (|d| << 14) + len and b = 2 len, sign of d, for 2^14 <= len and
+// |d| <= len < 2^16 (len = isqrt(n) above; |d| <= len since d^2 <= n).
+// Then a < 2^30 (exact in int32), 2^15 <= b < 2^17 (exact in float) and a / b = 8192 |d| / len + 1/2 <= 8192.5.
+// Estimate: e = float(a) / float(b); float(a) and the division each round with relative error <= 2^-24, so
+// |e - a/b| <= 8192.5 * (2^-23 + 2^-48) < 1/1000, and the truncation q0 of e is q - 1, q or q + 1. One step down
+// where q0 * b > a, then one step up where (q0 + 1) * b <= a, leave exactly q = floor(a / b), the scalar code's
+// integer division. The products are at most 8194 * 2^17 < 2^31. (Checked exhaustively too, over every len and |d|
+// of the range: the estimate is never more than 1 away; it is 1 below in 777 and 1 above in 161717 of the
+// 1188732928 cases, so both steps are needed.)
+HWY_INLINE VI unit_component(VI d, VI len) {
+    const DF df;
+    const DI di;
+    const VI a = hn::Add(hn::ShiftLeft<14>(hn::Abs(d)), len);
+    const VI b = hn::Add(len, len);
+    const VF e = hn::Div(hn::ConvertTo(df, a), hn::ConvertTo(df, b));
+    VI q = hn::ConvertTo(di, e);  // truncation, e >= 0
+    const VI one = hn::Set(di, 1);
+    q = hn::IfThenElse(hn::Gt(hn::Mul(q, b), a), hn::Sub(q, one), q);
+    const VI q1 = hn::Add(q, one);
+    q = hn::IfThenElse(hn::Gt(hn::Mul(q1, b), a), q, q1);
+    return hn::IfThenElse(hn::Lt(d, hn::Zero(di)), hn::Neg(q), q);
+}
+
+// pyr_unit_normal_from_tangents; `defined` clear where the scalar code returns (0, 0, 0) before it gets here.
+HWY_INLINE void unit_normal(VI ux, VI uy, VI uz, VI vx, VI vy, VI vz, VF px, VF py, VF pz, MI defined, VI& qx, VI& qy,
+                            VI& qz) {
+    const DI di;
+    const DU du;
+    // |u|, |v| < 2^15: each product < 2^30, each difference < 2^31.
+    const VI cx = hn::Sub(hn::Mul(uy, vz), hn::Mul(uz, vy));
+    const VI cy = hn::Sub(hn::Mul(uz, vx), hn::Mul(ux, vz));
+    const VI cz = hn::Sub(hn::Mul(ux, vy), hn::Mul(uy, vx));
+    const VI m = hn::Max(hn::Max(hn::Abs(cx), hn::Abs(cy)), hn::Abs(cz));
+    const MI some = hn::And(defined, hn::Gt(m, hn::Zero(di)));
+    // Lanes with m == 0 give (0, 0, 0); they compute with m = 1 (then d = 0, len = 0, taken as 1 below) so that
+    // no lane shifts by an out-of-range count or divides by zero.
+    const VI s = hn::Sub(msb(hn::Max(m, hn::Set(di, 1))), hn::Set(di, 14));
+    const VI dx = shift_magnitude(cx, s);
+    const VI dy = shift_magnitude(cy, s);
+    const VI dz = shift_magnitude(cz, s);
+    const VU n = hn::Add(hn::Add(hn::BitCast(du, hn::Mul(dx, dx)), hn::BitCast(du, hn::Mul(dy, dy))),
+                         hn::BitCast(du, hn::Mul(dz, dz)));
+    const VI len = hn::Max(hn::BitCast(di, isqrt_floor(n)), hn::Set(di, 1));
+    const VI ex = unit_component(dx, len);
+    const VI ey = unit_component(dy, len);
+    const VI ez = unit_component(dz, len);
+    // Toward the camera: q . F(P) < 0 (|q| <= 2^13, |F(P)| < 2^15: the dot fits int32).
+    VI fx, fy, fz;  // NOLINT(readability-isolate-declaration)
+    to_fixed(px, py, pz, fx, fy, fz);
+    const VI dot = hn::Add(hn::Add(hn::Mul(ex, fx), hn::Mul(ey, fy)), hn::Mul(ez, fz));
+    const MI flip = hn::Gt(dot, hn::Zero(di));
+    qx = hn::IfThenElseZero(some, hn::IfThenElse(flip, hn::Neg(ex), ex));
+    qy = hn::IfThenElseZero(some, hn::IfThenElse(flip, hn::Neg(ey), ey));
+    qz = hn::IfThenElseZero(some, hn::IfThenElse(flip, hn::Neg(ez), ez));
+}
+
+void store_normal(const PyrIVec3& q, float* out) {
+    out[0] = float(q.x) * PYR_NORMAL_UNIT;
+    out[1] = float(q.y) * PYR_NORMAL_UNIT;
+    out[2] = float(q.z) * PYR_NORMAL_UNIT;
+}
+
+// pyr_normal_q for the pixels x .. x + n - 1 of row y, all with both horizontal neighbours inside the image.
+// up / down: the rows y - r / y + r, or row y itself where that row is outside the image (has_up / has_down clear).
+HWY_INLINE void normals_vector(const float* row, const float* up, const float* down, std::size_t pf, std::size_t x,
+                               std::size_t r, MI has_up_row, MI has_down_row, float* out) {
+    const DF df;
+    VF cx, cy, cz, rx, ry, rz, lx, ly, lz, ux, uy, uz, dx, dy, dz;  // NOLINT(readability-isolate-declaration)
+    load_points(df, row + x * pf, pf, cx, cy, cz);
+    load_points(df, row + (x + r) * pf, pf, rx, ry, rz);
+    load_points(df, row + (x - r) * pf, pf, lx, ly, lz);
+    load_points(df, up + x * pf, pf, ux, uy, uz);
+    load_points(df, down + x * pf, pf, dx, dy, dz);
+    const MI has_right = point_valid(rx, ry, rz);
+    const MI has_left = point_valid(lx, ly, lz);
+    const MI has_up = hn::And(has_up_row, point_valid(ux, uy, uz));
+    const MI has_down = hn::And(has_down_row, point_valid(dx, dy, dz));
+    const MI defined = hn::And(point_valid(cx, cy, cz), hn::And(hn::Or(has_right, has_left), hn::Or(has_down, has_up)));
+    // u = P(xa) - P(xb), v = P(ya) - P(yb): the neighbour where it is valid, else the pixel itself.
+    const auto right = hn::RebindMask(df, has_right);
+    const auto left = hn::RebindMask(df, has_left);
+    const auto below = hn::RebindMask(df, has_down);
+    const auto above = hn::RebindMask(df, has_up);
+    VI fux, fuy, fuz, fvx, fvy, fvz;  // NOLINT(readability-isolate-declaration)
+    to_fixed(hn::Sub(hn::IfThenElse(right, rx, cx), hn::IfThenElse(left, lx, cx)),
+             hn::Sub(hn::IfThenElse(right, ry, cy), hn::IfThenElse(left, ly, cy)),
+             hn::Sub(hn::IfThenElse(right, rz, cz), hn::IfThenElse(left, lz, cz)), fux, fuy, fuz);
+    to_fixed(hn::Sub(hn::IfThenElse(below, dx, cx), hn::IfThenElse(above, ux, cx)),
+             hn::Sub(hn::IfThenElse(below, dy, cy), hn::IfThenElse(above, uy, cy)),
+             hn::Sub(hn::IfThenElse(below, dz, cz), hn::IfThenElse(above, uz, cz)), fvx, fvy, fvz);
+    VI qx, qy, qz;  // NOLINT(readability-isolate-declaration)
+    unit_normal(fux, fuy, fuz, fvx, fvy, fvz, cx, cy, cz, defined, qx, qy, qz);
+    const VF unit = hn::Set(df, PYR_NORMAL_UNIT);
+    hn::StoreInterleaved3(hn::Mul(hn::ConvertTo(df, qx), unit), hn::Mul(hn::ConvertTo(df, qy), unit),
+                          hn::Mul(hn::ConvertTo(df, qz), unit), df, out + 3 * x);
+}
+
+void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* out) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    const auto scalar = [&](std::uint32_t x) {
+        store_normal(kernels::pyr_normal_q(c, w, h, x, y, r), out + 3 * std::size_t(x));
+    };
+    // Pixels r .. w - r - 1 have both horizontal neighbours; the others are the scalar code's.
+    if (std::size_t(w) < 2 * std::size_t(r) + n) {
+        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
+        return;
+    }
+    const std::uint32_t x_end = w - r;
+    for (std::uint32_t x = 0; x < r; ++x) scalar(x);
+    for (std::uint32_t x = x_end; x < w; ++x) scalar(x);
+    const std::size_t pf = c.point_floats;
+    const float* row = c.points + std::size_t(y) * c.row_floats;
+    const bool up_exists = y >= r;
+    const bool down_exists = std::size_t(y) + r < h;
+    const float* up = up_exists ? row - std::size_t(r) * c.row_floats : row;
+    const float* down = down_exists ? row + std::size_t(r) * c.row_floats : row;
+    const MI has_up_row = hn::Ne(hn::Set(di, up_exists ? 1 : 0), hn::Zero(di));
+    const MI has_down_row = hn::Ne(hn::Set(di, down_exists ? 1 : 0), hn::Zero(di));
+    // Whole vectors; the last one ends at x_end, overlapping the one before (the same bytes are written again).
+    for (std::size_t x = r;; x += n) {
+        x = std::min(x, std::size_t(x_end) - n);
+        normals_vector(row, up, down, pf, x, r, has_up_row, has_down_row, out);
+        if (x + n >= x_end) break;
+    }
+}
+
+// ---- Quantize (shaders/pyr_quantize.h)
+
+// pyr_quantize_component for finite n: clamp to [-1, 1] (Min/Max equal the scalar comparisons for finite n), the
+// exact product by 2^13, rounded half to even.
+HWY_INLINE VI quantize_component(VF n) {
+    const DF df;
+    const DI di;
+    const VF clamped = hn::Min(hn::Max(n, hn::Set(df, -1.0f)), hn::Set(df, 1.0f));
+    return hn::ConvertTo(di, hn::Round(hn::Mul(clamped, hn::Set(df, PYR_NORMAL_SCALE))));
+}
+
+void quantize_row(const float* points, std::size_t point_floats, const float* normals, std::size_t normal_floats,
+                  std::uint32_t w, std::uint32_t* out) {
+    const DF df;
+    const DI di;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    if (w < n) {
+        for (std::size_t x = 0; x < w; ++x) {
+            const float* p = points + x * point_floats;
+            const float* q = normals + x * normal_floats;
+            const PyrQuant v = kernels::pyr_quantize(p[0], p[1], p[2], q[0], q[1], q[2]);
+            store_quant(out + kQuantWords * x, v.qx, v.qy, v.qz, v.valid, p[2]);
+        }
+        return;
+    }
+    const VI low = hn::Set(di, 0xffff);
+    for (std::size_t x = 0;; x += n) {
+        x = std::min(x, std::size_t(w) - n);
+        VF px, py, pz, nx, ny, nz;  // NOLINT(readability-isolate-declaration)
+        load_points(df, points + x * point_floats, point_floats, px, py, pz);
+        load_points(df, normals + x * normal_floats, normal_floats, nx, ny, nz);
+        const MI valid = hn::And(point_valid(px, py, pz), normal_valid(nx, ny, nz));
+        // Only valid lanes are converted in the scalar code; the others are 0 here too.
+        const VI qx = hn::IfThenElseZero(valid, quantize_component(nx));
+        const VI qy = hn::IfThenElseZero(valid, quantize_component(ny));
+        const VI qz = hn::IfThenElseZero(valid, quantize_component(nz));
+        const VI valid16 = hn::IfThenElseZero(valid, hn::Set(di, 1 << 16));
+        // store_quant's words.
+        const VU w0 = hn::BitCast(du, hn::Or(hn::And(qx, low), hn::ShiftLeft<16>(qy)));
+        const VU w1 = hn::BitCast(du, hn::Or(hn::And(qz, low), valid16));
+        hn::StoreInterleaved3(w0, w1, hn::BitCast(du, pz), du, out + kQuantWords * x);
+        if (x + n >= w) break;
+    }
+}
+
+// ---- The paper metric (shaders/pyr_metric.h)
+//
+// Per pixel the scalar code sums qn . qn_j over the valid 8-neighbours j and takes the smallest and largest |z - z_j|.
+// The sum is computed as qn . (sum of the valid neighbours' qn): the same integer, as integer arithmetic is exact
+// and no partial sum overflows (|sum of qn_j| <= 8 * 2^13, so each product is below 2^29 and their sum below 2^31).
+// The neighbours' sums come from column sums (three rows) of qn masked by validity: the 3 x 3 box less the pixel.
+// A row is handled in chunks: its three quant rows are unpacked, per pixel, into column sums, the middle row's qn,
+// and each row's depth and validity.
+
+// Pixels per chunk (with one more on either side).
+constexpr std::size_t kMetricChunk = 128;
+constexpr std::size_t kMetricSpan = kMetricChunk + 2;
+
+// The n quantized pixels whose words start at `words` (store_quant): qn (0 where not valid), validity (-1 where
+// valid, else 0) and depth.
+HWY_INLINE void load_quant(const std::uint32_t* words, VI& qx, VI& qy, VI& qz, VI& valid, VF& z) {
+    const DF df;
+    const DI di;
+    const DU du;
+    VU w0, w1, w2;  // NOLINT(readability-isolate-declaration)
+    hn::LoadInterleaved3(du, words, w0, w1, w2);
+    const VI i0 = hn::BitCast(di, w0);
+    const VI i1 = hn::BitCast(di, w1);
+    const MI is_valid = hn::RebindMask(di, hn::Ne(hn::ShiftRight<16>(w1), hn::Zero(du)));
+    qx = hn::IfThenElseZero(is_valid, hn::ShiftRight<16>(hn::ShiftLeft<16>(i0)));  // sign-extended halves
+    qy = hn::IfThenElseZero(is_valid, hn::ShiftRight<16>(i0));
+    qz = hn::IfThenElseZero(is_valid, hn::ShiftRight<16>(hn::ShiftLeft<16>(i1)));
+    valid = hn::VecFromMask(di, is_valid);
+    z = hn::BitCast(df, w2);
+}
+
+// One chunk of a row, unpacked. Index i is the pixel begin - 1 + i.
+struct MetricChunk {
+    HWY_ALIGN std::int32_t column[4][kMetricSpan];  // column sums of qx, qy, qz (masked) and of validity (-count)
+    HWY_ALIGN std::int32_t middle[4][kMetricSpan];  // the middle row's qx, qy, qz (masked) and validity
+    HWY_ALIGN std::int32_t valid[3][kMetricSpan];   // each row's validity, -1 or 0
+    HWY_ALIGN float z[3][kMetricSpan];              // each row's depth
+};
+
+// pyr_metric_fillable for the pixels begin + i .. begin + i + n - 1, which have both horizontal neighbours.
+HWY_INLINE void metric_vector(const MetricChunk& m, const bool has_row[3], std::size_t i, std::int32_t tc, float dt,
+                              std::uint8_t* out) {
+    const DF df;
+    const DI di;
+    const hn::Rebind<std::uint8_t, DI> d8;
+    const std::size_t c = i + 1;  // the pixel itself
+    // The 3 x 3 box of field f less the pixel itself.
+    const auto neighbours = [&](int f) {
+        const VI box = hn::Add(hn::Add(hn::LoadU(di, m.column[f] + c - 1), hn::LoadU(di, m.column[f] + c)),
+                               hn::LoadU(di, m.column[f] + c + 1));
+        return hn::Sub(box, hn::LoadU(di, m.middle[f] + c));
+    };
+    const VI qx = hn::LoadU(di, m.middle[0] + c);
+    const VI qy = hn::LoadU(di, m.middle[1] + c);
+    const VI qz = hn::LoadU(di, m.middle[2] + c);
+    const VI s = hn::Add(hn::Add(hn::Mul(qx, neighbours(0)), hn::Mul(qy, neighbours(1))), hn::Mul(qz, neighbours(2)));
+    const VI k = hn::Neg(neighbours(3));  // 0..8
+    // Both depths are finite where both pixels are valid: |dz| is then finite and >= 0, and Min / Max are the scalar
+    // code's comparisons. Invalid neighbours leave dmin and dmax as they are.
+    const VF z = hn::LoadU(df, m.z[1] + c);
+    VF dmin = hn::Set(df, hwy::HighestValue<float>());
+    VF dmax = hn::Zero(df);
+    for (int row = 0; row < 3; ++row) {
+        if (!has_row[row]) continue;
+        for (std::size_t j = c - 1; j <= c + 1; ++j) {
+            if (row == 1 && j == c) continue;
+            const auto use = hn::MaskFromVec(hn::BitCast(df, hn::LoadU(di, m.valid[row] + j)));
+            const VF dd = hn::Abs(hn::Sub(z, hn::LoadU(df, m.z[row] + j)));
+            dmin = hn::IfThenElse(use, hn::Min(dmin, dd), dmin);
+            dmax = hn::IfThenElse(use, hn::Max(dmax, dd), dmax);
+        }
+    }
+    // k * tc fits int32: k <= 8, tc in [-2^28, 2^26].
+    const MI curvature_ok = hn::Not(hn::Lt(s, hn::Mul(k, hn::Set(di, tc))));
+    const MI depth_ok = hn::RebindMask(di, hn::Le(hn::Sub(dmax, dmin), hn::Set(df, dt)));
+    const MI center_valid = hn::Ne(hn::LoadU(di, m.middle[3] + c), hn::Zero(di));
+    const MI fillable = hn::And(hn::And(center_valid, hn::Gt(k, hn::Zero(di))), hn::And(curvature_ok, depth_ok));
+    hn::StoreU(hn::DemoteTo(d8, hn::IfThenElseZero(fillable, hn::Set(di, 1))), d8, out);
+}
+
+void metric_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::int32_t tc, float dt,
+                std::uint8_t* out) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    const auto scalar = [&](std::uint32_t x) {
+        out[x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+    };
+    if (std::size_t(w) < n + 2 || n > kMetricChunk) {
+        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
+        return;
+    }
+    scalar(0);
+    scalar(w - 1);
+    const bool has_row[3] = {y > 0, true, std::size_t(y) + 1 < h};
+    const std::uint32_t* source[3];
+    for (int k = 0; k < 3; ++k) {
+        source[k] = c.quant + kQuantWords * std::size_t(has_row[k] ? y - 1 + std::uint32_t(k) : y) * w;
+    }
+    // Scratch: each chunk writes every element it reads first (zeroing it would cost a pass over 10 KiB a row).
+    MetricChunk m;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+    // Pixels 1 .. w - 2 in chunks; a chunk narrower than a vector starts earlier (recomputing some pixels).
+    for (std::size_t x0 = 1; x0 < std::size_t(w) - 1; x0 += kMetricChunk) {
+        const std::size_t x1 = std::min(x0 + kMetricChunk, std::size_t(w) - 1);
+        const std::size_t begin = std::min(x0, x1 - n);
+        const std::size_t span = x1 - begin + 2;  // pixels begin - 1 .. x1
+        // Every store below is a function of the words at i only: the last, overlapping vector rewrites the same.
+        for (std::size_t i = 0;; i += n) {
+            i = std::min(i, span - n);
+            VI cx, cy, cz, cv, qx, qy, qz, valid;  // NOLINT(readability-isolate-declaration)
+            VF z;
+            load_quant(source[1] + kQuantWords * (begin - 1 + i), cx, cy, cz, cv, z);
+            hn::StoreU(cx, di, m.middle[0] + i);
+            hn::StoreU(cy, di, m.middle[1] + i);
+            hn::StoreU(cz, di, m.middle[2] + i);
+            hn::StoreU(cv, di, m.middle[3] + i);
+            hn::StoreU(cv, di, m.valid[1] + i);
+            hn::StoreU(z, df, m.z[1] + i);
+            for (int k = 0; k < 3; k += 2) {
+                if (!has_row[k]) continue;
+                load_quant(source[k] + kQuantWords * (begin - 1 + i), qx, qy, qz, valid, z);
+                cx = hn::Add(cx, qx);
+                cy = hn::Add(cy, qy);
+                cz = hn::Add(cz, qz);
+                cv = hn::Add(cv, valid);
+                hn::StoreU(valid, di, m.valid[k] + i);
+                hn::StoreU(z, df, m.z[k] + i);
+            }
+            hn::StoreU(cx, di, m.column[0] + i);
+            hn::StoreU(cy, di, m.column[1] + i);
+            hn::StoreU(cz, di, m.column[2] + i);
+            hn::StoreU(cv, di, m.column[3] + i);
+            if (i + n >= span) break;
+        }
+        for (std::size_t x = begin;; x += n) {
+            x = std::min(x, x1 - n);
+            metric_vector(m, has_row, x - begin, tc, dt, out + x);
+            if (x + n >= x1) break;
+        }
+    }
+}
+
+// ---- Mip (shaders/pyr_mip.h)
+
+void mip_row(const std::uint8_t* child_top, std::uint32_t child_width, std::uint32_t parent_width, std::uint8_t* out) {
+    if (child_top == nullptr) {
+        std::memset(out, 0, parent_width);
+        return;
+    }
+    const hn::ScalableTag<std::uint8_t> d8;
+    const std::size_t n = hn::Lanes(d8);
+    // Texels 0 .. full - 1 have both child columns; a texel past them (odd child width) is 0.
+    const std::size_t full = child_width / 2;
+    const std::uint8_t* bottom = child_top + child_width;
+    std::size_t done = 0;
+    if (full >= n) {
+        const auto one = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
+        for (std::size_t x = 0;; x += n) {
+            x = std::min(x, full - n);
+            hn::Vec<decltype(d8)> te, to, be, bo;  // NOLINT(readability-isolate-declaration)
+            hn::LoadInterleaved2(d8, child_top + 2 * x, te, to);
+            hn::LoadInterleaved2(d8, bottom + 2 * x, be, bo);
+            hn::StoreU(hn::And(hn::And(hn::And(te, to), hn::And(be, bo)), one), d8, out + x);
+            if (x + n >= full) break;
+        }
+        done = full;
+    }
+    for (std::size_t x = done; x < full; ++x) {
+        out[x] = std::uint8_t(child_top[2 * x] & child_top[2 * x + 1] & bottom[2 * x] & bottom[2 * x + 1] &
+                              PYR_MASK_FILLABLE);
+    }
+    for (std::size_t x = full; x < parent_width; ++x) out[x] = 0;
+}
+
+// This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
+constexpr RowKernels kKernels = {"", HWY_TARGET, &normals_row, &quantize_row, &metric_row, &mip_row};
+
+// Only returns the address of constant data; see available_targets.
+const RowKernels* get_kernels() {
+    return &kKernels;
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace pyrseg::cpu::simd
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace pyrseg::cpu::simd {
+
+HWY_EXPORT(get_kernels);
+
+namespace {
+
+std::string lower_name(std::int64_t target) {
+    if (target == HWY_SCALAR) return "hwy_scalar";  // "scalar" is the shared scalar functions
+    std::string name = hwy::TargetName(target);
+    for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return name;
+}
+
+struct Registry {
+    std::vector<RowKernels> kernels;  // best first
+    std::vector<std::string> names;   // the storage of kernels[i].name
+};
+
+// Every entry of the dispatch table that this CPU runs. Calling an entry only returns the address of its target's
+// constant table (no vector instruction), so entries are called before their target is known to be supported.
+const Registry& registry() {
+    static const Registry r = [] {
+        Registry out;
+        const std::int64_t supported = hwy::SupportedTargets();
+        for (const auto entry : HWY_DISPATCH_TABLE(get_kernels)) {
+            if (entry == nullptr) continue;
+            const RowKernels* k = entry();
+            if ((k->target & supported) == 0) continue;
+#if HWY_ARCH_ARM_V7
+            // 32-bit Arm's NEON flushes subnormal floats to zero: not the IEEE arithmetic the passes need.
+            if (k->target == HWY_NEON) continue;
+#endif
+            const bool seen = std::any_of(out.kernels.begin(), out.kernels.end(),
+                                          [&](const RowKernels& e) { return e.target == k->target; });
+            if (!seen) out.kernels.push_back(*k);
+        }
+        // Highway's better targets have the lower bits.
+        std::sort(out.kernels.begin(), out.kernels.end(),
+                  [](const RowKernels& a, const RowKernels& b) { return a.target < b.target; });
+        out.names.reserve(out.kernels.size());
+        for (RowKernels& k : out.kernels) {
+            out.names.push_back(lower_name(k.target));
+            k.name = out.names.back().c_str();
+        }
+        return out;
+    }();
+    return r;
+}
+
+const RowKernels* by_target(std::int64_t target) {
+    for (const RowKernels& k : registry().kernels) {
+        if (k.target == target) return &k;
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+std::vector<const RowKernels*> available_targets() {
+    std::vector<const RowKernels*> out;
+    for (const RowKernels& k : registry().kernels) out.push_back(&k);
+    return out;
+}
+
+std::vector<std::string> accepted_names() {
+    std::vector<std::string> out = {"scalar"};
+    for (const RowKernels& k : registry().kernels) out.emplace_back(k.name);
+    return out;
+}
+
+const RowKernels* kernels_from_environment() {
+    const char* env = std::getenv("PYRSEG_CPU_SIMD");
+    const std::string want = env == nullptr ? "" : env;
+    if (want == "scalar") return nullptr;
+    if (want.empty() || want == "auto") {
+        // Highway's own choice; it is always among the registry's (when not, or with none: the scalar path).
+        const RowKernels* best = by_target(HWY_DYNAMIC_DISPATCH(get_kernels)()->target);
+        if (best != nullptr || registry().kernels.empty()) return best;
+        return &registry().kernels.front();
+    }
+    for (const RowKernels& k : registry().kernels) {
+        if (want == k.name) return &k;
+    }
+    std::string names;
+    for (const std::string& name : accepted_names()) names += (names.empty() ? "" : ", ") + name;
+    throw Error(ErrorCode::invalid_argument,
+                "PYRSEG_CPU_SIMD=" + want + " names no vector target of this build that this CPU runs; use one of: " +
+                    names + " (or leave it unset for the best)");
+}
+
+}  // namespace pyrseg::cpu::simd
+#endif  // HWY_ONCE

@@ -1,0 +1,60 @@
+#pragma once
+// The CPU backend's per-pixel passes over whole rows with Google Highway vectors: the normals of the paper metric
+// (shaders/pyr_normals.h, pyr_normal_q), quantize (pyr_quantize.h), the paper metric (pyr_metric.h) and mip
+// (pyr_mip.h). Each row function computes, lane by lane, exactly the integer and float operations of the shared
+// scalar function (contraction off, no fused multiply-add, integer divisions and square roots exact: see
+// cpu_simd.cpp), and calls the shared function itself for the pixels where the neighbour tests differ (image
+// borders), so the bytes are those of the scalar path on every target.
+//
+// One binary holds every target Highway can build for the architecture (x86: SSSE3, SSE4, AVX2, AVX3 (AVX-512)
+// and Highway's one-lane scalar; Arm: NEON, SVE, SVE2) and picks the best one the CPU runs. The environment
+// variable PYRSEG_CPU_SIMD, read when a Segmenter is made, overrides that choice:
+//   PYRSEG_CPU_SIMD=scalar       the shared scalar functions one pixel at a time (no Highway at all);
+//   PYRSEG_CPU_SIMD=<target>     that Highway target, by its lower-case name ("avx2", "sse4", "neon", ...; Highway's
+//                                own one-lane target is "hwy_scalar"), if this build has it and this CPU runs it;
+//   unset, empty or "auto"       the best target this CPU runs.
+// Any other value makes the Segmenter's constructor throw pyrseg::Error (invalid_argument) listing the names
+// that would work here. The tests force each target in turn this way (tests/unit/test_cpu_simd.cpp).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pyrseg::cpu {
+struct PassContext;
+}  // namespace pyrseg::cpu
+
+namespace pyrseg::cpu::simd {
+
+// The row functions of one Highway target. Rows are independent: the passes call these from many threads.
+struct RowKernels {
+    const char* name = "";    // the PYRSEG_CPU_SIMD name
+    std::int64_t target = 0;  // Highway's HWY_* bit
+
+    // Row y of the paper metric's normals with radius r (pyr_normal_q): 3 * w floats, q * 2^-13, packed.
+    void (*normals_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
+                        float* out) = nullptr;
+    // One row of quantize (pyr_quantize): w pixels; points and normals each point_floats / normal_floats apart; out
+    // gets kQuantWords words a pixel (cpu_kernels.hpp).
+    void (*quantize_row)(const float* points, std::size_t point_floats, const float* normals, std::size_t normal_floats,
+                         std::uint32_t w, std::uint32_t* out) = nullptr;
+    // Row y of the paper metric (pyr_metric_fillable) over c.quant: w mask bytes, 1 where fillable.
+    void (*metric_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::int32_t tc,
+                       float dt, std::uint8_t* out) = nullptr;
+    // Row y of the level above a child level (pyr_mip_texel): parent_width bytes. child_top is the child's row 2y
+    // (nullptr when 2y + 1 is not a row of the child: the whole row is then 0).
+    void (*mip_row)(const std::uint8_t* child_top, std::uint32_t child_width, std::uint32_t parent_width,
+                    std::uint8_t* out) = nullptr;
+};
+
+// The targets of this build that this CPU runs, best first.
+[[nodiscard]] std::vector<const RowKernels*> available_targets();
+
+// What PYRSEG_CPU_SIMD asks for (see above): nullptr for "scalar", else the kernels to use. Throws pyrseg::Error
+// (invalid_argument) for a value that names nothing available here.
+[[nodiscard]] const RowKernels* kernels_from_environment();
+
+// The names PYRSEG_CPU_SIMD accepts here: "scalar", then the available targets, best first.
+[[nodiscard]] std::vector<std::string> accepted_names();
+
+}  // namespace pyrseg::cpu::simd

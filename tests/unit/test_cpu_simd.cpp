@@ -1,0 +1,665 @@
+// The CPU backend's vector row passes (backends/cpu/simd/): for every Highway target this build has and this CPU
+// runs, forced in turn with PYRSEG_CPU_SIMD, each row function gives the bytes of the shared scalar function on
+// adversarial inputs (special floats, extreme exponents, odd widths, strided layouts), and whole segmentations give
+// the normals, fillable mask and labels of the scalar path and of the independent reference.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/simd/cpu_simd.hpp"
+#include "pyrseg/error.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
+#include "support/oracle.hpp"
+
+namespace pyrseg::test {
+namespace {
+
+namespace simd = ::pyrseg::cpu::simd;
+namespace kernels = ::pyrseg::cpu::kernels;
+using ::pyrseg::cpu::kQuantWords;
+using ::pyrseg::cpu::PassContext;
+
+// A quantized pixel as the metric tests make them (stored with cpu::store_quant).
+struct QuantPixel {
+    std::int16_t q[3] = {0, 0, 0};
+    std::uint16_t valid = 0;
+    float z = 0;
+};
+
+std::vector<std::uint32_t> to_words(const std::vector<QuantPixel>& pixels) {
+    std::vector<std::uint32_t> words(kQuantWords * pixels.size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const QuantPixel& p = pixels[i];
+        ::pyrseg::cpu::store_quant(words.data() + kQuantWords * i, p.q[0], p.q[1], p.q[2], p.valid, p.z);
+    }
+    return words;
+}
+
+// PYRSEG_CPU_SIMD for the lifetime of the object (the executor reads it when a Segmenter is made).
+class ScopedSimd {
+public:
+    explicit ScopedSimd(const std::string& value) {
+        const char* old = std::getenv("PYRSEG_CPU_SIMD");
+        had_old_ = old != nullptr;
+        if (had_old_) old_ = old;
+        setenv("PYRSEG_CPU_SIMD", value.c_str(), 1);
+    }
+    ~ScopedSimd() {
+        if (had_old_) {
+            setenv("PYRSEG_CPU_SIMD", old_.c_str(), 1);
+        } else {
+            unsetenv("PYRSEG_CPU_SIMD");
+        }
+    }
+    ScopedSimd(const ScopedSimd&) = delete;
+    ScopedSimd& operator=(const ScopedSimd&) = delete;
+
+private:
+    bool had_old_ = false;
+    std::string old_;
+};
+
+std::vector<std::string> target_names() {
+    std::vector<std::string> names;
+    for (const simd::RowKernels* k : simd::available_targets()) names.emplace_back(k->name);
+    return names;
+}
+
+const simd::RowKernels& kernels_named(const std::string& name) {
+    for (const simd::RowKernels* k : simd::available_targets()) {
+        if (name == k->name) return *k;
+    }
+    throw std::runtime_error("no target " + name);
+}
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kDenorm = std::numeric_limits<float>::denorm_min();
+constexpr float kMin = std::numeric_limits<float>::min();
+constexpr float kMax = std::numeric_limits<float>::max();
+
+float from_bits(std::uint32_t bits) {
+    float f = 0;
+    std::memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+// A value that breaks something: non-finite, zero of either sign, subnormal, extreme, or random bits.
+float special_value(std::mt19937& rng) {
+    static const float kSpecial[] = {kNaN,    -kNaN,    kInf,   -kInf,  0.0f,   -0.0f, -1.0f, -1e30f,
+                                     kDenorm, -kDenorm, kMin,   -kMin,  1e-38f, kMax,  -kMax, 1e30f,
+                                     -1e-38f, 3e38f,    2e-45f, 1e-40f, 5e-39f, 1.0f,  -3e38f};
+    const std::uint32_t pick = rng() % (std::size(kSpecial) + 4);
+    if (pick < std::size(kSpecial)) return kSpecial[pick];
+    return from_bits(static_cast<std::uint32_t>(rng()));
+}
+
+// A smooth bumpy surface in front of the camera, times `scale`, with a fraction of components replaced by special
+// values and a few pixels by random bit patterns.
+std::vector<float> make_points(int w, int h, float scale, double special_fraction, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> noise(-0.5f, 0.5f);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<float> p(3 * std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            float* q = &p[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+            const float z = 1000.0f + 40.0f * std::sin(float(x) * 0.21f) * std::cos(float(y) * 0.17f) +
+                            (x > w / 2 ? 35.0f : 0.0f) + noise(rng);
+            q[0] = (float(x) - float(w) / 2) * 1.7f * scale;
+            q[1] = (float(y) - float(h) / 2) * 1.7f * scale;
+            q[2] = z * scale;
+            for (int c = 0; c < 3; ++c) {
+                if (unit(rng) < special_fraction) q[c] = special_value(rng);
+            }
+        }
+    }
+    return p;
+}
+
+// Normals of any length (given normals need not be unit), with special values mixed in.
+std::vector<float> make_normals(std::size_t pixels, double special_fraction, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> component(-1.3f, 1.3f);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::uniform_int_distribution<int> tie(-8193, 8193);
+    std::vector<float> n(3 * pixels);
+    for (float& v : n) {
+        const float u = unit(rng);
+        if (u < special_fraction) {
+            v = special_value(rng);
+        } else if (u < special_fraction + 0.1) {
+            v = (float(tie(rng)) + 0.5f) / 8192.0f;  // exactly half way between two quantized values
+        } else if (u < special_fraction + 0.15) {
+            v = float(tie(rng)) / 8192.0f;
+        } else {
+            v = component(rng);
+        }
+    }
+    return n;
+}
+
+// The first differing byte of two buffers, as "element i (pixel p, byte b)", or "" when equal.
+std::string first_difference(const void* a, const void* b, std::size_t bytes, std::size_t element_bytes) {
+    const auto* x = static_cast<const unsigned char*>(a);
+    const auto* y = static_cast<const unsigned char*>(b);
+    for (std::size_t i = 0; i < bytes; ++i) {
+        if (x[i] != y[i]) {
+            std::ostringstream s;
+            s << "element " << i / element_bytes << ", byte " << i % element_bytes << ": " << int(x[i]) << " vs "
+              << int(y[i]);
+            return s.str();
+        }
+    }
+    return "";
+}
+
+// A cloud in a given layout: point_floats floats a point, rows padded by `pad` points (filled with junk).
+struct Layout {
+    std::vector<float> floats;
+    std::size_t point_floats = 3;
+    std::size_t row_floats = 0;
+};
+
+Layout lay_out(const std::vector<float>& packed, int w, int h, std::size_t point_floats, std::size_t pad) {
+    Layout l;
+    l.point_floats = point_floats;
+    l.row_floats = (std::size_t(w) + pad) * point_floats;
+    l.floats.assign(l.row_floats * std::size_t(h), -777.0f);
+    for (std::size_t y = 0; y < std::size_t(h); ++y) {
+        for (std::size_t x = 0; x < std::size_t(w); ++x) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                l.floats[y * l.row_floats + x * point_floats + c] = packed[3 * (y * std::size_t(w) + x) + c];
+            }
+        }
+    }
+    return l;
+}
+
+struct Size {
+    int w, h;
+};
+const Size kSizes[] = {{1, 1},  {2, 3},  {3, 2},  {5, 7},  {7, 5},   {8, 3},   {9, 9},   {15, 4},  {16, 5},
+                       {17, 6}, {31, 3}, {33, 8}, {63, 4}, {65, 11}, {67, 45}, {131, 9}, {17, 40}, {1, 30}};
+
+class CpuSimdRows : public ::testing::TestWithParam<std::string> {};
+
+// pyr_normal_q, pixel by pixel, against the target's normals_row: every size, radius, scale and layout.
+TEST_P(CpuSimdRows, NormalsMatchTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::uint32_t seed = 1;
+    const float scales[] = {1.0f, 1e30f, 1e-38f, 1e-30f, 3e36f};
+    std::size_t defined = 0;
+    std::size_t pixels = 0;
+    for (const Size s : kSizes) {
+        for (const int r : {1, 2, 3, 5, 8, 40}) {
+            for (const float scale : scales) {
+                for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{7}}) {
+                    const double specials = seed % 3 == 0 ? 0.0 : 0.08;
+                    const std::vector<float> packed = make_points(s.w, s.h, scale, specials, seed++);
+                    const Layout l = lay_out(packed, s.w, s.h, pf, pf == 3 ? 0 : 5);
+                    PassContext c;
+                    c.points = l.floats.data();
+                    c.point_floats = l.point_floats;
+                    c.row_floats = l.row_floats;
+                    const auto w = std::uint32_t(s.w);
+                    const auto h = std::uint32_t(s.h);
+                    std::vector<float> expected(packed.size());
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        for (std::uint32_t x = 0; x < w; ++x) {
+                            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, std::uint32_t(r));
+                            float* n = &expected[3 * (std::size_t(y) * w + x)];
+                            n[0] = float(q.x) * PYR_NORMAL_UNIT;
+                            n[1] = float(q.y) * PYR_NORMAL_UNIT;
+                            n[2] = float(q.z) * PYR_NORMAL_UNIT;
+                            defined += (q.x | q.y | q.z) != 0 ? 1 : 0;
+                        }
+                    }
+                    pixels += std::size_t(w) * h;
+                    std::vector<float> actual(packed.size(), 99.0f);
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        k.normals_row(c, w, h, y, std::uint32_t(r), actual.data() + 3 * std::size_t(y) * w);
+                    }
+                    const std::string diff = first_difference(actual.data(), expected.data(),
+                                                              actual.size() * sizeof(float), 3 * sizeof(float));
+                    ASSERT_EQ(diff, "") << s.w << "x" << s.h << " r=" << r << " scale=" << scale << " stride=" << pf;
+                }
+            }
+        }
+    }
+    EXPECT_GT(defined, pixels / 4) << "too few pixels with a normal to test much";
+}
+
+// Tangents chosen in fixed point: rows 3k and 3k + 2 give v = P(x, 3k + 2) - P(x, 3k) freely, row 3k + 1 gives
+// u = P(x + 1) - P(x - 1) freely (a chain on each parity of x). Among them the cross products whose largest
+// component rounds up to the next power of two in float (2^30 - 1 = 32767 * 32769: u = (32767, -2, a),
+// v = (32767, 32767, b)), parallel tangents, tiny and huge ones.
+TEST_P(CpuSimdRows, NormalsOfCraftedTangentsMatchTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(21);
+    const std::uint32_t w = 70;
+    const std::uint32_t blocks = 60;
+    const std::uint32_t h = 3 * blocks;
+    std::vector<float> points(3 * std::size_t(w) * h);
+    const auto at = [&](std::uint32_t x, std::uint32_t y) { return &points[3 * (std::size_t(y) * w + x)]; };
+    std::uniform_int_distribution<int> big(-32767, 32767);
+    std::uniform_int_distribution<int> small(-9, 9);
+    std::uniform_int_distribution<int> medium(-16000, 16000);
+    for (std::uint32_t b = 0; b < blocks; ++b) {
+        const int kind = int(b % 4);  // 0: the carry case, 1: random, 2: small, 3: parallel
+        const auto draw = [&](int which) { return float(which == 2 ? small(rng) : big(rng)); };
+        float u[70][3];
+        float v[70][3];
+        for (std::uint32_t x = 0; x < w; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                u[x][c] = draw(kind);
+                v[x][c] = draw(kind);
+            }
+            if (kind == 0 || (kind == 1 && x % 5 == 0)) {
+                // |z| <= 16000 keeps 2^30 - 1 the largest component, and the others need all their bits.
+                const float cu[3] = {32767.0f, -2.0f, float(medium(rng))};
+                const float cv[3] = {32767.0f, 32767.0f, float(medium(rng))};
+                for (int c = 0; c < 3; ++c) {
+                    u[x][c] = (x % 2 == 0) ? cu[c] : -cu[c];
+                    v[x][c] = (x % 3 == 0) ? cv[c] : -cv[c];
+                }
+            }
+            if (kind == 3) {
+                for (int c = 0; c < 3; ++c) v[x][c] = u[x][c] * float(1 + x % 3);
+            }
+        }
+        for (std::uint32_t x = 0; x < w; ++x) {
+            float* top = at(x, 3 * b);
+            float* bottom = at(x, 3 * b + 2);
+            top[0] = 0.0f;
+            top[1] = 0.0f;
+            top[2] = 50000.0f;
+            for (int c = 0; c < 3; ++c) bottom[c] = top[c] + v[x][c];
+        }
+        // Row 3b + 1: P(x + 1) = P(x - 1) + u(x), from P(0) and P(1).
+        for (std::uint32_t x = 0; x < 2; ++x) {
+            float* p = at(x, 3 * b + 1);
+            p[0] = float(x);
+            p[1] = 0.0f;
+            p[2] = 4194304.0f;  // 2^22: stays positive and exact along the chain
+        }
+        for (std::uint32_t x = 1; x + 1 < w; ++x) {
+            const float* left = at(x - 1, 3 * b + 1);
+            float* right = at(x + 1, 3 * b + 1);
+            for (int c = 0; c < 3; ++c) right[c] = left[c] + u[x][c];
+        }
+    }
+    PassContext c;
+    c.points = points.data();
+    c.row_floats = 3 * std::size_t(w);
+    std::vector<float> expected(points.size());
+    std::vector<float> actual(points.size(), 99.0f);
+    int defined = 0;
+    for (std::uint32_t y = 0; y < h; ++y) {
+        for (std::uint32_t x = 0; x < w; ++x) {
+            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, 1);
+            float* n = &expected[3 * (std::size_t(y) * w + x)];
+            n[0] = float(q.x) * PYR_NORMAL_UNIT;
+            n[1] = float(q.y) * PYR_NORMAL_UNIT;
+            n[2] = float(q.z) * PYR_NORMAL_UNIT;
+            defined += (q.x | q.y | q.z) != 0 ? 1 : 0;
+        }
+        k.normals_row(c, w, h, y, 1, actual.data() + 3 * std::size_t(y) * w);
+    }
+    EXPECT_GT(defined, int(w * h / 2));
+    const std::string diff =
+        first_difference(actual.data(), expected.data(), actual.size() * sizeof(float), 3 * sizeof(float));
+    EXPECT_EQ(diff, "");
+}
+
+// pyr_quantize against quantize_row: special points and normals, ties, components past +-1, layouts.
+TEST_P(CpuSimdRows, QuantizeMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::uint32_t seed = 100;
+    for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 131, 1000}) {
+        for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{12}}) {
+            for (const std::size_t nf : {std::size_t{3}, std::size_t{5}}) {
+                const std::vector<float> points = make_points(w, 1, seed % 2 == 0 ? 1.0f : 1e-38f, 0.2, seed);
+                const std::vector<float> normals = make_normals(std::size_t(w), 0.2, seed + 7);
+                ++seed;
+                const Layout lp = lay_out(points, w, 1, pf, 0);
+                const Layout ln = lay_out(normals, w, 1, nf, 0);
+                std::vector<std::uint32_t> expected(kQuantWords * std::size_t(w), 0xabababab);
+                std::vector<std::uint32_t> actual(kQuantWords * std::size_t(w), 0xcdcdcdcd);
+                for (std::size_t x = 0; x < std::size_t(w); ++x) {
+                    const float* p = &lp.floats[x * pf];
+                    const float* n = &ln.floats[x * nf];
+                    const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                    ::pyrseg::cpu::store_quant(expected.data() + kQuantWords * x, q.qx, q.qy, q.qz, q.valid, p[2]);
+                }
+                k.quantize_row(lp.floats.data(), pf, ln.floats.data(), nf, std::uint32_t(w), actual.data());
+                const std::string diff =
+                    first_difference(actual.data(), expected.data(), actual.size() * sizeof(std::uint32_t),
+                                     kQuantWords * sizeof(std::uint32_t));
+                ASSERT_EQ(diff, "") << "width " << w << " point stride " << pf << " normal stride " << nf;
+            }
+        }
+    }
+}
+
+// pyr_metric_fillable against metric_row over a whole image; returns how many pixels are fillable.
+int check_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h, const std::vector<QuantPixel>& quant,
+                 std::int32_t tc, float dt) {
+    const std::vector<std::uint32_t> words = to_words(quant);
+    PassContext c;
+    c.quant = words.data();
+    std::vector<std::uint8_t> expected(quant.size());
+    std::vector<std::uint8_t> actual(quant.size(), 0x55);
+    int fillable = 0;
+    for (std::uint32_t y = 0; y < h; ++y) {
+        for (std::uint32_t x = 0; x < w; ++x) {
+            expected[std::size_t(y) * w + x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+            fillable += expected[std::size_t(y) * w + x];
+        }
+        k.metric_row(c, w, h, y, tc, dt, actual.data() + std::size_t(y) * w);
+    }
+    const std::string diff = first_difference(actual.data(), expected.data(), actual.size(), 1);
+    EXPECT_EQ(diff, "") << w << "x" << h << " tc=" << tc << " dt=" << dt;
+    return fillable;
+}
+
+// Random quantized pixels (random validity, qn, depths of every magnitude) and thresholds over their whole range.
+TEST_P(CpuSimdRows, MetricMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> qn(-8192, 8192);
+    std::uniform_int_distribution<int> near(-40, 40);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const std::int32_t tcs[] = {-268435456, 67108864, 0, 60000000, -5000000, 67100000};
+    const float dts[] = {0.0f, 1.0f, 5.0f, kDenorm, 1e-38f, 3e38f, 0.25f};
+    int round = 0;
+    int fillable = 0;
+    std::size_t pixels = 0;
+    for (const Size s : kSizes) {
+        for (const std::int32_t tc : tcs) {
+            const float dt = dts[std::size_t(round++) % std::size(dts)];
+            const auto w = std::uint32_t(s.w);
+            const auto h = std::uint32_t(s.h);
+            std::vector<QuantPixel> quant(std::size_t(w) * h);
+            const bool smooth = round % 2 == 0;  // nearly parallel normals, so that the curvature test passes too
+            for (QuantPixel& p : quant) {
+                p.valid = unit(rng) < 0.85f ? 1 : 0;
+                if (smooth) {
+                    p.q[0] = std::int16_t(near(rng));
+                    p.q[1] = std::int16_t(near(rng));
+                    p.q[2] = std::int16_t(-8150 + near(rng));
+                } else {
+                    for (std::int16_t& c : p.q) c = std::int16_t(qn(rng));
+                }
+                const float u = unit(rng);
+                p.z = u < 0.05f ? kDenorm * float(rng() % 1000)
+                                : (u < 0.1f ? 3e38f * unit(rng) : 1000.0f + 6.0f * unit(rng));
+                if (p.valid == 0 && u < 0.3f) p.z = kNaN;  // invalid pixels may hold anything
+            }
+            fillable += check_metric(k, w, h, quant, tc, dt);
+            pixels += quant.size();
+            if (::testing::Test::HasFailure()) return;
+        }
+    }
+    EXPECT_GT(fillable, int(pixels / 20)) << "too few fillable pixels to test much";
+    EXPECT_LT(fillable, int(pixels / 2)) << "too many fillable pixels to test much";
+}
+
+// The thresholds' ties: s == k * tc (fillable) and dmax - dmin == dt (fillable), on many pixels.
+TEST_P(CpuSimdRows, MetricTiesMatchTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const float depths[] = {1000.0f, 1001.0f, 1003.0f, 1000.5f};
+    for (const Size s : kSizes) {
+        const auto w = std::uint32_t(s.w);
+        const auto h = std::uint32_t(s.h);
+        std::vector<QuantPixel> quant(std::size_t(w) * h);
+        for (QuantPixel& p : quant) {
+            p.valid = unit(rng) < 0.9f ? 1 : 0;
+            p.q[0] = 0;
+            p.q[1] = std::int16_t(unit(rng) < 0.2f ? 1 : 0);
+            p.q[2] = -8150;
+            p.z = depths[rng() % std::size(depths)];
+        }
+        for (const float dt : {0.0f, 0.5f, 1.0f, 2.0f, 2.5f, 3.0f}) {
+            for (const std::int32_t tc : {8150 * 8150, 8150 * 8150 - 1, 8150 * 8150 + 1}) {
+                check_metric(k, w, h, quant, tc, dt);
+                if (::testing::Test::HasFailure()) return;
+            }
+        }
+    }
+}
+
+// pyr_mip_texel against mip_row, called as the CPU backend calls it, on random mask bytes (all bits set at random:
+// only bit 0 counts).
+TEST_P(CpuSimdRows, MipMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(9);
+    for (int cw = 1; cw <= 140; cw += (cw < 40 ? 1 : 13)) {
+        for (const int ch : {1, 2, 3, 6, 7}) {
+            const PyrLevel child = pyr_level(std::uint32_t(cw), std::uint32_t(ch), 3);
+            const std::uint32_t pw = (child.width + 1) / 2;
+            const std::uint32_t ph = (child.height + 1) / 2;
+            std::vector<std::uint8_t> mask(3 + std::size_t(cw) * std::size_t(ch));
+            for (std::uint8_t& m : mask) m = std::uint8_t(rng() % 4 == 0 ? rng() : 0xff);
+            PassContext c;
+            c.mask = mask.data();
+            std::vector<std::uint8_t> expected(std::size_t(pw) * ph);
+            std::vector<std::uint8_t> actual(expected.size(), 0x77);
+            for (std::uint32_t y = 0; y < ph; ++y) {
+                for (std::uint32_t x = 0; x < pw; ++x) {
+                    expected[std::size_t(y) * pw + x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, y));
+                }
+                const std::size_t cy = 2 * std::size_t(y);
+                const std::uint8_t* top =
+                    cy + 1 < child.height ? mask.data() + child.offset + cy * child.width : nullptr;
+                k.mip_row(top, child.width, pw, actual.data() + std::size_t(y) * pw);
+            }
+            const std::string diff = first_difference(actual.data(), expected.data(), actual.size(), 1);
+            ASSERT_EQ(diff, "") << "child " << cw << "x" << ch;
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Targets, CpuSimdRows, ::testing::ValuesIn(target_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
+// ---- Whole segmentations
+
+struct Frame {
+    std::string name;
+    int w = 0, h = 0;
+    std::vector<float> points;
+    std::vector<float> normals;  // empty: estimated
+    Params params;
+};
+
+// Given normals at lengths from 0.985 to 1.02 (components past +-1 clamp when quantized), so that most pixels still
+// pass the curvature test while no quantized component is the one of the unit normal; a few much shorter or longer.
+std::vector<float> lengthen(std::vector<float> normals, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> length(0.985f, 1.02f);
+    for (std::size_t i = 0; i < normals.size(); i += 3) {
+        const float f = i % 97 == 0 ? 0.3f : (i % 89 == 0 ? 3.7f : length(rng));
+        for (std::size_t c = 0; c < 3; ++c) normals[i + c] *= f;
+    }
+    return normals;
+}
+
+std::vector<Frame> frames() {
+    std::vector<Frame> out;
+    const Size sizes[] = {{131, 97}, {67, 45}, {1, 1}, {2, 3}, {17, 300}, {33, 1}, {1, 29}, {200, 7}};
+    std::uint32_t seed = 11;
+    for (const Size s : sizes) {
+        for (const int radius : {1, 2, 3, 5}) {
+            for (const double unit_mm : {1.0, 1000.0}) {
+                synthetic::SceneOptions o;
+                o.width = s.w;
+                o.height = s.h;
+                o.seed = seed++;
+                o.object_count = 6;
+                o.threads = 1;
+                const synthetic::Scene scene = synthetic::generate(o);
+                Frame f;
+                f.w = s.w;
+                f.h = s.h;
+                f.points = scene.points;
+                if (unit_mm != 1.0) {
+                    for (float& v : f.points) v *= 0.001f;  // metres
+                }
+                f.params.unit_mm = unit_mm;
+                f.params.normal_radius = radius;
+                const bool given = radius == 2;
+                if (given) f.normals = lengthen(scene.normals, seed);
+                std::ostringstream name;
+                name << s.w << "x" << s.h << "_r" << radius << "_unit" << unit_mm << (given ? "_given" : "_estimated");
+                f.name = name.str();
+                out.push_back(std::move(f));
+            }
+        }
+    }
+    // Clouds with special values and extreme magnitudes, estimated and given (non-unit, special) normals.
+    const float scales[] = {1.0f, 1e30f, 1e-38f};
+    for (const float scale : scales) {
+        for (const Size s : {Size{131, 97}, Size{67, 45}, Size{17, 300}, Size{2, 3}}) {
+            for (const bool given : {false, true}) {
+                Frame f;
+                f.w = s.w;
+                f.h = s.h;
+                f.points = make_points(s.w, s.h, scale, 0.03, seed);
+                if (given) {  // facing the camera, tilted a little, at lengths other than 1, a few special
+                    std::mt19937 rng(seed);
+                    std::uniform_real_distribution<float> tilt(-0.05f, 0.05f);
+                    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+                    f.normals.resize(f.points.size());
+                    for (std::size_t i = 0; i < f.normals.size(); i += 3) {
+                        f.normals[i] = tilt(rng);
+                        f.normals[i + 1] = tilt(rng);
+                        f.normals[i + 2] = -1.0f;
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            if (unit(rng) < 0.01f) f.normals[i + c] = special_value(rng);
+                        }
+                    }
+                    f.normals = lengthen(f.normals, seed);
+                }
+                ++seed;
+                f.params.normal_radius = 1 + int(seed % 3);
+                f.params.dt = 30.0 * double(scale);
+                std::ostringstream name;
+                name << "special_" << s.w << "x" << s.h << "_scale" << scale << (given ? "_given" : "_estimated");
+                f.name = name.str();
+                out.push_back(std::move(f));
+            }
+        }
+    }
+    return out;
+}
+
+Result segment_with(const std::string& mode, const Frame& f) {
+    const ScopedSimd env(mode);
+    Segmenter segmenter(f.w, f.h, f.params, "cpu", everything());
+    CloudView view;
+    view.points = f.points.data();
+    view.normals = f.normals.empty() ? nullptr : f.normals.data();
+    view.width = f.w;
+    view.height = f.h;
+    Result result;
+    segmenter.segment(view, result);
+    return result;
+}
+
+class CpuSimdFrames : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(CpuSimdFrames, MatchTheScalarPathAndTheReference) {
+    const std::string& mode = GetParam();
+    std::uint32_t segments = 0;
+    for (const Frame& f : frames()) {
+        SCOPED_TRACE(f.name);
+        const pyrseg_ref::Output ref = pyrseg_ref::segment(
+            f.points.data(), f.normals.empty() ? nullptr : f.normals.data(), f.w, f.h, to_reference(f.params));
+        ASSERT_TRUE(ref.ok) << ref.error;
+        segments += ref.segment_count;
+        const Result scalar = segment_with("scalar", f);
+        const Result r = segment_with(mode, f);
+        EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, f.w, 3));
+        EXPECT_TRUE(same_bytes("fillable mask", r.fillable_mask, ref.fillable, f.w));
+        EXPECT_TRUE(same_bytes("raw labels", r.raw_labels, ref.raw_labels, f.w));
+        EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, f.w));
+        EXPECT_TRUE(same_segments(r.segments, ref.segments));
+        EXPECT_TRUE(same_bytes("normals (scalar path)", r.normals, scalar.normals, f.w, 3));
+        EXPECT_TRUE(same_bytes("fillable mask (scalar path)", r.fillable_mask, scalar.fillable_mask, f.w));
+        EXPECT_TRUE(same_bytes("labels (scalar path)", r.labels, scalar.labels, f.w));
+        if (::testing::Test::HasFailure()) return;
+    }
+    EXPECT_GT(segments, 200u) << "the frames must have segments for the labels to say much";
+}
+
+// A strided cloud (PCL's padded PointXYZ, rows padded) reads like the packed one on every target.
+TEST_P(CpuSimdFrames, StridedCloudsMatchTheReference) {
+    synthetic::SceneOptions o;
+    o.width = 97;
+    o.height = 61;
+    o.seed = 3;
+    o.threads = 1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const Layout l = lay_out(scene.points, o.width, o.height, 4, 3);
+    const Layout ln = lay_out(scene.normals, o.width, o.height, 4, 3);
+    for (const bool given : {false, true}) {
+        const pyrseg_ref::Output ref = pyrseg_ref::segment(scene.points.data(), given ? scene.normals.data() : nullptr,
+                                                           o.width, o.height, to_reference({}));
+        ASSERT_TRUE(ref.ok);
+        const ScopedSimd env(GetParam());
+        Segmenter segmenter(o.width, o.height, {}, "cpu", everything());
+        CloudView view;
+        view.points = l.floats.data();
+        view.normals = given ? ln.floats.data() : nullptr;
+        view.width = o.width;
+        view.height = o.height;
+        view.point_stride = 4;
+        view.row_stride = std::size_t(o.width) + 3;
+        Result r;
+        segmenter.segment(view, r);
+        EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, o.width, 3));
+        EXPECT_TRUE(same_bytes("fillable mask", r.fillable_mask, ref.fillable, o.width));
+        EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, o.width));
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Targets, CpuSimdFrames, ::testing::ValuesIn(simd::accepted_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
+TEST(CpuSimd, ListsTheScalarPathAndTheTargets) {
+    const std::vector<std::string> names = simd::accepted_names();
+    ASSERT_GE(names.size(), 2u) << "at least one Highway target (its one-lane fallback) must be available";
+    EXPECT_EQ(names.front(), "scalar");
+    for (const std::string& name : names) std::cout << "[ PYRSEG_CPU_SIMD ] " << name << "\n";
+}
+
+TEST(CpuSimd, AnUnknownTargetIsAnError) {
+    const ScopedSimd env("no_such_target");
+    try {
+        Segmenter segmenter(16, 16, {}, "cpu");
+        FAIL() << "PYRSEG_CPU_SIMD=no_such_target was accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+        EXPECT_NE(std::string(e.what()).find("scalar"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace pyrseg::test
