@@ -55,8 +55,6 @@ void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceL
     impl.timings.clear();  // host times of queued work: meaningless, and no device times were kept
 }
 
-}  // namespace
-
 void check_device_cloud(const DeviceCloud& cloud, int width, int height) {
     const std::size_t row = 12 * std::size_t(width);
     const std::size_t pitch = cloud.row_step_bytes == 0 ? row : cloud.row_step_bytes;
@@ -78,6 +76,8 @@ void check_device_labels(const DeviceLabels& labels, int width, int height) {
     check_rows("labels", labels.labels, pitch, row, std::size_t(height), 4, width, height);
     if (labels.count.handle != 0) check_rows("segment count", labels.count, 4, 4, 1, 4, width, height);
 }
+
+}  // namespace
 
 Segmenter::Impl& SegmenterAccess::impl(Segmenter& segmenter) {
     if (!segmenter.impl_) throw Error(ErrorCode::invalid_argument, "the Segmenter was moved from");

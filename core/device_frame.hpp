@@ -52,13 +52,6 @@ struct DeviceLabels {
     ExternalBuffer count;
 };
 
-// The checks every API shares: a frame of the Segmenter's size fits each buffer at its offset, the steps fit the
-// rows and are multiples of 4, depth's units and intrinsics are positive and finite. Throws pyrseg::Error naming the
-// problem; nothing is queued before these pass.
-void check_device_cloud(const DeviceCloud& cloud, int width, int height);
-void check_device_depth(const DeviceDepth& depth, int width, int height);
-void check_device_labels(const DeviceLabels& labels, int width, int height);
-
 // A Segmenter over an executor a backend made on the caller's context (the interop functions' constructors).
 [[nodiscard]] Segmenter make_segmenter(int width, int height, const Params& params, const Outputs& outputs,
                                        const std::string& backend,
@@ -67,10 +60,12 @@ void check_device_labels(const DeviceLabels& labels, int width, int height);
 // The Segmenter's executor, for a backend's interop functions to reach their device.
 [[nodiscard]] PassExecutor& executor_of(Segmenter& segmenter);
 
-// One device-resident frame: the checks, then `checked` (where an API queues what the frame waits for: nothing is
-// queued before every check passed), the input bound, every pass, the labels (and K) written to the caller's
-// buffers; then the executor submits without waiting. The results of Outputs other than the labels and K are not
-// produced (they are host results); Segmenter::last_timings() is empty after such a frame.
+// One device-resident frame: the checks every API shares (a frame of the Segmenter's size fits each buffer at its
+// offset, the steps fit the rows and are multiples of 4 (of 2 for u16 depth), depth's units and intrinsics are
+// positive and finite; a pyrseg::Error names the problem), then `checked` (where an API queues what the frame waits
+// for: nothing is queued before every check passed), the input bound, every pass, the labels (and K) written to the
+// caller's buffers; then the executor submits without waiting. The results of Outputs other than the labels and K are
+// not produced (they are host results); Segmenter::last_timings() is empty after such a frame.
 void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels,
                       const std::function<void()>& checked = {});
 void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels,
