@@ -37,6 +37,10 @@ public:
     virtual void estimate_normals() = 0;                          // when the cloud has no normals
     virtual void quantize() = 0;                                  // validity and qn per pixel
     virtual void metric() = 0;                                    // fillable mask B into level N
+    // A backend that returns true runs normals (when estimate_normals), quantize and metric as the one pass
+    // points_to_mask, over bands of rows that stay in cache, instead of the three; the results are the same.
+    [[nodiscard]] virtual bool fuses_points_to_mask() const { return false; }
+    virtual void points_to_mask(bool /*estimate_normals*/) {}
     virtual void mip(int parent_level) = 0;                       // level parent_level from level parent_level + 1
     virtual void init_labels(int level, std::uint32_t mode) = 0;  // PYR_INIT_* (shaders/pyr_types.h)
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4

@@ -38,9 +38,14 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
     const int n = plan.level_count;
     if (input != InputKind::mask) {
         if (input == InputKind::depth) clock.run("depth", [&] { ex.depth_to_points(); });
-        if (input != InputKind::cloud_with_normals) clock.run("normals", [&] { ex.estimate_normals(); });
-        clock.run("quantize", [&] { ex.quantize(); });
-        clock.run("metric", [&] { ex.metric(); });
+        const bool estimate = input != InputKind::cloud_with_normals;
+        if (ex.fuses_points_to_mask()) {
+            clock.run("points_to_mask", [&] { ex.points_to_mask(estimate); });  // the next three, fused
+        } else {
+            if (estimate) clock.run("normals", [&] { ex.estimate_normals(); });
+            clock.run("quantize", [&] { ex.quantize(); });
+            clock.run("metric", [&] { ex.metric(); });
+        }
     }
     if (plan.small_image) {
         // The contract's fallback: plain 4-connected components of B, each labelled 1 + its smallest index,

@@ -177,6 +177,7 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         plan.old_label_max = std::uint32_t(offsets[std::size_t(u) + 1]);
         plan.max_label = std::uint32_t(offsets[std::size_t(m) + 1]);  // fits: total_texels does
     }
+    plan.keep_normals = outputs.normals;
     if (outputs.segment_stats) {
         // Steps 3 to 6 only copy labels, so every final label lies on a fillable texel of level M and
         // K <= w_M * h_M; the fallback's labels are pixels.

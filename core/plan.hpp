@@ -41,6 +41,8 @@ struct Plan {
     // and the fixed point of the point sums, 2^stats_point_shift steps per input unit.
     std::uint32_t stats_slots = 0;
     int stats_point_shift = 0;
+    // Outputs::normals: the frame returns the normals the metric used, so a backend must keep them per pixel.
+    bool keep_normals = false;
 
     [[nodiscard]] const PyrLevel& level(int k) const { return levels[static_cast<std::size_t>(k - 1)]; }
     [[nodiscard]] const PyrLevel& full() const { return levels.back(); }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/points_to_mask.hpp"
 #include "backends/cpu/robust_windows.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "backends/cpu/thread_pool.hpp"
@@ -64,6 +65,7 @@ public:
         cloud_ = cloud;
         layout_ = core::cloud_layout(cloud);
         normals_estimated_ = false;
+        valid_bytes_ = false;
         from_mask_ = false;
     }
 
@@ -73,6 +75,7 @@ public:
         depth_ = depth;
         depth_tables_ = &tables;
         normals_estimated_ = false;
+        valid_bytes_ = false;
         from_mask_ = false;
     }
 
@@ -216,6 +219,34 @@ public:
                                                                             t.curvature, t.depth));
             }
         });
+    }
+
+    // The paper metric on the vector kernels: fused (backends/cpu/points_to_mask.hpp). The robust metric's windows
+    // and the scalar path run as separate passes.
+    [[nodiscard]] bool fuses_points_to_mask() const override {
+        return simd_ != nullptr && plan_.params.metric == Metric::paper;
+    }
+
+    void points_to_mask(bool estimate_normals) override {
+        PointsToMaskFrame f;
+        f.points = context();
+        f.given_normals = estimate_normals ? nullptr : cloud_.normals;
+        f.width = plan_.width;
+        f.height = plan_.height;
+        f.normal_radius = uint32_t(plan_.params.normal_radius);
+        f.curvature = plan_.thresholds.curvature;
+        f.depth = plan_.thresholds.depth;
+        if (estimate_normals && plan_.keep_normals) {
+            if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
+            f.normals_out = normals_.data();
+        }
+        // The statistics read each pixel's qn; nothing else reads the quantized pixels after the metric.
+        if (plan_.stats_slots != 0) f.quant_out = quant_.data();
+        f.mask_out = mask_.data() + plan_.full().offset;
+        f.valid_out = mask_valid_.data();
+        points_to_mask_.run(pool_, *simd_, f);
+        normals_estimated_ = estimate_normals;
+        valid_bytes_ = true;
     }
 
     void mip(int parent_level) override {
@@ -430,7 +461,7 @@ private:
         c.row_floats = layout_.row_floats;
         c.point_floats = layout_.point_floats;
         c.quant = quant_.data();
-        c.mask_valid = from_mask_ ? mask_valid_.data() : nullptr;
+        c.mask_valid = from_mask_ || valid_bytes_ ? mask_valid_.data() : nullptr;
         c.mask = mask_.data();
         c.labels = labels_.data();
         c.lut = lut_.data();
@@ -552,7 +583,8 @@ private:
     const core::DepthTables* depth_tables_ = nullptr;
     std::vector<float> depth_points_;       // its back-projection (depth frames only)
     std::vector<uint32_t> quant_;           // kQuantWords per pixel
-    std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask (bytes: quant_ is 12 per pixel)
+    std::vector<std::uint8_t> mask_valid_;  // validity of a caller's mask, or from points_to_mask (bytes)
+    PointsToMask points_to_mask_;           // its per-thread windows
     std::vector<std::uint8_t> mask_;        // all levels
     std::vector<uint32_t> labels_;          // all levels
     std::vector<uint32_t> lut_;             // raw label -> compacted label
@@ -567,6 +599,7 @@ private:
     uint32_t fill_rounds_ = 0;
     bool compacted_ = false;
     bool normals_estimated_ = false;
+    bool valid_bytes_ = false;  // mask_valid_ holds this frame's validity (points_to_mask wrote it)
     bool from_mask_ = false;
 };
 
