@@ -34,9 +34,9 @@ public:
     // into the points the passes from normals on read.
     virtual void bind_depth(const DepthView& depth, const DepthTables& tables) = 0;
     virtual void depth_to_points() = 0;
-    virtual void estimate_normals() = 0;                          // when the cloud has no normals
-    virtual void quantize() = 0;                                  // validity and qn per pixel
-    virtual void metric() = 0;                                    // fillable mask B into level N
+    virtual void estimate_normals() = 0;  // when the cloud has no normals
+    virtual void quantize() = 0;          // validity and qn per pixel
+    virtual void metric() = 0;            // fillable mask B into level N
     // A backend that returns true runs normals (when estimate_normals), quantize and metric as the one pass
     // points_to_mask, over bands of rows that stay in cache, instead of the three; the results are the same.
     [[nodiscard]] virtual bool fuses_points_to_mask() const { return false; }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -119,18 +120,22 @@ public:
         const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;
         std::uint8_t* full = mask_.data() + plan_.full().offset;
         std::uint8_t* valid = mask_valid_.data();
+        const std::uint8_t* in_fillable = mask.fillable;
+        const std::uint8_t* in_valid = mask.valid;
         rows(size_t(plan_.height), [&](size_t y) {
-            // Local row pointers: byte stores may alias anything, so members would be reloaded per pixel.
-            const std::uint8_t* in = mask.fillable + y * stride;
-            std::uint8_t* out = full + y * w;
-            for (size_t x = 0; x < w; ++x) out[x] = in[x] != 0 ? 1 : 0;
-            std::uint8_t* out_valid = valid + y * w;
-            if (mask.valid == nullptr) {
-                std::memset(out_valid, 1, w);
+            // Everything the loops read in locals: byte stores may alias anything, so a captured reference (the
+            // width too) would be reloaded per pixel and the loops would not vectorise.
+            const size_t n = w;
+            const std::uint8_t* in = in_fillable + y * stride;
+            std::uint8_t* out = full + y * n;
+            for (size_t x = 0; x < n; ++x) out[x] = in[x] != 0 ? 1 : 0;
+            std::uint8_t* out_valid = valid + y * n;
+            if (in_valid == nullptr) {
+                std::memset(out_valid, 1, n);
                 return;
             }
-            const std::uint8_t* in_valid = mask.valid + y * stride;
-            for (size_t x = 0; x < w; ++x) out_valid[x] = in_valid[x] != 0 ? 1 : 0;
+            const std::uint8_t* in_v = in_valid + y * stride;
+            for (size_t x = 0; x < n; ++x) out_valid[x] = in_v[x] != 0 ? 1 : 0;
         });
     }
 
@@ -273,17 +278,29 @@ public:
         const PassContext c = context();
         const PyrLevel lv = plan_.level(level);
         const PyrLevel parent = level > 1 ? plan_.level(level - 1) : PyrLevel{0, 0, 0};
+        if (simd_ != nullptr && mode == PYR_INIT_INHERIT && level > 1) {
+            rows(lv.height, [&](size_t y) {
+                simd_->inherit_row(c.mask + lv.offset + y * lv.width,
+                                   c.labels + parent.offset + (y >> 1) * parent.width, lv.width,
+                                   c.labels + lv.offset + y * lv.width, nullptr);
+            });
+            return;
+        }
         rows(lv.height, [&](size_t y) { init_row(c, lv, parent, uint32_t(y), mode); });
     }
 
     void fill_to_fixed_point(int level, uint32_t anchor_max) override {
         const PyrLevel lv = plan_.level(level);
         if (anchor_max != 0) {
+            std::uint8_t* mask = mask_.data();
+            const uint32_t* labels = labels_.data();
             rows(lv.height, [&](size_t y) {
-                const size_t row = lv.offset + y * lv.width;
-                for (size_t i = row; i < row + lv.width; ++i) {
-                    mask_[i] = std::uint8_t(kernels::pyr_anchor_mask(mask_[i], labels_[i], anchor_max));
-                }
+                // Locals: byte stores may alias the captured references, which would be reloaded per texel.
+                std::uint8_t* m = mask + lv.offset + y * lv.width;
+                const uint32_t* l = labels + lv.offset + y * lv.width;
+                const uint32_t n = lv.width;
+                const uint32_t max = anchor_max;
+                for (uint32_t x = 0; x < n; ++x) m[x] = std::uint8_t(kernels::pyr_anchor_mask(m[x], l[x], max));
             });
         }
         if (sweeps_) {
@@ -296,7 +313,16 @@ public:
     }
 
     // Steps 5 and 6 a, b: each row's step-5 labels just before its row sweeps, while the row is in cache.
-    void final_fill(int level) override { sweep(plan_.level(level), true, true); }
+    // The vector path runs steps 5, 6 a, b (and 6c, with one edge round) in one pass over the rows instead.
+    void final_fill(int level) override {
+        edges_fused_ = false;
+        if (simd_ == nullptr) {
+            sweep(plan_.level(level), true, true);
+            return;
+        }
+        edges_fused_ = plan_.params.label_edges && plan_.params.edge_rounds == 1;
+        final_fill_rows(plan_.level(level), plan_.level(level - 1), edges_fused_);
+    }
 
     // Step 6c, and compaction's marking of each row once its labels are final (one pass over the image fewer).
     void label_edges() override {
@@ -304,6 +330,15 @@ public:
         const PyrLevel full = plan_.full();
         std::fill(lut_.begin(), lut_.end(), 0u);
         const auto rounds = uint32_t(plan_.params.edge_rounds);
+        if (edges_fused_) {
+            // final_fill labelled the edges. Every label of the full level comes from level N-1 (step 5 copies
+            // each one to the four children of its texel, and steps 6 only copy labels): marking that level's
+            // labels marks the same set from a quarter of the texels.
+            const PyrLevel below = plan_.level(plan_.level_count - 1);
+            rows(below.height,
+                 [&](size_t y) { mark_labels(labels_.data() + below.offset + y * below.width, below.width); });
+            return;
+        }
         if (rounds == 1) {
             rows(full.height, [&](size_t y) {
                 for (uint32_t x = 0; x < full.width; ++x) {
@@ -372,16 +407,20 @@ public:
         out.segment_count = segment_count_;
         out.labels.resize(pixels);
         const PassContext c = context();
+        uint32_t* labels = out.labels.data();
+        const bool compacted = compacted_;
+        const size_t width = size_t(plan_.width);
         rows(size_t(plan_.height), [&](size_t y) {
-            const size_t w = size_t(plan_.width);
             uint32_t previous_raw = 0;  // labels come in runs: a run is looked up once
             uint32_t previous = 0;
-            for (size_t i = y * w; i < (y + 1) * w; ++i) {
-                if (raw[i] != previous_raw) {
-                    previous_raw = raw[i];
-                    previous = compacted_ ? kernels::pyr_compact_label(c, raw[i]) : raw[i];
+            const uint32_t* in = raw + y * width;
+            uint32_t* to = labels + y * width;
+            for (size_t x = 0; x < width; ++x) {
+                if (in[x] != previous_raw) {
+                    previous_raw = in[x];
+                    previous = compacted ? kernels::pyr_compact_label(c, previous_raw) : previous_raw;
                 }
-                out.labels[i] = previous;
+                to[x] = previous;
             }
         });
         if (outputs.raw_labels) {
@@ -440,8 +479,10 @@ private:
 
     // Marks the labels of row y of the full level in the compaction table (concurrent rows write the same value).
     void mark_row(size_t y) {
-        const size_t w = size_t(plan_.width);
-        const uint32_t* row = labels_.data() + plan_.full().offset + y * w;
+        mark_labels(labels_.data() + plan_.full().offset + y * size_t(plan_.width), plan_.width);
+    }
+
+    void mark_labels(const uint32_t* row, size_t w) {
         uint32_t previous = 0;  // labels come in runs: a run is marked once
         for (size_t x = 0; x < w; ++x) {
             const uint32_t l = row[x];
@@ -571,6 +612,161 @@ private:
         return ch;
     }
 
+    // ---- Steps 5 and 6 on the vector kernels (final_fill_rows)
+    // Step 6 changes only the pixels that are fillable and unlabelled after step 5, few of them (the children of
+    // non-fillable texels at the regions' borders), and its schedule reduces to runs of them: a row's run takes the
+    // label of the pixel left of it when that one is fillable (so labelled), else of the one right of it, else stays
+    // 0; then a column's run of those still unlabelled takes the label above it, else the one below it. So one pass
+    // over the rows runs step 5 with a vector kernel that also marks those pixels in a bitmap, and steps 6 a and the
+    // downward sweep then touch only the marked pixels; the upward sweep visits the pixels still marked, bottom up.
+
+    // The first pixel at or after x whose bit is `set` (w when none).
+    static size_t next_bit(const uint64_t* bits, size_t x, size_t w, bool set) {
+        if (x >= w) return w;
+        const uint64_t flip = set ? 0 : ~uint64_t{0};
+        size_t i = x / 64;
+        uint64_t word = (bits[i] ^ flip) & (~uint64_t{0} << (x % 64));
+        const size_t words = (w + 63) / 64;
+        while (word == 0) {
+            if (++i == words) return w;
+            word = bits[i] ^ flip;
+        }
+        return std::min(w, i * 64 + size_t(std::countr_zero(word)));
+    }
+
+    static void clear_bits(uint64_t* bits, size_t x0, size_t x1) {
+        for (size_t x = x0; x < x1;) {
+            const size_t end = std::min(x1, (x / 64 + 1) * 64);
+            const size_t n = end - x;
+            const uint64_t span = n == 64 ? ~uint64_t{0} : ((uint64_t{1} << n) - 1) << (x % 64);
+            bits[x / 64] &= ~span;
+            x = end;
+        }
+    }
+
+    // Step 6a on a row whose unlabelled fillable pixels are marked: each run of them, there and back.
+    static void fill_row_runs(const std::uint8_t* mask, uint32_t* row, uint64_t* bits, size_t w) {
+        for (size_t x = next_bit(bits, 0, w, true); x < w; x = next_bit(bits, x, w, true)) {
+            const size_t end = next_bit(bits, x, w, false);
+            uint32_t label = 0;  // a fillable pixel next to the run is not in it, so it is labelled
+            if (x > 0 && (mask[x - 1] & PYR_MASK_FILLABLE) != 0) {
+                label = row[x - 1];
+            } else if (end < w && (mask[end] & PYR_MASK_FILLABLE) != 0) {
+                label = row[end];
+            }
+            if (label != 0) {
+                std::fill(row + x, row + end, label);
+                clear_bits(bits, x, end);
+            }
+            x = end;
+        }
+    }
+
+    // One step of a column sweep on the marked pixels of a row, from the row before it in the sweep (pyr_fill_once:
+    // an unlabelled fillable pixel takes the label of a fillable neighbour, maybe 0). changed(x, label) is called
+    // for each pixel labelled. Returns whether one was.
+    template <class Changed>
+    static bool column_step_marked(uint32_t* row, uint64_t* bits, const std::uint8_t* from_mask, const uint32_t* from,
+                                   size_t w, const Changed& changed) {
+        bool any = false;
+        for (size_t x = next_bit(bits, 0, w, true); x < w; x = next_bit(bits, x + 1, w, true)) {
+            if ((from_mask[x] & PYR_MASK_FILLABLE) == 0 || from[x] == 0) continue;
+            row[x] = from[x];
+            bits[x / 64] &= ~(uint64_t{1} << (x % 64));
+            changed(x, from[x]);
+            any = true;
+        }
+        return any;
+    }
+
+    // Row y's validity bytes: the mask's own, else from the quantized pixels into scratch.
+    [[nodiscard]] const std::uint8_t* valid_row(const PassContext& c, size_t y, std::uint8_t* scratch) const {
+        const size_t w = plan_.width;
+        if (c.mask_valid != nullptr) return c.mask_valid + y * w;
+        for (size_t x = 0; x < w; ++x) scratch[x] = std::uint8_t(c.quant[kQuantWords * (y * w + x) + 1] >> 16);
+        return scratch;
+    }
+
+    void edge_row(const PassContext& c, const PyrLevel& lv, size_t y, std::uint8_t* scratch) const {
+        const size_t w = lv.width;
+        const size_t i = lv.offset + y * w;
+        const bool up = y > 0;
+        const bool down = y + 1 < lv.height;
+        simd_->edge_row(up ? c.mask + i - w : nullptr, c.mask + i, down ? c.mask + i + w : nullptr,
+                        up ? c.labels + i - w : nullptr, c.labels + i, down ? c.labels + i + w : nullptr,
+                        valid_row(c, y, scratch), lv.width);
+    }
+
+    void final_fill_rows(const PyrLevel& lv, const PyrLevel& parent, bool edges) {
+        const PassContext c = context();
+        const size_t w = lv.width;
+        const size_t h = lv.height;
+        const size_t words = (w + 63) / 64;
+        if (unlabelled_.size() < h * words) unlabelled_.resize(h * words);  // once per Segmenter
+        // Bands of rows run in parallel; the column sweeps cross their borders afterwards, in order.
+        const size_t bands = std::min(h, size_t(pool_.size()) * 2);
+        if (edges && c.mask_valid == nullptr && valid_scratch_.size() < bands * w) valid_scratch_.resize(bands * w);
+        const auto band_begin = [&](size_t b) { return h * b / bands; };
+        const auto row_of = [&](size_t y) { return c.labels + lv.offset + y * w; };
+        const auto mask_of = [&](size_t y) { return c.mask + lv.offset + y * w; };
+        const auto bits_of = [&](size_t y) { return unlabelled_.data() + y * words; };
+        pool_.parallel_for(bands, 1, [&](size_t b0, size_t b1) {
+            for (size_t b = b0; b < b1; ++b) {
+                const size_t y0 = band_begin(b);
+                const size_t y1 = band_begin(b + 1);
+                std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data() + b * w;
+                for (size_t y = y0; y < y1; ++y) {
+                    uint32_t* row = row_of(y);
+                    const std::uint8_t* m = mask_of(y);
+                    if (simd_->inherit_row(m, c.labels + parent.offset + (y >> 1) * parent.width, uint32_t(w), row,
+                                           bits_of(y))) {
+                        fill_row_runs(m, row, bits_of(y), w);
+                        if (y > y0)
+                            column_step_marked(row, bits_of(y), mask_of(y - 1), row_of(y - 1), w,
+                                               [](size_t, uint32_t) {});
+                    }
+                    // Edges read rows y - 2 .. y: all of this band's, and each only ever gains labels later.
+                    if (edges && y >= y0 + 2) edge_row(c, lv, y - 1, scratch);
+                }
+            }
+        });
+        // What a pixel labels from here on reaches the edge pixels next to it: their minimum is taken again.
+        const auto reach_edges = [&](size_t x, size_t y, uint32_t label) {
+            if (!edges) return;
+            const auto touch = [&](size_t p) {
+                const size_t i = lv.offset + p;
+                if ((c.mask[i] & PYR_MASK_FILLABLE) != 0) return;
+                const bool valid =
+                    c.mask_valid != nullptr ? c.mask_valid[p] != 0 : (c.quant[kQuantWords * p + 1] >> 16) != 0;
+                if (valid && (c.labels[i] == 0 || label < c.labels[i])) c.labels[i] = label;
+            };
+            const size_t p = y * w + x;
+            if (x > 0) touch(p - 1);
+            if (x + 1 < w) touch(p + 1);
+            if (y > 0) touch(p - w);
+            if (y + 1 < h) touch(p + w);
+        };
+        // The downward sweep across each band's top, down as far as it changes something.
+        for (size_t b = 1; b < bands; ++b) {
+            for (size_t y = band_begin(b); y < h; ++y) {
+                const bool changed = column_step_marked(row_of(y), bits_of(y), mask_of(y - 1), row_of(y - 1), w,
+                                                        [&](size_t x, uint32_t l) { reach_edges(x, y, l); });
+                if (!changed) break;
+            }
+        }
+        // The upward sweep: only marked pixels can change.
+        for (size_t y = h - 1; y-- > 0;) {
+            column_step_marked(row_of(y), bits_of(y), mask_of(y + 1), row_of(y + 1), w,
+                               [&](size_t x, uint32_t l) { reach_edges(x, y, l); });
+        }
+        if (!edges) return;
+        std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data();
+        for (size_t b = 0; b < bands; ++b) {
+            edge_row(c, lv, band_begin(b), scratch);
+            if (band_begin(b + 1) - 1 > band_begin(b)) edge_row(c, lv, band_begin(b + 1) - 1, scratch);
+        }
+    }
+
     const core::Plan& plan_;
     ThreadPool pool_;
     CloudView cloud_{};
@@ -590,7 +786,10 @@ private:
     std::vector<uint32_t> lut_;             // raw label -> compacted label
     std::vector<uint32_t> parent_;          // union-find scratch
     std::vector<uint32_t> best_;
-    std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
+    std::vector<std::uint64_t> unlabelled_;    // final_fill_rows: the pixels step 6 can change, a bit each
+    std::vector<std::uint8_t> valid_scratch_;  // final_fill_rows: validity rows, when they are in the quant words
+    bool edges_fused_ = false;                 // final_fill_rows labelled the edges too
+    std::vector<uint32_t> stats_;              // per-segment statistics words, when asked for
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::RowKernels* simd_;

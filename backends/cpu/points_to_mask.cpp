@@ -50,10 +50,7 @@ void PointsToMask::run(ThreadPool& pool, const simd::RowKernels& kernels, const 
         window_rows_ = std::max(kMinWindowRows, kWindowBytes / (kQuantWords * sizeof(uint32_t) * w));
         window_rows_ = std::min(window_rows_, size_t(frame.height) + 2);
         scratch_.resize(threads);
-        for (Scratch& s : scratch_) {
-            s.window.resize(window_rows_ * kQuantWords * w);
-            s.normals_row.resize(3 * w);
-        }
+        for (Scratch& s : scratch_) s.window.resize(window_rows_ * kQuantWords * w);
         busy_.assign(threads, false);
     }
     const size_t rows = frame.height;
@@ -79,19 +76,14 @@ void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskF
     uint32_t filled = first;
     const auto own = [&](uint32_t y) { return y >= y0 && y < y1; };
     const auto produce = [&](uint32_t y, uint32_t* out) {
-        const float* points = c.points + size_t(y) * c.row_floats;
-        const float* normals = nullptr;
-        size_t normal_floats = 3;
         if (f.given_normals != nullptr) {
-            normals = f.given_normals + size_t(y) * c.row_floats;
-            normal_floats = c.point_floats;
+            kernels.quantize_row(c.points + size_t(y) * c.row_floats, c.point_floats,
+                                 f.given_normals + size_t(y) * c.row_floats, c.point_floats, f.width, out);
         } else {
-            // Rows of the neighbouring chunks are recomputed here but written only by their own chunk.
-            float* row = f.normals_out != nullptr && own(y) ? f.normals_out + 3 * size_t(y) * w : s.normals_row.data();
-            kernels.normals_row(c, f.width, f.height, y, f.normal_radius, row);
-            normals = row;
+            // Rows of the neighbouring chunks are recomputed here but their normals written only by their own chunk.
+            float* normals = f.normals_out != nullptr && own(y) ? f.normals_out + 3 * size_t(y) * w : nullptr;
+            kernels.normals_to_row(c, f.width, f.height, y, f.normal_radius, normals, out);
         }
-        kernels.quantize_row(points, c.point_floats, normals, normal_floats, f.width, out);
         if (!own(y)) return;
         std::uint8_t* valid = f.valid_out + size_t(y) * w;
         copy_validity(out, w, valid);

@@ -2,8 +2,9 @@
 // The CPU backend's fused front end: normals (paper metric, when estimated), quantize and the paper metric as one
 // pass over bands of rows. Each thread produces a row's quantized pixels just before the metric of the row above
 // reads them, in a window of a few rows that stays in its L2 cache, so the frame's normals and quantized pixels
-// need never travel to memory and back (the separate passes write and re-read 12 bytes a pixel twice). The row
-// functions are the vector kernels of backends/cpu/simd, unchanged: the bytes are those of the separate passes.
+// need never travel to memory and back (the separate passes write and re-read 12 bytes a pixel twice); estimated
+// normals go from their integer form straight to quantize's words (RowKernels::normals_to_row). The row functions
+// are the vector kernels of backends/cpu/simd: the bytes are those of the separate passes.
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
@@ -36,7 +37,6 @@ public:
 private:
     struct Scratch {
         std::vector<std::uint32_t> window;  // consecutive rows of quantized pixels
-        std::vector<float> normals_row;     // one row of estimated normals
     };
     // Each running chunk takes a free scratch; at most pool.size() run at once. Allocated on the first frame.
     Scratch& acquire(std::size_t& slot);

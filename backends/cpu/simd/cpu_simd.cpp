@@ -244,10 +244,11 @@ void store_normal(const PyrIVec3& q, float* out) {
     out[2] = float(q.z) * PYR_NORMAL_UNIT;
 }
 
-// pyr_normal_q for the pixels x .. x + n - 1 of row y, all with both horizontal neighbours inside the image.
-// up / down: the rows y - r / y + r, or row y itself where that row is outside the image (has_up / has_down clear).
-HWY_INLINE void normals_vector(const float* row, const float* up, const float* down, std::size_t pf, std::size_t x,
-                               std::size_t r, MI has_up_row, MI has_down_row, float* out) {
+// pyr_normal_q for the pixels x .. x + n - 1 of row y, all with both horizontal neighbours inside the image, and
+// their points' z. up / down: the rows y - r / y + r, or row y itself where that row is outside the image (has_up /
+// has_down clear).
+HWY_INLINE void normal_q_vector(const float* row, const float* up, const float* down, std::size_t pf, std::size_t x,
+                                std::size_t r, MI has_up_row, MI has_down_row, VI& qx, VI& qy, VI& qz, VF& z) {
     const DF df;
     VF cx, cy, cz, rx, ry, rz, lx, ly, lz, ux, uy, uz, dx, dy, dz;  // NOLINT(readability-isolate-declaration)
     load_points(df, row + x * pf, pf, cx, cy, cz);
@@ -272,19 +273,48 @@ HWY_INLINE void normals_vector(const float* row, const float* up, const float* d
     to_fixed(hn::Sub(hn::IfThenElse(below, dx, cx), hn::IfThenElse(above, ux, cx)),
              hn::Sub(hn::IfThenElse(below, dy, cy), hn::IfThenElse(above, uy, cy)),
              hn::Sub(hn::IfThenElse(below, dz, cz), hn::IfThenElse(above, uz, cz)), fvx, fvy, fvz);
-    VI qx, qy, qz;  // NOLINT(readability-isolate-declaration)
     unit_normal(fux, fuy, fuz, fvx, fvy, fvz, cx, cy, cz, defined, qx, qy, qz);
-    const VF unit = hn::Set(df, PYR_NORMAL_UNIT);
-    hn::StoreInterleaved3(hn::Mul(hn::ConvertTo(df, qx), unit), hn::Mul(hn::ConvertTo(df, qy), unit),
-                          hn::Mul(hn::ConvertTo(df, qz), unit), df, out + 3 * x);
+    z = cz;
 }
 
-void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* out) {
+// n = q * 2^-13, packed (the scalar code's store_normal).
+HWY_INLINE void store_normals(VI qx, VI qy, VI qz, float* out) {
+    const DF df;
+    const VF unit = hn::Set(df, PYR_NORMAL_UNIT);
+    hn::StoreInterleaved3(hn::Mul(hn::ConvertTo(df, qx), unit), hn::Mul(hn::ConvertTo(df, qy), unit),
+                          hn::Mul(hn::ConvertTo(df, qz), unit), df, out);
+}
+
+// What quantize makes of the normal n = q * 2^-13 of a point with depth z: n is finite, and non-zero exactly where
+// q is (|q| >= 1 and 2^-13 is a normal float); q is (0, 0, 0) wherever the point is not valid (pyr_normal_q); and
+// rint(clamp(n, -1, 1) * 2^13) = q since |q| <= 2^13 and the products by powers of two are exact. So the pixel is
+// valid iff q != 0, its qn is q, and its words are store_quant's of (q, valid, z).
+HWY_INLINE void store_quant_of_normal(VI qx, VI qy, VI qz, VF z, std::uint32_t* out) {
+    const DI di;
+    const DU du;
+    const VI low = hn::Set(di, 0xffff);
+    const MI valid = hn::Ne(hn::Or(hn::Or(qx, qy), qz), hn::Zero(di));
+    const VU w0 = hn::BitCast(du, hn::Or(hn::And(qx, low), hn::ShiftLeft<16>(qy)));
+    const VU w1 = hn::BitCast(du, hn::Or(hn::And(qz, low), hn::IfThenElseZero(valid, hn::Set(di, 1 << 16))));
+    hn::StoreInterleaved3(w0, w1, hn::BitCast(du, z), du, out);
+}
+
+// Row y of the paper metric's normals, as floats (normals, unless null) and as quantize's words (quant, unless
+// null): what normals_row and then quantize_row write, in one pass over the row's points.
+void normals_to_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
+                    float* normals, std::uint32_t* quant) {
     const DF df;
     const DI di;
     const std::size_t n = hn::Lanes(df);
     const auto scalar = [&](std::uint32_t x) {
-        store_normal(kernels::pyr_normal_q(c, w, h, x, y, r), out + 3 * std::size_t(x));
+        const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, r);
+        float v[3];
+        store_normal(q, v);
+        if (normals != nullptr) std::copy_n(v, 3, normals + 3 * std::size_t(x));
+        if (quant == nullptr) return;
+        const float* p = c.points + std::size_t(y) * c.row_floats + std::size_t(x) * c.point_floats;
+        const PyrQuant pq = kernels::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
+        store_quant(quant + kQuantWords * x, pq.qx, pq.qy, pq.qz, pq.valid, p[2]);
     };
     // Pixels r .. w - r - 1 have both horizontal neighbours; the others are the scalar code's.
     if (std::size_t(w) < 2 * std::size_t(r) + n) {
@@ -305,9 +335,17 @@ void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::ui
     // Whole vectors; the last one ends at x_end, overlapping the one before (the same bytes are written again).
     for (std::size_t x = r;; x += n) {
         x = std::min(x, std::size_t(x_end) - n);
-        normals_vector(row, up, down, pf, x, r, has_up_row, has_down_row, out);
+        VI qx, qy, qz;  // NOLINT(readability-isolate-declaration)
+        VF z;
+        normal_q_vector(row, up, down, pf, x, r, has_up_row, has_down_row, qx, qy, qz, z);
+        if (normals != nullptr) store_normals(qx, qy, qz, normals + 3 * x);
+        if (quant != nullptr) store_quant_of_normal(qx, qy, qz, z, quant + kQuantWords * x);
         if (x + n >= x_end) break;
     }
+}
+
+void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* out) {
+    normals_to_row(c, w, h, y, r, out, nullptr);
 }
 
 // ---- Quantize (shaders/pyr_quantize.h)
@@ -530,8 +568,123 @@ void mip_row(const std::uint8_t* child_top, std::uint32_t child_width, std::uint
     for (std::size_t x = full; x < parent_width; ++x) out[x] = 0;
 }
 
+// ---- Step 5's label init (shaders/pyr_labels.h, PYR_INIT_INHERIT) and step 6c's edges (shaders/pyr_edges.h)
+
+// ORs n mask bits for pixels x .. x + n - 1 into the pixel bitmap (n <= 64; SVE's lane counts need not divide 64).
+HWY_INLINE void or_bits(std::uint64_t* words, std::size_t x, std::uint64_t bits, std::size_t n) {
+    if (n < 64) bits &= (std::uint64_t{1} << n) - 1;
+    const std::size_t shift = x % 64;
+    words[x / 64] |= bits << shift;
+    if (shift != 0 && shift + n > 64) words[x / 64 + 1] |= bits >> (64 - shift);
+}
+
+bool inherit_row(const std::uint8_t* mask, const std::uint32_t* parent, std::uint32_t w, std::uint32_t* out,
+                 std::uint64_t* unlabelled) {
+    if (unlabelled != nullptr) std::memset(unlabelled, 0, (std::size_t(w) + 63) / 64 * sizeof(std::uint64_t));
+    bool any = false;
+    std::size_t x = 0;
+#if HWY_TARGET != HWY_SCALAR
+    const DU du;
+    const hn::Rebind<std::uint8_t, DU> d8;
+    const hn::Repartition<std::uint64_t, DU> d64;
+    const hn::Rebind<std::uint32_t, decltype(d64)> dhalf;
+    const std::size_t n = hn::Lanes(du);
+    const VU one = hn::Set(du, 1u);
+    if (n <= 64) {
+        for (; x + n <= w; x += n) {
+            // Each parent label twice: widened to 64 bits, its copy shifted into the upper half (lanes are
+            // little-endian on every target).
+            const auto p64 = hn::PromoteTo(d64, hn::LoadU(dhalf, parent + x / 2));
+            const VU p = hn::BitCast(du, hn::Or(p64, hn::ShiftLeft<32>(p64)));
+            const auto fillable = hn::Ne(hn::And(hn::PromoteTo(du, hn::LoadU(d8, mask + x)), one), hn::Zero(du));
+            const VU v = hn::IfThenElseZero(fillable, p);
+            hn::StoreU(v, du, out + x);
+            if (unlabelled == nullptr) continue;
+            const auto hole = hn::And(fillable, hn::Eq(v, hn::Zero(du)));
+            if (hn::AllFalse(du, hole)) continue;
+            std::uint8_t bytes[8] = {};
+            hn::StoreMaskBits(du, hole, bytes);
+            std::uint64_t bits = 0;
+            std::memcpy(&bits, bytes, sizeof bits);
+            or_bits(unlabelled, x, bits, n);
+            any = true;
+        }
+    }
+#endif
+    for (; x < w; ++x) {
+        const bool fillable = (mask[x] & PYR_MASK_FILLABLE) != 0;
+        out[x] = fillable ? parent[x / 2] : 0u;
+        if (unlabelled != nullptr && fillable && out[x] == 0) {
+            unlabelled[x / 64] |= std::uint64_t{1} << (x % 64);
+            any = true;
+        }
+    }
+    return any;
+}
+
+// The edge label of pixel x of the row (edge_row's rule), one pixel at a time: the image's borders and the tails.
+std::uint32_t edge_pixel(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+                         const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
+                         const std::uint8_t* valid, std::uint32_t w, std::uint32_t x) {
+    const std::uint32_t own = labels[x];
+    if ((mask[x] & PYR_MASK_FILLABLE) != 0 || valid[x] == 0) return own;
+    // Labels minus 1 (0 wraps to the largest value): the minimum then skips 0, and adding 1 back gives 0 for none.
+    std::uint32_t best = own - 1u;
+    const auto take = [&](std::uint8_t m, std::uint32_t l) {
+        if ((m & PYR_MASK_FILLABLE) != 0) best = std::min(best, l - 1u);
+    };
+    if (x > 0) take(mask[x - 1], labels[x - 1]);
+    if (x + 1 < w) take(mask[x + 1], labels[x + 1]);
+    if (above != nullptr) take(mask_above[x], above[x]);
+    if (below != nullptr) take(mask_below[x], below[x]);
+    return best + 1u;
+}
+
+void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+              const std::uint32_t* above, std::uint32_t* labels, const std::uint32_t* below, const std::uint8_t* valid,
+              std::uint32_t w) {
+    const auto scalar = [&](std::size_t x) {
+        labels[x] = edge_pixel(mask_above, mask, mask_below, above, labels, below, valid, w, std::uint32_t(x));
+    };
+    const hn::ScalableTag<std::uint8_t> d8;
+    const DU du;
+    const hn::Rebind<std::uint8_t, DU> d8q;
+    const std::size_t n8 = hn::Lanes(d8);
+    const std::size_t n = hn::Lanes(du);
+    const VU one = hn::Set(du, 1u);
+    // Labels minus 1 of fillable neighbours, the largest value for the others (see edge_pixel).
+    const auto candidate = [&](const std::uint32_t* l, const std::uint8_t* m) {
+        const VU not_fillable = hn::Sub(hn::And(hn::PromoteTo(du, hn::LoadU(d8q, m)), one), one);
+        return hn::Or(hn::Sub(hn::LoadU(du, l), one), not_fillable);
+    };
+    std::size_t x = 1;
+    // Pixels 1 .. w - 2 by vectors of bytes; a vector with no valid non-fillable pixel (most of a frame) is skipped.
+    if (n8 % n == 0) {
+        const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
+        for (; x + n8 + 1 <= w; x += n8) {
+            const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
+            const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
+            if (hn::AllFalse(d8, hn::AndNot(invalid, not_fillable))) continue;
+            for (std::size_t s = x; s < x + n8; s += n) {
+                const VU own = hn::LoadU(du, labels + s);
+                VU best = hn::Min(hn::Sub(own, one), hn::Min(candidate(labels + s - 1, mask + s - 1),
+                                                             candidate(labels + s + 1, mask + s + 1)));
+                if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
+                if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
+                const VU m = hn::PromoteTo(du, hn::LoadU(d8q, mask + s));
+                const VU v = hn::PromoteTo(du, hn::LoadU(d8q, valid + s));
+                const auto is_edge = hn::AndNot(hn::Eq(v, hn::Zero(du)), hn::Eq(hn::And(m, one), hn::Zero(du)));
+                hn::StoreU(hn::IfThenElse(is_edge, hn::Add(best, one), own), du, labels + s);
+            }
+        }
+    }
+    if (w > 0) scalar(0);
+    for (; x < w; ++x) scalar(x);
+}
+
 // This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
-constexpr RowKernels kKernels = {"", HWY_TARGET, &normals_row, &quantize_row, &metric_row, &mip_row};
+constexpr RowKernels kKernels = {"",       HWY_TARGET,   &normals_row, &quantize_row,  &metric_row,
+                                 &mip_row, &inherit_row, &edge_row,    &normals_to_row};
 
 // Only returns the address of constant data; see available_targets.
 const RowKernels* get_kernels() {

@@ -45,6 +45,24 @@ struct RowKernels {
     // (nullptr when 2y + 1 is not a row of the child: the whole row is then 0).
     void (*mip_row)(const std::uint8_t* child_top, std::uint32_t child_width, std::uint32_t parent_width,
                     std::uint8_t* out) = nullptr;
+    // One row of step 3's or 5's label init (pyr_label_init_texel, PYR_INIT_INHERIT): out[x] is parent[x / 2]
+    // where mask[x] is fillable, else 0, for x < w (parent: the parent level's row, (w + 1) / 2 labels). Unless
+    // unlabelled is null, it gets (w + 63) / 64 words with bit x % 64 of word x / 64 set where x is fillable and
+    // out[x] is 0 (the pixels step 6 can change), bits past w clear. Returns whether a bit is set.
+    bool (*inherit_row)(const std::uint8_t* mask, const std::uint32_t* parent, std::uint32_t w, std::uint32_t* out,
+                        std::uint64_t* unlabelled) = nullptr;
+    // Step 6c with one round (pyr_edge_label, round 1) on one row of the full level, in place: each valid
+    // (valid[x] != 0), non-fillable pixel gets the smallest non-zero label among its own and those of its fillable
+    // 4-neighbours, 0 when there is none; other pixels keep theirs. With its own label 0 that is pyr_edge_label's;
+    // with a non-zero one it is the same minimum taken again, so neighbours labelled later can be folded in. The
+    // rows above and below (labels and masks) are null at the image's top and bottom.
+    void (*edge_row)(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+                     const std::uint32_t* above, std::uint32_t* labels, const std::uint32_t* below,
+                     const std::uint8_t* valid, std::uint32_t w) = nullptr;
+    // Row y of the paper metric's normals (as normals_row, unless normals is null) and their quantize words (as
+    // quantize_row of the row's points and those normals, unless quant is null), from one pass over the points.
+    void (*normals_to_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
+                           float* normals, std::uint32_t* quant) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
