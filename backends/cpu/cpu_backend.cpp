@@ -87,24 +87,31 @@ public:
         const size_t step = depth_.row_step_bytes == 0 ? w * sample : depth_.row_step_bytes;
         const auto format = depth_.format == DepthFormat::u16 ? PYR_DEPTH_U16 : PYR_DEPTH_F32;
         const core::DepthTables& t = *depth_tables_;
-        rows(size_t(plan_.height), [&](size_t y) {
-            const auto* row = static_cast<const unsigned char*>(depth_.depth) + y * step;
-            for (size_t x = 0; x < w; ++x) {
-                uint32_t bits = 0;
-                if (format == PYR_DEPTH_U16) {
-                    std::uint16_t d = 0;
-                    std::memcpy(&d, row + 2 * x, 2);  // rows may start at any byte
-                    bits = d;
-                } else {
-                    std::memcpy(&bits, row + 4 * x, 4);
+        if (simd_ != nullptr) {
+            rows(size_t(plan_.height), [&](size_t y) {
+                simd_->depth_row(static_cast<const unsigned char*>(depth_.depth) + y * step, format, uint32_t(w),
+                                 t.scale, t.ku.data(), t.kv[y], depth_points_.data() + 3 * y * w);
+            });
+        } else {
+            rows(size_t(plan_.height), [&](size_t y) {
+                const auto* row = static_cast<const unsigned char*>(depth_.depth) + y * step;
+                for (size_t x = 0; x < w; ++x) {
+                    uint32_t bits = 0;
+                    if (format == PYR_DEPTH_U16) {
+                        std::uint16_t d = 0;
+                        std::memcpy(&d, row + 2 * x, 2);  // rows may start at any byte
+                        bits = d;
+                    } else {
+                        std::memcpy(&bits, row + 4 * x, 4);
+                    }
+                    const PyrFVec3 p = kernels::pyr_depth_point(bits, format, t.scale, t.ku[x], t.kv[y]);
+                    float* out = depth_points_.data() + 3 * (y * w + x);
+                    out[0] = p.x;
+                    out[1] = p.y;
+                    out[2] = p.z;
                 }
-                const PyrFVec3 p = kernels::pyr_depth_point(bits, format, t.scale, t.ku[x], t.kv[y]);
-                float* out = depth_points_.data() + 3 * (y * w + x);
-                out[0] = p.x;
-                out[1] = p.y;
-                out[2] = p.z;
-            }
-        });
+            });
+        }
         CloudView cloud;
         cloud.points = depth_points_.data();
         cloud.width = plan_.width;

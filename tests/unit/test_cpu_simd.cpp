@@ -476,6 +476,67 @@ TEST_P(CpuSimdRows, MipMatchesTheSharedFunction) {
     }
 }
 
+// pyr_depth_point against depth_row, both formats, on samples that hit every branch (no data, special floats,
+// products that underflow, overflow or turn subnormal), for rows aligned and starting at an odd byte.
+TEST_P(CpuSimdRows, DepthRowMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(13);
+    const float special[] = {0.0f,  -0.0f, kDenorm, -kDenorm, kMin, -kMin,  kNaN,  -kNaN,   kInf,
+                             -kInf, kMax,  1.0f,    -1.0f,    0.5f, 1e-30f, 1e30f, 3.0e38f, 65535.0f};
+    // Scales: millimetres to millimetres, to metres, and two that push products out of the normal range.
+    const float scales[] = {1.0f, 0.001f, 1e35f, 1.5e-38f};
+    for (const std::uint32_t format : {std::uint32_t{PYR_DEPTH_U16}, std::uint32_t{PYR_DEPTH_F32}}) {
+        for (const float scale : scales) {
+            for (const std::uint32_t w : {1u, 3u, 15u, 16u, 17u, 40u, 131u}) {
+                for (const std::size_t offset : {std::size_t{0}, std::size_t{1}}) {
+                    const std::size_t sample = format == PYR_DEPTH_U16 ? 2 : 4;
+                    std::vector<unsigned char> bytes(offset + sample * w);
+                    std::vector<float> ku(w);
+                    for (std::uint32_t x = 0; x < w; ++x) {
+                        if (format == PYR_DEPTH_U16) {
+                            const auto v = std::uint16_t(rng() % 5 == 0 ? (rng() % 3 == 0 ? 0 : 65535) : rng());
+                            std::memcpy(bytes.data() + offset + 2 * x, &v, 2);
+                        } else {
+                            const float v = rng() % 3 == 0 ? special[rng() % std::size(special)]
+                                                           : std::uniform_real_distribution<float>(0.0f, 5000.0f)(rng);
+                            std::memcpy(bytes.data() + offset + 4 * x, &v, 4);
+                        }
+                        // Slopes of both signs, zero, and tiny ones whose products are subnormal.
+                        const std::uint32_t pick = rng() % 6;
+                        ku[x] = pick == 0
+                                    ? 0.0f
+                                    : (pick == 1 ? -1e-38f
+                                                 : (pick == 2 ? 3e-39f : float(int(rng() % 2001) - 1000) / 700.0f));
+                    }
+                    for (const float kv : {-0.7f, 0.0f, 1e-39f}) {
+                        std::vector<float> expected(3 * std::size_t(w));
+                        std::vector<float> actual(expected.size(), 7.0f);
+                        for (std::uint32_t x = 0; x < w; ++x) {
+                            std::uint32_t value = 0;
+                            if (format == PYR_DEPTH_U16) {
+                                std::uint16_t d = 0;
+                                std::memcpy(&d, bytes.data() + offset + 2 * x, 2);
+                                value = d;
+                            } else {
+                                std::memcpy(&value, bytes.data() + offset + 4 * x, 4);
+                            }
+                            const PyrFVec3 p = kernels::pyr_depth_point(value, format, scale, ku[x], kv);
+                            expected[3 * x] = p.x;
+                            expected[3 * x + 1] = p.y;
+                            expected[3 * x + 2] = p.z;
+                        }
+                        k.depth_row(bytes.data() + offset, format, w, scale, ku.data(), kv, actual.data());
+                        const std::string diff =
+                            first_difference(actual.data(), expected.data(), actual.size() * 4, 12);
+                        ASSERT_EQ(diff, "") << "format " << format << " scale " << scale << " width " << w << " offset "
+                                            << offset << " kv " << kv;
+                    }
+                }
+            }
+        }
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Targets, CpuSimdRows, ::testing::ValuesIn(target_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 

@@ -63,6 +63,10 @@ struct RowKernels {
     // quantize_row of the row's points and those normals, unless quant is null), from one pass over the points.
     void (*normals_to_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
                            float* normals, std::uint32_t* quant) = nullptr;
+    // One row of a depth image to points (pyr_depth_point): w samples (u16 or f32 as `format` says: PYR_DEPTH_*)
+    // from `samples`, with the row's ku[0..w-1] and kv; 3 * w floats out, packed.
+    void (*depth_row)(const void* samples, std::uint32_t format, std::uint32_t w, float scale, const float* ku,
+                      float kv, float* out) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
