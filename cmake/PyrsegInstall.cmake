@@ -1,19 +1,68 @@
-# `cmake --install`: the library (pyrseg::pyrseg), the synthetic scenes (pyrseg::synthetic), their headers, the
-# pyrseg tool, and a CMake package so that consumers write find_package(pyrseg) and link pyrseg::pyrseg.
+# `cmake --install`: the library (pyrseg::pyrseg), the file formats (pyrseg::io), the synthetic scenes
+# (pyrseg::synthetic), their headers, the pyrseg tool, a CMake package so that consumers write find_package(pyrseg)
+# and link pyrseg::pyrseg, pkg-config files (pyrseg, pyrseg-io, pyrseg-synthetic), and `cpack` making a .deb of it all.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set_target_properties(pyrseg PROPERTIES EXPORT_NAME pyrseg)
+set_target_properties(pyrseg_io PROPERTIES EXPORT_NAME io)
 set_target_properties(pyrseg_synthetic PROPERTIES EXPORT_NAME synthetic)
-# Static libraries carry their private link dependencies; the flags target only adds link options (sanitizers).
-install(TARGETS pyrseg pyrseg_synthetic pyrseg_build_flags EXPORT pyrsegTargets
-        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# Static libraries carry their private link dependencies, so the interface targets they link go into the export set
+# too: the flags target only adds link options (sanitizers); OpenCV core and PCL io are found without a CMake package
+# (io/CMakeLists.txt) and exported as the paths found here.
+set(_pyrseg_exported pyrseg pyrseg_io pyrseg_synthetic pyrseg_build_flags)
+foreach(_t pyrseg_opencv_core pyrseg_pcl_io)
+  if(TARGET ${_t})
+    list(APPEND _pyrseg_exported ${_t})
+  endif()
+endforeach()
+install(TARGETS ${_pyrseg_exported} EXPORT pyrsegTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The interop headers of backends this build lacks would declare functions the library does not have.
+set(_pyrseg_header_excludes "")
+foreach(_b cuda vulkan opencl)
+  if(NOT PYRSEG_BUILD_${_b})
+    list(APPEND _pyrseg_header_excludes PATTERN "${_b}.hpp" EXCLUDE)
+  endif()
+endforeach()
 install(DIRECTORY include/pyrseg DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.hpp" PATTERN "io.hpp" EXCLUDE)
+        FILES_MATCHING PATTERN "*.hpp" ${_pyrseg_header_excludes})
 install(FILES ${PROJECT_BINARY_DIR}/generated/include/pyrseg/version.hpp
+              ${PROJECT_BINARY_DIR}/generated/include/pyrseg/export.hpp
+              ${PROJECT_BINARY_DIR}/generated/include/pyrseg/io_export.hpp
+              ${PROJECT_BINARY_DIR}/generated/include/pyrseg/synthetic_export.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pyrseg)
 if(TARGET pyrseg_cli)
   install(TARGETS pyrseg_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  if(BUILD_SHARED_LIBS)
+    # The tool finds the shared libraries beside it wherever the prefix is (a temporary prefix, an unpacked .deb).
+    file(RELATIVE_PATH _bin_to_lib ${CMAKE_INSTALL_FULL_BINDIR} ${CMAKE_INSTALL_FULL_LIBDIR})
+    set_target_properties(pyrseg_cli PROPERTIES INSTALL_RPATH "$ORIGIN/${_bin_to_lib}")
+  endif()
+endif()
+install(FILES LICENSE CHANGELOG.md README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+
+# What a consumer's find_package(pyrseg) must find first: a static library's private dependencies become the
+# consumer's link dependencies (pyrsegConfig.cmake.in); a shared library resolves them itself.
+set(PYRSEG_STATIC_DEPENDENCIES "")
+if(NOT BUILD_SHARED_LIBS)
+  set(PYRSEG_STATIC_DEPENDENCIES "find_dependency(hwy)\nfind_dependency(nlohmann_json)\nfind_dependency(PNG)\n")
+  string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(TIFF)\n")
+  if(OpenCV_FOUND)
+    string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(OpenCV COMPONENTS core)\n")
+  endif()
+  if(PYRSEG_BUILD_opencl)
+    string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(OpenCL)\n")
+  endif()
+  if(PYRSEG_BUILD_cuda)
+    string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(CUDAToolkit)\n")
+  endif()
+  if(PYRSEG_BUILD_vulkan)
+    string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(Vulkan)\n")
+  endif()
 endif()
 install(EXPORT pyrsegTargets NAMESPACE pyrseg:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pyrseg)
 configure_package_config_file(cmake/pyrsegConfig.cmake.in ${PROJECT_BINARY_DIR}/pyrsegConfig.cmake
@@ -21,3 +70,83 @@ configure_package_config_file(cmake/pyrsegConfig.cmake.in ${PROJECT_BINARY_DIR}/
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/pyrsegConfigVersion.cmake COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/pyrsegConfig.cmake ${PROJECT_BINARY_DIR}/pyrsegConfigVersion.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pyrseg)
+
+# pkg-config files, relocatable (${pcfiledir}): the same files serve a temporary prefix and an unpacked .deb.
+# Libs.private and Requires.private are what `pkg-config --static` adds for the static libraries.
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}" OR IS_ABSOLUTE "${CMAKE_INSTALL_INCLUDEDIR}")
+  message(FATAL_ERROR "pyrseg: the pkg-config files need CMAKE_INSTALL_LIBDIR and CMAKE_INSTALL_INCLUDEDIR relative")
+endif()
+file(RELATIVE_PATH _pc_to_prefix /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+string(REGEX REPLACE "/$" "" _pc_to_prefix "${_pc_to_prefix}")
+set(PYRSEG_PC_PREFIX "\${pcfiledir}/${_pc_to_prefix}")
+# _pyrseg_pc(NAME DESCRIPTION LIBRARY REQUIRES REQUIRES_PRIVATE LIBS_PRIVATE)
+function(_pyrseg_pc name description library requires requires_private libs_private)
+  set(PC_NAME ${name})
+  set(PC_DESCRIPTION "${description}")
+  set(PC_LIBRARY ${library})
+  set(PC_REQUIRES "${requires}")
+  # A shared library records its own dependencies (DT_NEEDED): consumers need neither list, nor the -dev packages
+  # that provide the .pc files named in Requires.private (which pkg-config looks for even without --static).
+  set(PC_REQUIRES_PRIVATE "")
+  set(PC_LIBS_PRIVATE "")
+  if(NOT BUILD_SHARED_LIBS)
+    set(PC_REQUIRES_PRIVATE "${requires_private}")
+    set(PC_LIBS_PRIVATE "${libs_private}")
+  endif()
+  # A static library's export macros are empty (cmake/PyrsegLibraries.cmake), as they are in its own build.
+  get_target_property(type ${library} TYPE)
+  set(PC_CFLAGS "")
+  if(type STREQUAL "STATIC_LIBRARY")
+    string(TOUPPER "${library}" base)
+    set(PC_CFLAGS " -D${base}_STATIC_DEFINE")
+  endif()
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/pyrseg.pc.in ${PROJECT_BINARY_DIR}/pkgconfig/${name}.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/${name}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endfunction()
+set(_core_requires "libhwy")
+set(_core_libs "")
+if(PYRSEG_BUILD_opencl)
+  string(APPEND _core_requires " OpenCL")
+endif()
+if(PYRSEG_BUILD_vulkan)
+  string(APPEND _core_requires " vulkan")
+endif()
+if(PYRSEG_BUILD_cuda)
+  string(APPEND _core_libs " -L${CUDAToolkit_LIBRARY_DIR} -lcudart_static -ldl -lrt")
+endif()
+_pyrseg_pc(pyrseg "${PROJECT_DESCRIPTION}" pyrseg "" "${_core_requires}" "${_core_libs}")
+set(_io_libs "${LZF_LIBRARY}")
+if(OpenCV_FOUND)
+  string(APPEND _io_libs " -lopencv_core")
+else()
+  string(APPEND _io_libs " ${PYRSEG_OPENCV_CORE_LIBRARY}")
+endif()
+if(TARGET pyrseg_pcl_io)
+  string(APPEND _io_libs " ${PYRSEG_PCL_IO_LIBRARY} ${PYRSEG_PCL_COMMON_LIBRARY}")
+endif()
+_pyrseg_pc(pyrseg-io "pyrseg's file formats: PCD, PLY, NumPy, PNG and TIFF depth images" pyrseg_io pyrseg
+           "libpng libtiff-4" "${_io_libs}")
+_pyrseg_pc(pyrseg-synthetic "Seeded synthetic bin-picking scenes with ground truth, for tests and demos"
+           pyrseg_synthetic "" "" "")
+
+# cpack: one .deb with the libraries, headers, CMake and pkg-config files and the tool (build/package, made by
+# scripts/package.sh, is a shared CPU-only build). Its Depends come from dpkg-shlibdeps on the binaries inside.
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME pyrseg)
+set(CPACK_PACKAGE_VENDOR "pyrseg maintainers")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
+set(CPACK_PACKAGE_DESCRIPTION "pyrseg segments organized point clouds and depth images into surfaces (C++20 \
+library, file formats, synthetic test scenes and the pyrseg command-line tool), with CMake and pkg-config files.")
+set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
+set(PYRSEG_PACKAGE_MAINTAINER "pyrseg maintainers <maintainers@users.noreply.h-seed-f5177c9b.example>"
+    CACHE STRING "The Maintainer field of the .deb cpack makes")
+set(CPACK_DEBIAN_PACKAGE_MAINTAINER "${PYRSEG_PACKAGE_MAINTAINER}")
+set(CPACK_DEBIAN_PACKAGE_SECTION libdevel)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# The tool links the package's own libraries: dpkg-shlibdeps looks for them in the staging tree, not the system.
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS_PRIVATE_DIRS ${CMAKE_INSTALL_FULL_LIBDIR})
+# libpyrseg.so is a library others link: ship its shlibs file so that their packages depend on this one.
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS_POLICY ">=")
+include(CPack)

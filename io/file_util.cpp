@@ -1,5 +1,8 @@
 #include "file_util.hpp"
 
+#include <unistd.h>
+
+#include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
@@ -54,15 +57,55 @@ std::vector<unsigned char> read_file(const std::filesystem::path& path) {
     return bytes;
 }
 
-void write_file(const std::filesystem::path& path, const void* data, std::size_t size) {
-    errno = 0;
-    File file(std::fopen(path.c_str(), "wb"));
-    if (!file) fail(ErrorCode::io, path, "cannot open for writing: " + errno_text(errno));
-    if (size > 0 && std::fwrite(data, 1, size, file.get()) != size) {
-        fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path& temporary)>& write_to) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status)) fail(ErrorCode::io, path, "cannot open for writing: is a directory");
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+        write_to(path);
+        return;
     }
-    // Buffered data only reaches the disk at fclose, so a full disk shows up here.
-    if (std::fclose(file.release()) != 0) fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+    // Through a symbolic link the file it names is replaced, not the link.
+    std::filesystem::path target = path;
+    if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
+        const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, ec);
+        if (!ec) target = resolved;
+    }
+    // Beside the target, so that the rename stays within one file system; pid and a counter keep concurrent
+    // writers (threads, processes) of the same target apart.
+    static std::atomic<unsigned> counter{0};
+    std::filesystem::path temporary = target;
+    std::string name = ".";
+    name += target.filename().string();
+    name += ".pyrseg-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1)) + ".tmp";
+    temporary.replace_filename(name);
+    try {
+        write_to(temporary);
+    } catch (...) {
+        std::filesystem::remove(temporary, ec);
+        throw;
+    }
+    std::filesystem::rename(temporary, target, ec);
+    if (ec) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        fail(ErrorCode::io, path, "cannot replace the file: " + ec.message());
+    }
+}
+
+void write_file(const std::filesystem::path& path, const void* data, std::size_t size) {
+    write_atomically(path, [&](const std::filesystem::path& temporary) {
+        errno = 0;
+        File file(std::fopen(temporary.c_str(), "wb"));
+        // Named by the target: the temporary file is an implementation detail.
+        if (!file) fail(ErrorCode::io, path, "cannot open for writing: " + errno_text(errno));
+        if (size > 0 && std::fwrite(data, 1, size, file.get()) != size) {
+            fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+        }
+        // Buffered data only reaches the disk at fclose, so a full disk shows up here.
+        if (std::fclose(file.release()) != 0) fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+    });
 }
 
 void check_cloud_to_write(const std::filesystem::path& path, const PointCloud& cloud) {

@@ -1,10 +1,12 @@
-// Writing PCD files the way PCL does: fields x y z [normal_x normal_y normal_z], all F 4, VERSION 0.7.
+// Writing PCD files the way PCL does: fields x y z [normal_x normal_y normal_z] as F 4 [label as U 4], VERSION 0.7.
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "file_util.hpp"
 #include "lzf_block.hpp"
@@ -18,11 +20,33 @@ using detail::fail;
 
 static_assert(std::endian::native == std::endian::little, "PCD binary writing assumes a little-endian host");
 
-std::string header(const PointCloud& cloud, bool normals, const char* data) {
+// What one point holds, in file order: x y z, then normal_x normal_y normal_z, then label (PCL's PointXYZL and
+// PointXYZLNormal name it so; pcl::io::loadPCDFile matches fields by name, so the order is free).
+struct Layout {
+    bool normals = false;
+    const std::uint32_t* labels = nullptr;
+    [[nodiscard]] std::size_t float_fields() const { return normals ? 6 : 3; }
+    [[nodiscard]] std::size_t fields() const { return float_fields() + (labels != nullptr ? 1 : 0); }
+    [[nodiscard]] std::size_t point_bytes() const { return 4 * fields(); }
+};
+
+std::string header(const PointCloud& cloud, const Layout& layout, const char* data) {
     const std::string n = std::to_string(static_cast<long long>(cloud.width) * cloud.height);
+    std::string names = "x y z", sizes = "4 4 4", types = "F F F", counts = "1 1 1";
+    if (layout.normals) {
+        names += " normal_x normal_y normal_z";
+        sizes += " 4 4 4";
+        types += " F F F";
+        counts += " 1 1 1";
+    }
+    if (layout.labels != nullptr) {
+        names += " label";
+        sizes += " 4";
+        types += " U";
+        counts += " 1";
+    }
     std::string h = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
-    h += normals ? "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\nCOUNT 1 1 1 1 1 1\n"
-                 : "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+    h += "FIELDS " + names + "\nSIZE " + sizes + "\nTYPE " + types + "\nCOUNT " + counts + "\n";
     h += "WIDTH " + std::to_string(cloud.width) + "\nHEIGHT " + std::to_string(cloud.height) + "\n";
     h += "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + n + "\nDATA " + data + "\n";
     return h;
@@ -43,47 +67,56 @@ void append_float(std::string& out, float v) {
     out.append(buf, end);
 }
 
-std::string ascii_body(const PointCloud& cloud, std::size_t n, bool normals) {
+std::string ascii_body(const PointCloud& cloud, std::size_t n, const Layout& layout) {
     std::string out;
-    out.reserve(n * (normals ? 60 : 30));
+    out.reserve(n * 10 * layout.fields());
     for (std::size_t i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) {
             if (c > 0) out += ' ';
             append_float(out, cloud.points[3 * i + static_cast<std::size_t>(c)]);
         }
-        for (int c = 0; normals && c < 3; ++c) {
+        for (int c = 0; layout.normals && c < 3; ++c) {
             out += ' ';
             append_float(out, cloud.normals[3 * i + static_cast<std::size_t>(c)]);
+        }
+        if (layout.labels != nullptr) {
+            char buf[16];
+            const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, layout.labels[i]);
+            out += ' ';
+            out.append(buf, end);
         }
         out += '\n';
     }
     return out;
 }
 
-std::string binary_body(const PointCloud& cloud, std::size_t n, bool normals) {
+std::string binary_body(const PointCloud& cloud, std::size_t n, const Layout& layout) {
     std::string out;
-    out.reserve(n * (normals ? 24 : 12));
+    out.reserve(n * layout.point_bytes());
     for (std::size_t i = 0; i < n; ++i) {
         append_bytes(out, &cloud.points[3 * i], 3 * sizeof(float));
-        if (normals) append_bytes(out, &cloud.normals[3 * i], 3 * sizeof(float));
+        if (layout.normals) append_bytes(out, &cloud.normals[3 * i], 3 * sizeof(float));
+        if (layout.labels != nullptr) append_bytes(out, &layout.labels[i], sizeof(std::uint32_t));
     }
     return out;
 }
 
-std::string compressed_body(const std::filesystem::path& path, const PointCloud& cloud, std::size_t n, bool normals) {
-    const std::size_t fields = normals ? 6 : 3;
-    const std::size_t raw_size = n * fields * sizeof(float);
+std::string compressed_body(const std::filesystem::path& path, const PointCloud& cloud, std::size_t n,
+                            const Layout& layout) {
+    const std::size_t raw_size = n * layout.point_bytes();
     if (raw_size > std::numeric_limits<std::uint32_t>::max()) {
         fail(ErrorCode::invalid_argument, path,
              "cloud too large for DATA binary_compressed (" + std::to_string(raw_size) +
                  " bytes; the format stores sizes in 32 bits): write it as binary");
     }
-    // Structure of arrays: all x, then all y, ... as PCL's reader expects.
-    std::vector<float> soa(n * fields);
-    for (std::size_t f = 0; f < fields; ++f) {
+    // Structure of arrays: all x, then all y, ... (then all labels) as PCL's reader expects.
+    std::vector<unsigned char> soa(raw_size);
+    unsigned char* block = soa.data();
+    for (std::size_t f = 0; f < layout.float_fields(); ++f, block += 4 * n) {
         const std::vector<float>& src = f < 3 ? cloud.points : cloud.normals;
-        for (std::size_t i = 0; i < n; ++i) soa[f * n + i] = src[3 * i + f % 3];
+        for (std::size_t i = 0; i < n; ++i) std::memcpy(block + 4 * i, &src[3 * i + f % 3], sizeof(float));
     }
+    if (layout.labels != nullptr) std::memcpy(block, layout.labels, n * sizeof(std::uint32_t));
     const std::vector<unsigned char> packed = detail::lzf_pack(soa.data(), raw_size);
     if (packed.empty()) fail(ErrorCode::internal, path, "LZF compression failed");
     const auto compressed = static_cast<std::uint32_t>(packed.size());
@@ -97,25 +130,30 @@ std::string compressed_body(const std::filesystem::path& path, const PointCloud&
 
 }  // namespace
 
-void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding) {
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
+               PcdEncoding encoding) {
     detail::check_cloud_to_write(path, cloud);
     const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
-    const bool normals = !cloud.normals.empty();
+    const Layout layout{!cloud.normals.empty(), labels};
     std::string out;
     switch (encoding) {
         case PcdEncoding::ascii:
-            out = header(cloud, normals, "ascii") + ascii_body(cloud, n, normals);
+            out = header(cloud, layout, "ascii") + ascii_body(cloud, n, layout);
             break;
         case PcdEncoding::binary:
-            out = header(cloud, normals, "binary") + binary_body(cloud, n, normals);
+            out = header(cloud, layout, "binary") + binary_body(cloud, n, layout);
             break;
         case PcdEncoding::binary_compressed:
-            out = header(cloud, normals, "binary_compressed") + compressed_body(path, cloud, n, normals);
+            out = header(cloud, layout, "binary_compressed") + compressed_body(path, cloud, n, layout);
             break;
         default:
             fail(ErrorCode::invalid_argument, path, "unknown PcdEncoding");
     }
     detail::write_file(path, out.data(), out.size());
+}
+
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding) {
+    write_pcd(path, cloud, nullptr, encoding);
 }
 
 }  // namespace pyrseg::io

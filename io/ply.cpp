@@ -614,32 +614,34 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const
             std::memcpy(p + rgb_offset, &packed, sizeof packed);
         }
     }
-    // Open it here first: PCL's failure to would be silent, and this way the message carries the reason.
-    errno = 0;
-    {
-        const std::unique_ptr<std::FILE, FileCloser> probe(std::fopen(path.c_str(), "wb"));
-        if (!probe) {
-            fail(ErrorCode::io, path,
-                 "cannot open for writing: " + std::error_code(errno, std::generic_category()).message());
+    detail::write_atomically(path, [&](const std::filesystem::path& temporary) {
+        // Open it here first: PCL's failure to would be silent, and this way the message carries the reason.
+        errno = 0;
+        {
+            const std::unique_ptr<std::FILE, FileCloser> probe(std::fopen(temporary.c_str(), "wb"));
+            if (!probe) {
+                fail(ErrorCode::io, path,
+                     "cannot open for writing: " + std::error_code(errno, std::generic_category()).message());
+            }
         }
-    }
-    int status = -1;
-    {
-        const QuietPcl quiet;
-        pcl::PLYWriter writer;
-        const Eigen::Vector4f origin = Eigen::Vector4f::Zero();
-        const Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
-        // use_camera = false: obj_info num_cols/num_rows and a range_grid element keep the grid, and only points
-        // with finite x y z become vertices. (PCL 1.13 writes those ascii values with 6 significant digits: the
-        // precision argument does not reach its range-grid path. Binary is exact.)
-        try {
-            status = binary ? writer.writeBinary(path.string(), blob, origin, orientation, false)
-                            : writer.writeASCII(path.string(), blob, origin, orientation, 9, false);
-        } catch (const std::exception& e) {
-            fail(ErrorCode::io, path, std::string("PCL's PLY writer failed: ") + e.what());
+        int status = -1;
+        {
+            const QuietPcl quiet;
+            pcl::PLYWriter writer;
+            const Eigen::Vector4f origin = Eigen::Vector4f::Zero();
+            const Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+            // use_camera = false: obj_info num_cols/num_rows and a range_grid element keep the grid, and only
+            // points with finite x y z become vertices. (PCL 1.13 writes those ascii values with 6 significant
+            // digits: the precision argument does not reach its range-grid path. Binary is exact.)
+            try {
+                status = binary ? writer.writeBinary(temporary.string(), blob, origin, orientation, false)
+                                : writer.writeASCII(temporary.string(), blob, origin, orientation, 9, false);
+            } catch (const std::exception& e) {
+                fail(ErrorCode::io, path, std::string("PCL's PLY writer failed: ") + e.what());
+            }
         }
-    }
-    if (status != 0) fail(ErrorCode::io, path, "PCL's PLY writer could not write the file");
+        if (status != 0) fail(ErrorCode::io, path, "PCL's PLY writer could not write the file");
+    });
 }
 
 #else  // !PYRSEG_HAVE_PLY

@@ -13,6 +13,7 @@ packages=(
   clang clang-format glslang-tools spirv-tools  # shaders/ compile checks as OpenCL C and GLSL; style
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd  # the OpenCL backend, and PoCL to run it on in CI
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers  # the Vulkan backend, lavapipe, the validation layer
+  doxygen                                       # the API reference (scripts/api-docs.sh)
 )
 
 missing=()

@@ -190,8 +190,8 @@ int cmd_demo(const std::vector<std::string>& argv) {
         for (const fs::path& scan : scans) {
             const io::PointCloud cloud = io::read_pcd(scan);
             Params scan_params = params;
-            // The shared scans are in metres; a cloud whose median depth is under 20 units is taken as metres.
-            if (!args.value("unit-mm") && median_depth(cloud.points) < 20.0) scan_params.unit_mm = 1000.0;
+            // The shared scans are in metres: the unit comes from the median depth, as in pyrseg segment.
+            if (!args.value("unit-mm")) scan_params.unit_mm = detected_unit_mm(median_depth(cloud.points));
             CloudView scan_view;
             scan_view.points = cloud.points.data();
             scan_view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();

@@ -1,10 +1,12 @@
 #include <glob.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <set>
@@ -28,13 +30,13 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
-    "Usage: pyrseg segment INPUT [--labels OUT.npy] [--png OUT.png] [--mask-png OUT.png] [--figure OUT.png]\n"
-    "                      [--ply OUT.ply] [--stats OUT.json|OUT.csv] [--pcl-png OUT.png] [--backend NAME]\n"
-    "                      [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,stats]\n"
-    "                      [--progress auto|bar|lines|none]\n"
+    "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [input options] [parameters]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats]\n"
+    "                      [--progress auto|bar|lines|none] [--backend NAME] [input options] [parameters]\n"
     "\n"
-    "Segments one organized point cloud or depth image (see Inputs below). At least one output:\n"
+    "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
+    "and the time. With no output option it writes nothing and also prints the segment sizes. Outputs (each name\n"
+    "must end in the extension shown, else nothing is done; a file is written whole or not at all):\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments);\n"
     "  --labels OUT.png      or as a 16-bit grayscale PNG, when every label fits in 16 bits\n"
     "  --png OUT.png         the segments in colour\n"
@@ -42,25 +44,82 @@ constexpr const char* kSegmentUsage =
     "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
     "  --ply OUT.ply         the cloud coloured by segment (gray: no segment), binary PLY, organized (obj_info\n"
     "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
+    "  --pcd OUT.pcd         the cloud with each point's segment in a 'label' field (0: none), binary PCD in PCL's\n"
+    "                        PointXYZL layout: pcl::io::loadPCDFile reads it into pcl::PointCloud<pcl::PointXYZL>.\n"
+    "                        Organized, invalid points NaN, in the input's unit (millimetres for depth images)\n"
     "  --stats OUT.json      per segment: label, pixel count, bounding box, 3D centroid (the cloud's units) and\n"
-    "  --stats OUT.csv       mean normal, computed by the backend; JSON, or CSV when the name ends in .csv\n"
+    "  --stats OUT.csv       mean normal, computed by the backend; JSON or CSV, as the extension says\n"
     "  --pcl-png OUT.png     PCL's organized segmentation of the same frame in colour, to compare (builds with\n"
     "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
     "                        PCL's defaults\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "\n"
+    "Units: cloud files do not say theirs. Without --unit-mm, a cloud whose median depth is under 20 units is read\n"
+    "as metres (pyrseg says so), any other as millimetres; --unit-mm always wins. Depth images and depth maps take\n"
+    "the unit of their samples from --metres-per-unit (below).\n"
+    "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply, NAME.stats.json as --write asks (default labels,png). A frame that fails is reported and skipped; the "
-    "exit status is\n"
-    "1 if any failed. No output may overwrite its input.\n"
+    "NAME.ply, NAME.labels.pcd, NAME.stats.json as --write asks (default labels,png). A frame that fails is reported\n"
+    "and skipped; the exit status is 1 if any failed. No output may overwrite its input.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply, stats, pcl_png;
-    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || stats || pcl_png; }
+    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, pcl_png;
+    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || pcd || stats || pcl_png; }
 };
+
+// The output options, the extensions their files may have, and what they write (for the message refusing another
+// extension: a name is never silently given a format it does not say).
+struct OutputOption {
+    const char* name;
+    std::optional<fs::path> OutputPaths::*path;
+    std::vector<std::string> extensions;
+    const char* writes;
+};
+const std::vector<OutputOption>& output_options() {
+    static const std::vector<OutputOption> options = {
+        {"labels",
+         &OutputPaths::labels,
+         {".npy", ".png"},
+         "labels as a NumPy uint32 array or a 16-bit PNG; for a cloud with a label field, give --pcd OUT.pcd"},
+        {"png", &OutputPaths::png, {".png"}, "the segments in colour, as PNG"},
+        {"mask-png", &OutputPaths::mask, {".png"}, "the mask, as PNG"},
+        {"figure", &OutputPaths::figure, {".png"}, "the figure, as PNG"},
+        {"ply", &OutputPaths::ply, {".ply"}, "the coloured cloud, as PLY"},
+        {"pcd", &OutputPaths::pcd, {".pcd"}, "the cloud with a label field, as PCD"},
+        {"stats", &OutputPaths::stats, {".json", ".csv"}, "the statistics, as JSON or CSV"},
+        {"pcl-png", &OutputPaths::pcl_png, {".png"}, "PCL's segmentation in colour, as PNG"},
+    };
+    return options;
+}
+
+std::string lower_extension(const fs::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+OutputPaths output_paths(const Args& args) {
+    OutputPaths out;
+    for (const OutputOption& o : output_options()) {
+        const std::optional<std::string> name = args.value(o.name);
+        if (!name) continue;
+        const std::string ext = lower_extension(*name);
+        if (std::find(o.extensions.begin(), o.extensions.end(), ext) == o.extensions.end()) {
+            std::string accepted;
+            for (const std::string& e : o.extensions) {
+                if (!accepted.empty()) accepted += " or ";
+                accepted += e;
+            }
+            throw UsageError{"--" + std::string(o.name) + " " + *name + ": the name must end in " + accepted + " (" +
+                             o.writes + ")"};
+        }
+        out.*o.path = *name;
+    }
+    return out;
+}
 
 struct FrameReport {
     std::string line;
@@ -68,11 +127,14 @@ struct FrameReport {
     double milliseconds = 0;
 };
 
+// Said once per run: a batch of clouds in metres needs one note, not one per frame.
+struct RunNotes {
+    bool metres_read = false;
+};
+
 // .npy (uint32) or, when every label fits, a 16-bit PNG that image viewers and OpenCV read directly.
 void write_labels(const fs::path& path, const Result& result) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".png") {
+    if (lower_extension(path) != ".png") {
         io::write_npy(path, result.labels.data(), result.height, result.width);
         return;
     }
@@ -96,24 +158,88 @@ bool same_params(const Params& a, const Params& b) {
            a.ct_growth_per_m2 == b.ct_growth_per_m2;
 }
 
+// The cloud's unit in millimetres: --unit-mm when given (which always wins, with a warning when it puts the median
+// depth out of every sensor's range), else the one its median depth says (detected_unit_mm), telling when that is
+// metres so that nobody is surprised by it.
+double cloud_unit_mm(const fs::path& input, const io::PointCloud& cloud, const Args& args, double given_unit_mm,
+                     RunNotes& notes) {
+    const double median = median_depth(cloud.points);
+    if (args.value("unit-mm")) {
+        const double metres = median * given_unit_mm / 1000.0;
+        if (median > 0 && !plausible_median_metres(metres)) {
+            std::fprintf(stderr,
+                         "pyrseg: warning: %s: with --unit-mm %s the median depth is %.4g m, outside any depth "
+                         "sensor's range (%g to %g m): is --unit-mm right? (1 for millimetres, 1000 for metres)\n",
+                         input.string().c_str(), args.value("unit-mm")->c_str(), metres, kPlausibleMedianMetresMin,
+                         kPlausibleMedianMetresMax);
+        }
+        return given_unit_mm;
+    }
+    const double unit_mm = detected_unit_mm(median);
+    if (unit_mm == 1000.0 && !notes.metres_read) {
+        std::fprintf(stderr,
+                     "pyrseg: note: %s: median depth %.3g units, so the cloud is read as metres (--unit-mm 1000); "
+                     "pass --unit-mm 1 if it is in millimetres\n",
+                     input.string().c_str(), median);
+        notes.metres_read = true;
+    }
+    return unit_mm;
+}
+
+// What a run without outputs prints under the frame's line: the segments' sizes, largest first, and how much of the
+// frame they cover.
+std::string size_summary(const Result& result, const io::PointCloud& cloud) {
+    std::vector<std::uint32_t> labels;
+    for (const std::uint32_t l : result.labels) {
+        if (l != 0) labels.push_back(l);
+    }
+    std::sort(labels.begin(), labels.end());
+    std::vector<std::size_t> sizes;
+    for (std::size_t i = 0; i < labels.size();) {
+        std::size_t j = i;
+        while (j < labels.size() && labels[j] == labels[i]) ++j;
+        sizes.push_back(j - i);
+        i = j;
+    }
+    std::sort(sizes.begin(), sizes.end(), std::greater<>());
+    std::size_t valid = 0;
+    for (std::size_t i = 2; i < cloud.points.size(); i += 3) {
+        if (std::isfinite(cloud.points[i]) && cloud.points[i] > 0) ++valid;
+    }
+    const std::size_t pixels = result.labels.size();
+    std::string text = "  segment sizes in pixels, largest first:";
+    constexpr std::size_t kShown = 10;
+    for (std::size_t i = 0; i < sizes.size() && i < kShown; ++i) {
+        text += i == 0 ? " " : ", ";
+        text += std::to_string(sizes[i]);
+    }
+    if (sizes.empty()) text += " none";
+    if (sizes.size() > kShown) {
+        text +=
+            ", ... (" + std::to_string(sizes.size()) + " in all, the smallest " + std::to_string(sizes.back()) + ")";
+    }
+    char coverage[160];
+    std::snprintf(coverage, sizeof coverage, "\n  labelled: %zu of %zu pixels (%.1f%%); %zu valid points\n",
+                  labels.size(), pixels, pixels > 0 ? 100.0 * double(labels.size()) / double(pixels) : 0.0, valid);
+    text += coverage;
+    text += "  nothing written: --labels, --png, --pcd, --ply, --stats ... write outputs (pyrseg segment --help)";
+    return text;
+}
+
 FrameReport segment_frame(const fs::path& input, const Args& args, const Params& base_params, const OutputPaths& out,
-                          std::unique_ptr<Segmenter>& segmenter) {
+                          std::unique_ptr<Segmenter>& segmenter, RunNotes& notes) {
     // NAME.png or NAME.ply in the input's own folder would be the input itself.
-    for (const std::optional<fs::path>* o :
-         {&out.labels, &out.png, &out.mask, &out.figure, &out.ply, &out.stats, &out.pcl_png}) {
+    for (const OutputOption& o : output_options()) {
+        const std::optional<fs::path>& path = out.*o.path;
         std::error_code ec;
-        if (o->has_value() && fs::equivalent(**o, input, ec)) {
-            throw Error(ErrorCode::io, (*o)->string() + ": is the input; refusing to overwrite it");
+        if (path.has_value() && fs::equivalent(*path, input, ec)) {
+            throw Error(ErrorCode::io, path->string() + ": is the input; refusing to overwrite it");
         }
     }
     const LoadedInput loaded = load_input(input, args);
     const io::PointCloud& cloud = loaded.cloud;
-    const double median_z = median_depth(cloud.points);
-    if (!loaded.millimetres && base_params.unit_mm == 1.0 && median_z > 0 && median_z < 20.0) {
-        std::fprintf(stderr,
-                     "pyrseg: note: %s: median depth is %.3g units; if the cloud is in metres, pass --unit-mm 1000\n",
-                     input.string().c_str(), median_z);
-    }
+    Params frame_params = base_params;
+    if (!loaded.millimetres) frame_params.unit_mm = cloud_unit_mm(input, cloud, args, base_params.unit_mm, notes);
     CloudView view;
     view.points = cloud.points.data();
     view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();
@@ -121,14 +247,15 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     view.height = cloud.height;
     const std::optional<SensorChoice> sensor = parse_sensor(args);
     std::string sensor_note;
-    Params params = base_params;
+    Params params = frame_params;
     std::optional<SensorKind> kind;  // the sensor the parameters are for, when one is named or chosen
     if (sensor && !sensor->automatic) kind = sensor->kind;
     if (!sensor || sensor->automatic) {
-        const FrameNoise noise = measure_frame_noise(view, base_params.unit_mm);
+        const FrameNoise noise = measure_frame_noise(view, frame_params.unit_mm);
         if (sensor) {
             kind = noise.suggested;
             params = parse_params(args, noise.suggested);
+            params.unit_mm = frame_params.unit_mm;
             sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
         } else if (noise.suggested != SensorKind::structured_light) {
             std::fprintf(stderr,
@@ -155,6 +282,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
     if (out.figure) write_png(*out.figure, comparison_figure(result));
     if (out.ply) io::write_ply(*out.ply, cloud, result.labels.data(), true);
+    if (out.pcd) io::write_pcd(*out.pcd, cloud, result.labels.data(), io::PcdEncoding::binary);
     std::string pcl_note;
     if (out.pcl_png) {
         const PclRun pcl = pcl_segment(cloud, params.unit_mm, kind);
@@ -165,12 +293,19 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         io::write_segment_stats(*out.stats, result.segments,
                                 io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
     }
+    const std::string unit_note =
+        !loaded.millimetres && !args.value("unit-mm") && params.unit_mm == 1000.0 ? " in metres" : "";
     char line[512];
-    std::snprintf(line, sizeof line, "%s: %s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s",
-                  input.string().c_str(), loaded.kind.c_str(), result.width, result.height,
+    std::snprintf(line, sizeof line, "%s: %s%s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s",
+                  input.string().c_str(), loaded.kind.c_str(), unit_note.c_str(), result.width, result.height,
                   cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
                   segmenter->backend_name().c_str(), sensor_note.c_str(), pcl_note.c_str());
-    return {line, result.segment_count, elapsed.count()};
+    std::string report = line;
+    if (!out.any()) {
+        report += '\n';
+        report += size_summary(result, cloud);
+    }
+    return {report, result.segment_count, elapsed.count()};
 }
 
 // Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
@@ -207,13 +342,14 @@ std::set<std::string> parse_write_list(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" &&
+        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" && item != "pcd" &&
             item != "stats") {
-            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, stats; got '" + item + "'"};
+            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, pcd, stats; got '" + item +
+                             "'"};
         }
         kinds.insert(item);
     }
-    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, stats"};
+    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats"};
     return kinds;
 }
 
@@ -228,6 +364,7 @@ int run_batch(const Args& args, const Params& params) {
 
     Progress progress(inputs.size(), Progress::style_for(args.value("progress").value_or("auto"), stderr), stderr);
     std::unique_ptr<Segmenter> segmenter;
+    RunNotes notes;
     std::set<std::string> stems;
     std::vector<std::string> failures;
     double total_ms = 0;
@@ -242,9 +379,10 @@ int run_batch(const Args& args, const Params& params) {
         if (kinds.count("mask") != 0) out.mask = out_dir / (stem + ".mask.png");
         if (kinds.count("figure") != 0) out.figure = out_dir / (stem + ".figure.png");
         if (kinds.count("ply") != 0) out.ply = out_dir / (stem + ".ply");
+        if (kinds.count("pcd") != 0) out.pcd = out_dir / (stem + ".labels.pcd");
         if (kinds.count("stats") != 0) out.stats = out_dir / (stem + ".stats.json");
         try {
-            const FrameReport r = segment_frame(input, args, params, out, segmenter);
+            const FrameReport r = segment_frame(input, args, params, out, segmenter, notes);
             total_ms += r.milliseconds;
             total_segments += r.segments;
             progress.frame_done(r.line, false);
@@ -279,8 +417,8 @@ void say_backend_choice(const Args& args) {
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
-    values.insert(
-        {"labels", "png", "mask-png", "figure", "ply", "stats", "pcl-png", "backend", "out-dir", "write", "progress"});
+    for (const OutputOption& o : output_options()) values.insert(o.name);
+    values.insert({"backend", "out-dir", "write", "progress"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -288,29 +426,24 @@ int cmd_segment(const std::vector<std::string>& argv) {
         std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
         return 0;
     }
-    OutputPaths out;
-    if (auto v = args.value("labels")) out.labels = *v;
-    if (auto v = args.value("png")) out.png = *v;
-    if (auto v = args.value("mask-png")) out.mask = *v;
-    if (auto v = args.value("figure")) out.figure = *v;
-    if (auto v = args.value("ply")) out.ply = *v;
-    if (auto v = args.value("stats")) out.stats = *v;
-    if (auto v = args.value("pcl-png")) out.pcl_png = *v;
+    // Every option is checked before the first input is read: a mistake costs a message, not a partial run.
+    const OutputPaths out = output_paths(args);
+    check_input_options(args);
     const Params params = parse_params(args);
-    say_backend_choice(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
         if (out.any()) throw UsageError{"in a batch (--out-dir), choose the outputs with --write, not file names"};
+        say_backend_choice(args);
         return run_batch(args, params);
     }
     if (args.value("write") || args.value("progress")) throw UsageError{"--write and --progress need --out-dir"};
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
     }
-    if (!out.any())
-        throw UsageError{"nothing to write: give --labels, --png, --mask-png, --figure, --ply, --stats or --pcl-png"};
+    say_backend_choice(args);
     std::unique_ptr<Segmenter> segmenter;
-    std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter).line.c_str());
+    RunNotes notes;
+    std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter, notes).line.c_str());
     return 0;
 }
 

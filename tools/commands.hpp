@@ -36,9 +36,11 @@ struct SensorChoice {
 [[nodiscard]] Params parse_params(const Args& args, std::optional<SensorKind> preset = std::nullopt);
 
 // The inputs `segment` reads: organized PCD, or a depth image with intrinsics (--intrinsics, --calib,
-// --depth-scale), turned into a cloud in millimetres.
+// --metres-per-unit), turned into a cloud in millimetres.
 extern const char* const kInputHelp;
 extern const std::set<std::string> kInputValueOptions;
+// Once per run, before any input is read: refuses contradicting input options and warns about deprecated ones.
+void check_input_options(const Args& args);
 // A depth image's samples as the file holds them, for Segmenter::segment(DepthView): back-projected on the device.
 struct DepthFrame {
     std::vector<std::uint16_t> u16;  // one of the two, W*H

@@ -1,10 +1,13 @@
 // What `pyrseg segment` reads: organized PCD and PLY clouds, and depth images back-projected with pinhole intrinsics.
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
 
 #include "pyrseg/error.hpp"
+#include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 
 namespace pyrseg::cli {
@@ -22,11 +25,15 @@ const char* const kInputHelp =
     "  --intrinsics FX,FY,CX,CY   focal lengths and principal point in pixels\n"
     "  --calib FILE[:NODE]   an OpenCV FileStorage file (XML/YAML/JSON) with a 3x3 camera matrix or fx fy cx cy;\n"
     "                        NODE names the matrix when the file has several (e.g. IR_intrinsic_params)\n"
-    "  --depth-scale S       depth units per metre: 1000 for millimetres (default for 16-bit images), 5000 for\n"
-    "                        TUM RGB-D, 1 for metres (default for float images)\n"
+    "  --metres-per-unit M   the depth of one sample unit in metres, as depth SDKs state it (RealSense's depth\n"
+    "                        scale, get_depth_scale()): 0.001 for millimetres (default for 16-bit images), 0.0002\n"
+    "                        for TUM RGB-D (1/5000 m), 1 for metres (default for float images). A value that puts\n"
+    "                        the frame's median depth outside 0.05 to 100 m is refused, with the value that fits.\n"
+    "  --depth-scale S       deprecated: depth units per metre, the inverse of --metres-per-unit (1000 for\n"
+    "                        millimetres); still read, with a warning saying what to pass instead\n"
     "\n";
 
-const std::set<std::string> kInputValueOptions = {"intrinsics", "calib", "depth-scale"};
+const std::set<std::string> kInputValueOptions = {"intrinsics", "calib", "metres-per-unit", "depth-scale"};
 
 namespace {
 
@@ -38,7 +45,7 @@ std::string lower_extension(const std::filesystem::path& path) {
 
 // The frame's samples as DepthView reads them: 16-bit images stay integers (their float copies are exact), float
 // images stay floats.
-DepthFrame depth_frame(const io::DepthImage& image, const io::Intrinsics& k, double per_metre) {
+DepthFrame depth_frame(const io::DepthImage& image, const io::Intrinsics& k, double metres_per_unit) {
     DepthFrame f;
     if (image.floating) {
         f.f32 = image.depth;
@@ -46,9 +53,57 @@ DepthFrame depth_frame(const io::DepthImage& image, const io::Intrinsics& k, dou
         f.u16.resize(image.depth.size());
         for (std::size_t i = 0; i < image.depth.size(); ++i) f.u16[i] = static_cast<std::uint16_t>(image.depth[i]);
     }
-    f.metres_per_unit = 1.0 / per_metre;
+    f.metres_per_unit = metres_per_unit;
     f.intrinsics = k;
     return f;
+}
+
+std::string number_text(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return text;
+}
+
+// The samples' unit: --metres-per-unit, else the deprecated --depth-scale inverted, else the default of the
+// sample type. A unit that puts the median depth out of every depth sensor's range is refused rather than
+// segmented into nothing (RealSense's depth scale 0.001 given as --depth-scale is 1000 m per unit), and the
+// message names the usual unit that fits, when one does.
+double depth_metres_per_unit(const Args& args, const io::DepthImage& image, const std::filesystem::path& path) {
+    double metres_per_unit = image.floating ? 1.0 : 0.001;
+    std::string given = image.floating ? "float samples read as metres (the default)"
+                                       : "16-bit samples read as millimetres (the default)";
+    if (auto m = args.number("metres-per-unit")) {
+        if (!(*m > 0) || !std::isfinite(*m)) {
+            throw UsageError{"--metres-per-unit must be a number > 0 (0.001 for millimetres), got '" +
+                             *args.value("metres-per-unit") + "'"};
+        }
+        metres_per_unit = *m;
+        given = "--metres-per-unit " + *args.value("metres-per-unit");
+    } else if (auto s = args.number("depth-scale")) {
+        if (!(*s > 0) || !std::isfinite(*s)) {
+            throw UsageError{
+                "--depth-scale must be a number > 0; better, pass --metres-per-unit (0.001 for "
+                "millimetres)"};
+        }
+        metres_per_unit = 1.0 / *s;
+        given = "--depth-scale " + *args.value("depth-scale") +
+                " (depth units per metre: " + number_text(metres_per_unit) + " m per unit)";
+    }
+    const double median = median_sample(image.depth);
+    if (median <= 0 || plausible_median_metres(median * metres_per_unit)) return metres_per_unit;
+    std::string message = path.string() + ": with " + given + " the median depth is " +
+                          number_text(median * metres_per_unit) + " m, outside any depth sensor's range (" +
+                          number_text(kPlausibleMedianMetresMin) + " to " + number_text(kPlausibleMedianMetresMax) +
+                          " m). Pass the depth of one sample unit in metres, as SDKs state it (RealSense's depth "
+                          "scale), as --metres-per-unit";
+    for (const double usual : {0.001, 1.0, 0.0001}) {
+        if (plausible_median_metres(median * usual)) {
+            message += ": --metres-per-unit " + number_text(usual) + " makes the median sample " + number_text(median) +
+                       " a depth of " + number_text(median * usual) + " m";
+            break;
+        }
+    }
+    throw Error(ErrorCode::invalid_argument, message);
 }
 
 // A NumPy depth map (H x W uint16 or float32) as a depth image.
@@ -120,6 +175,18 @@ DepthView DepthFrame::view(int width, int height) const {
     return v;
 }
 
+void check_input_options(const Args& args) {
+    if (args.value("metres-per-unit") && args.value("depth-scale")) {
+        throw UsageError{"give --metres-per-unit, not --depth-scale as well (it is deprecated)"};
+    }
+    if (auto s = args.number("depth-scale"); s && *s > 0 && std::isfinite(*s)) {
+        std::fprintf(stderr,
+                     "pyrseg: warning: --depth-scale is deprecated (it is depth units per metre, the inverse of the "
+                     "depth scale SDKs state): --depth-scale %s is --metres-per-unit %s; pass that instead\n",
+                     args.value("depth-scale")->c_str(), number_text(1.0 / *s).c_str());
+    }
+}
+
 bool is_supported_input(const std::filesystem::path& path) {
     const std::string ext = lower_extension(path);
     return is_cloud_extension(ext) || is_depth_image_extension(ext);
@@ -138,32 +205,28 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
         if (ext == ".npy") {
             const io::NpyArray npy = io::read_npy(path);
             if (npy.shape.size() != 2) return {io::read_npy_cloud(path), "NumPy cloud", false, std::nullopt};
-            // H x W: a depth map, which needs intrinsics and takes --depth-scale like a depth image.
+            // H x W: a depth map, which needs intrinsics and takes --metres-per-unit like a depth image.
             if (args.value("unit-mm")) {
-                throw UsageError{"--unit-mm applies to point clouds; a depth map's units are set by --depth-scale"};
+                throw UsageError{"--unit-mm applies to point clouds; a depth map's unit is set by --metres-per-unit"};
             }
             const io::DepthImage image = depth_map_of(npy, path);
             const io::Intrinsics k = intrinsics_from(args, path);
-            double per_metre = image.floating ? 1.0 : 1000.0;
-            if (auto s = args.number("depth-scale")) per_metre = *s;
-            if (!(per_metre > 0)) throw UsageError{"--depth-scale must be > 0"};
-            return {io::depth_to_cloud(image, k, 1000.0 / per_metre), "NumPy depth map", true,
-                    depth_frame(image, k, per_metre)};
+            const double metres_per_unit = depth_metres_per_unit(args, image, path);
+            return {io::depth_to_cloud(image, k, 1000.0 * metres_per_unit), "NumPy depth map", true,
+                    depth_frame(image, k, metres_per_unit)};
         }
         if (ext == ".ply") return {io::read_ply(path), "PLY", false, std::nullopt};
         return {io::read_pcd(path), "PCD", false, std::nullopt};
     }
     if (is_depth_image_extension(ext)) {
         if (args.value("unit-mm")) {
-            throw UsageError{"--unit-mm applies to point clouds; a depth image's units are set by --depth-scale"};
+            throw UsageError{"--unit-mm applies to point clouds; a depth image's unit is set by --metres-per-unit"};
         }
         const io::Intrinsics k = intrinsics_from(args, path);
         const io::DepthImage depth = io::read_depth_image(path);
-        double per_metre = depth.floating ? 1.0 : 1000.0;
-        if (auto s = args.number("depth-scale")) per_metre = *s;
-        if (!(per_metre > 0)) throw UsageError{"--depth-scale must be > 0"};
-        return {io::depth_to_cloud(depth, k, 1000.0 / per_metre), "depth image", true,
-                depth_frame(depth, k, per_metre)};
+        const double metres_per_unit = depth_metres_per_unit(args, depth, path);
+        return {io::depth_to_cloud(depth, k, 1000.0 * metres_per_unit), "depth image", true,
+                depth_frame(depth, k, metres_per_unit)};
     }
     throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +
                                        "' (pyrseg reads .pcd, .ply and .npy clouds, and .png/.tif/.tiff depth images)");

@@ -4,6 +4,8 @@
 #include <string_view>
 #include <vector>
 
+#include "pyrseg/export.hpp"
+
 namespace pyrseg {
 
 struct BackendInfo {
@@ -18,7 +20,7 @@ struct BackendInfo {
 };
 
 // Every backend pyrseg knows, in preference order: GPUs first, the CPU last.
-[[nodiscard]] std::vector<BackendInfo> list_backends();
+[[nodiscard]] PYRSEG_EXPORT std::vector<BackendInfo> list_backends();
 
 // The backend a request resolves to, and why, in one sentence for users ("auto: vulkan's device llvmpipe ... is a
 // CPU emulation; cpu runs natively").
@@ -30,7 +32,8 @@ struct BackendChoice {
 // Resolves a backend request: an explicit name, else the PYRSEG_BACKEND environment variable, else "auto" (the
 // first available backend whose device is a real GPU, else cpu). Throws pyrseg::Error(backend_unavailable) naming
 // the reason when the chosen backend cannot run.
-[[nodiscard]] BackendChoice choose_backend(std::string_view requested);
-[[nodiscard]] std::string resolve_backend_name(std::string_view requested);  // choose_backend(requested).name
+[[nodiscard]] PYRSEG_EXPORT BackendChoice choose_backend(std::string_view requested);
+// choose_backend(requested).name
+[[nodiscard]] PYRSEG_EXPORT std::string resolve_backend_name(std::string_view requested);
 
 }  // namespace pyrseg

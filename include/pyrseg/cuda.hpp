@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "pyrseg/depth.hpp"
+#include "pyrseg/export.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -40,8 +41,8 @@ namespace pyrseg::cuda {
 // Destroying the Segmenter waits for the stream (its queued frames read pyrseg's buffers), unless the stream is
 // being captured then, and frees the buffers: do it outside any capture, once no graph that captured one of its
 // frames will run again.
-[[nodiscard]] Segmenter make_segmenter(int width, int height, cudaStream_t stream, const Params& params = {},
-                                       const Outputs& outputs = {});
+[[nodiscard]] PYRSEG_EXPORT Segmenter make_segmenter(int width, int height, cudaStream_t stream,
+                                                     const Params& params = {}, const Outputs& outputs = {});
 
 // The application's memory: device memory of the Segmenter's device (cudaMalloc, cudaMallocAsync, cudaMallocPitch,
 // a pool, the virtual memory API) or managed memory (cudaMallocManaged, from any device). Host memory, pinned or
@@ -101,7 +102,7 @@ struct LabelPointers {
 // the labels there; launch it on the Segmenter's stream (or keep it ordered with the Segmenter's other frames),
 // while the Segmenter lives. A depth frame carries its own ray table (W + H floats, as the parameters of small
 // kernels among its commands), so its graph gives that calibration's points whatever frames ran in between.
-void segment(Segmenter& segmenter, const CloudPointers& cloud, const LabelPointers& out);
-void segment(Segmenter& segmenter, const DepthPointers& depth, const LabelPointers& out);
+PYRSEG_EXPORT void segment(Segmenter& segmenter, const CloudPointers& cloud, const LabelPointers& out);
+PYRSEG_EXPORT void segment(Segmenter& segmenter, const DepthPointers& depth, const LabelPointers& out);
 
 }  // namespace pyrseg::cuda

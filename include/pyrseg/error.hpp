@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pyrseg/export.hpp"
+
 namespace pyrseg {
 
 enum class ErrorCode {
@@ -17,9 +19,9 @@ enum class ErrorCode {
     internal,             // a bug: please report it
 };
 
-[[nodiscard]] const char* to_string(ErrorCode code) noexcept;
+[[nodiscard]] PYRSEG_EXPORT const char* to_string(ErrorCode code) noexcept;
 
-class Error : public std::runtime_error {
+class PYRSEG_EXPORT Error : public std::runtime_error {
 public:
     Error(ErrorCode code, const std::string& message);
     [[nodiscard]] ErrorCode code() const noexcept { return code_; }

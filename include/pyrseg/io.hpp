@@ -2,7 +2,8 @@
 // pyrseg::io: the file formats the CLI and the tests need: PCD and PLY in; .npy, PNG and PLY out (and back in).
 // Every failure is a pyrseg::Error whose message names the file: ErrorCode::io when the file cannot be opened,
 // read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::invalid_argument
-// for bad arguments to a writer.
+// for bad arguments to a writer. The writers of .npy, PNG, PCD, PLY and statistics replace their file only once it
+// is complete (a temporary file beside it, renamed): a failure leaves the old file or none, never a partial one.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pyrseg/io_export.hpp"
 #include "pyrseg/result.hpp"
 
 namespace pyrseg::io {
@@ -26,10 +28,15 @@ enum class PcdEncoding { ascii, binary, binary_compressed };
 // Reads a PCD v0.7 file (DATA ascii, binary or binary_compressed). Needs fields x y z (TYPE F, SIZE 4 or 8) and an
 // organized cloud (HEIGHT > 1); normal_x normal_y normal_z are read when present, every other field is skipped.
 // VIEWPOINT is ignored: points are returned in the file's frame.
-PointCloud read_pcd(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT PointCloud read_pcd(const std::filesystem::path& path);
 
 // Writes fields x y z (and normal_x normal_y normal_z when cloud.normals is not empty) as F 4, the way PCL does.
-void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding);
+PYRSEG_IO_EXPORT void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding);
+// The same with a `label` field (U 4) after them when labels (W*H, row-major) are given: PCL's PointXYZL layout
+// (PointXYZLNormal's fields but curvature, with normals), which pcl::io::loadPCDFile reads into
+// pcl::PointCloud<pcl::PointXYZL>. Label 0 is no segment.
+PYRSEG_IO_EXPORT void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
+                                PcdEncoding encoding);
 
 // PLY through PCL's PLY reader and writer (pcl_io). Without PCL at build time (PYRSEG_HAVE_PLY=0) both throw
 // ErrorCode::format saying that pyrseg was built without PLY support.
@@ -41,20 +48,22 @@ void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEn
 // empty cells read as NaN), the camera element's viewportx / viewporty (PCL's writer with use_camera), or a
 // Photoneo PhoXi header line "obj_info Photoneo PLY PointCloud ( Width = W; Height = H)". Points are returned as
 // stored (PhoXi marks missing points as 0 0 0, which pyrseg's z > 0 rule treats as invalid).
-PointCloud read_ply(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT PointCloud read_ply(const std::filesystem::path& path);
 
 // Writes an organized PLY that PCL, CloudCompare and MeshLab read: x y z, nx ny nz when cloud.normals is not empty,
 // and red green blue (uchar) from label_color when labels (W*H, row-major) are given, label 0 as gray 128. Points
 // with a non-finite coordinate are not written as vertices: obj_info num_cols/num_rows and a range_grid element
 // keep the grid (PCL's organized layout), so viewers never see NaN vertices and read_ply returns them as NaN.
 // Binary is exact; ascii has 6 significant digits (PCL's writer ignores its precision setting on this path).
-void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels, bool binary);
+PYRSEG_IO_EXPORT void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
+                                bool binary);
 
 // NumPy .npy (format 1.0), C order, little-endian.
-void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int height, int width);  // '<u4' H x W
-void write_npy(const std::filesystem::path& path, const std::uint8_t* data, int height, int width);   // '|u1' H x W
-void write_npy(const std::filesystem::path& path, const float* data, int height, int width,
-               int channels);  // '<f4' H x W x C (C=1: H x W)
+// '<u4' H x W, '|u1' H x W, '<f4' H x W x C (C=1: H x W).
+PYRSEG_IO_EXPORT void write_npy(const std::filesystem::path& path, const std::uint32_t* data, int height, int width);
+PYRSEG_IO_EXPORT void write_npy(const std::filesystem::path& path, const std::uint8_t* data, int height, int width);
+PYRSEG_IO_EXPORT void write_npy(const std::filesystem::path& path, const float* data, int height, int width,
+                                int channels);
 
 struct NpyArray {
     std::string dtype;                 // numpy's descr, e.g. "<f4", "|u1"
@@ -62,22 +71,24 @@ struct NpyArray {
     std::vector<unsigned char> bytes;  // the array data, C order, as stored
 };
 // Format 1.0/2.0/3.0 headers, C order, little-endian or byte-order-free dtypes of kind b, i, u, f, c.
-NpyArray read_npy(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT NpyArray read_npy(const std::filesystem::path& path);
 
-void write_png_rgb(const std::filesystem::path& path, const std::uint8_t* rgb, int width, int height);
-void write_png_gray16(const std::filesystem::path& path, const std::uint16_t* gray, int width, int height);
-void write_png_gray8(const std::filesystem::path& path, const std::uint8_t* gray, int width, int height);
+PYRSEG_IO_EXPORT void write_png_rgb(const std::filesystem::path& path, const std::uint8_t* rgb, int width, int height);
+PYRSEG_IO_EXPORT void write_png_gray16(const std::filesystem::path& path, const std::uint16_t* gray, int width,
+                                       int height);
+PYRSEG_IO_EXPORT void write_png_gray8(const std::filesystem::path& path, const std::uint8_t* gray, int width,
+                                      int height);
 
 struct Image {
     int width = 0, height = 0, channels = 0, bit_depth = 0;
     std::vector<std::uint8_t> data;  // data as stored: 16-bit samples in host order
 };
 // Palette images come back as RGB (RGBA with transparency), gray below 8 bits as 8-bit; bit_depth is 8 or 16.
-Image read_png(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT Image read_png(const std::filesystem::path& path);
 
 // An organized cloud stored as a NumPy array: H x W x 3 (points) or H x W x 6 (points, then normals), float32 or
 // float64 ('<f4', '<f8'), C order.
-PointCloud read_npy_cloud(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT PointCloud read_npy_cloud(const std::filesystem::path& path);
 
 // A depth image: one sample per pixel in the file's units, row-major. 0, NaN, infinite or negative: no data.
 struct DepthImage {
@@ -87,28 +98,29 @@ struct DepthImage {
 };
 // A 16-bit grayscale PNG (as depth cameras and TUM/CAPE datasets store millimetres or 1/5000 m), or a
 // single-channel TIFF of 16-bit unsigned or 32-bit float samples (libtiff).
-DepthImage read_depth_image(const std::filesystem::path& path);
-void write_tiff_float(const std::filesystem::path& path, const float* depth, int width, int height);
+PYRSEG_IO_EXPORT DepthImage read_depth_image(const std::filesystem::path& path);
+PYRSEG_IO_EXPORT void write_tiff_float(const std::filesystem::path& path, const float* depth, int width, int height);
 
 // Pinhole intrinsics in pixels.
 struct Intrinsics {
     double fx = 0, fy = 0, cx = 0, cy = 0;
 };
 // "fx,fy,cx,cy" (four numbers, fx and fy > 0). Throws ErrorCode::invalid_argument naming the problem.
-Intrinsics parse_intrinsics(const std::string& text);
+PYRSEG_IO_EXPORT Intrinsics parse_intrinsics(const std::string& text);
 // An OpenCV FileStorage file (XML, YAML or JSON), read by OpenCV. `node` names either a 3x3 camera matrix
 // [fx 0 cx; 0 fy cy; 0 0 1] or a map with keys fx, fy, cx, cy. With an empty `node` the file's top level must hold
 // fx fy cx cy, or exactly one 3x3 matrix. The message of a failure names the file and the node.
-Intrinsics read_intrinsics(const std::filesystem::path& path, const std::string& node = {});
+PYRSEG_IO_EXPORT Intrinsics read_intrinsics(const std::filesystem::path& path, const std::string& node = {});
 
 // An organized cloud in millimetres from a depth image: z = depth * mm_per_unit, x = (u - cx) * z / fx,
 // y = (v - cy) * z / fy (computed in double, stored as float); pixels without data are NaN.
-PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit);
+PYRSEG_IO_EXPORT PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit);
 
 // Colour-coded segmentation: label 0 black, other labels distinct saturated colours (a fixed hash of the label so
 // the same label is the same colour in every picture; neighbouring label values clearly different).
-std::array<std::uint8_t, 3> label_color(std::uint32_t label);
-std::vector<std::uint8_t> colorize_labels(const std::uint32_t* labels, int width, int height);  // 3*W*H RGB
+PYRSEG_IO_EXPORT std::array<std::uint8_t, 3> label_color(std::uint32_t label);
+// 3*W*H RGB
+PYRSEG_IO_EXPORT std::vector<std::uint8_t> colorize_labels(const std::uint32_t* labels, int width, int height);
 
 // Per-segment statistics (Result::segments) as a table: CSV with a header line when the path ends in .csv, else
 // JSON (nlohmann/json) with the frame's size and units, and one object per segment. Centroids are in the cloud's
@@ -118,7 +130,7 @@ struct SegmentTable {
     double unit_mm = 1.0;
     std::string source;  // the input file, written into the JSON
 };
-void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
-                         const SegmentTable& frame);
+PYRSEG_IO_EXPORT void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
+                                          const SegmentTable& frame);
 
 }  // namespace pyrseg::io

@@ -15,6 +15,7 @@
 #include <span>
 
 #include "pyrseg/depth.hpp"
+#include "pyrseg/export.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -31,8 +32,8 @@ struct Queue {
 
 // Builds pyrseg's kernels for the device (once per context and process) and its buffers in the context. Throws
 // pyrseg::Error when the queue is not of that device and context, is out of order, or the frame does not fit.
-[[nodiscard]] Segmenter make_segmenter(int width, int height, const Queue& queue, const Params& params = {},
-                                       const Outputs& outputs = {});
+[[nodiscard]] PYRSEG_EXPORT Segmenter make_segmenter(int width, int height, const Queue& queue,
+                                                     const Params& params = {}, const Outputs& outputs = {});
 
 // A cloud in the application's buffers: float32 x, y, z packed within each row (12 bytes a point), rows
 // row_step_bytes apart (0: 12 * width), from byte `offset` on; normals (optional) in the same layout.
@@ -69,9 +70,9 @@ struct LabelBuffers {
 // pyrseg::Error names the problem). Frames of one Segmenter run in queue order; its buffers serve one frame at a
 // time, so two Segmenters are needed for two frames at once. Outputs other than the labels (mask, normals, raw
 // labels, statistics) are host results and are not produced; Segmenter::last_timings() is empty after it.
-[[nodiscard]] cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
-                               std::span<const cl_event> wait = {});
-[[nodiscard]] cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,
-                               std::span<const cl_event> wait = {});
+[[nodiscard]] PYRSEG_EXPORT cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
+                                             std::span<const cl_event> wait = {});
+[[nodiscard]] PYRSEG_EXPORT cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,
+                                             std::span<const cl_event> wait = {});
 
 }  // namespace pyrseg::opencl

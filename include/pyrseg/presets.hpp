@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "pyrseg/cloud.hpp"
+#include "pyrseg/export.hpp"
 #include "pyrseg/params.hpp"
 
 namespace pyrseg {
@@ -20,15 +21,15 @@ enum class SensorKind : std::uint8_t {
 };
 
 // Every kind, in this order.
-[[nodiscard]] std::span<const SensorKind> sensor_kinds();
+[[nodiscard]] PYRSEG_EXPORT std::span<const SensorKind> sensor_kinds();
 // "structured-light", "kinect-v1", "realsense-d435", "azure-kinect".
-[[nodiscard]] const char* sensor_kind_name(SensorKind kind);
-[[nodiscard]] std::optional<SensorKind> sensor_kind_from_name(std::string_view name);
+[[nodiscard]] PYRSEG_EXPORT const char* sensor_kind_name(SensorKind kind);
+[[nodiscard]] PYRSEG_EXPORT std::optional<SensorKind> sensor_kind_from_name(std::string_view name);
 // One line on what the preset suits and how it differs from the defaults, for --help and messages.
-[[nodiscard]] const char* sensor_kind_summary(SensorKind kind);
+[[nodiscard]] PYRSEG_EXPORT const char* sensor_kind_summary(SensorKind kind);
 
 // The preset for a kind of sensor, for clouds in units of unit_mm millimetres. Every other field keeps its default.
-[[nodiscard]] Params sensor_preset(SensorKind kind, double unit_mm = 1.0);
+[[nodiscard]] PYRSEG_EXPORT Params sensor_preset(SensorKind kind, double unit_mm = 1.0);
 
 // How noisy a frame's depth is, measured on the frame itself (no ground truth needed): the mean absolute second
 // difference of depth along rows, |z(x-1) - 2 z(x) + z(x+1)|, over triples of valid pixels on one surface (each
@@ -43,6 +44,6 @@ struct FrameNoise {
     std::string reason;  // one sentence for users: what was measured and why that kind
 };
 // unit_mm as in Params. Frames with fewer than 1000 samples are suggested the defaults (structured_light).
-[[nodiscard]] FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm);
+[[nodiscard]] PYRSEG_EXPORT FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm);
 
 }  // namespace pyrseg

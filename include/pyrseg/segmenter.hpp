@@ -8,6 +8,7 @@
 
 #include "pyrseg/cloud.hpp"
 #include "pyrseg/depth.hpp"
+#include "pyrseg/export.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/result.hpp"
 
@@ -24,7 +25,7 @@ struct PassTiming {
     double milliseconds;
 };
 
-class Segmenter {
+class PYRSEG_EXPORT Segmenter {
 public:
     // backend: "cpu", "cuda", "vulkan", "opencl", "auto", or empty for $PYRSEG_BACKEND (else "auto").
     // Throws pyrseg::Error for invalid parameters, sizes that do not fit, or an unavailable backend.

@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "pyrseg/synthetic_export.hpp"
+
 namespace pyrseg::synthetic {
 
 // Values of Scene::object_id.
@@ -82,18 +84,18 @@ struct Scene {
 // Throws std::invalid_argument for width or height outside 1..max_image_side, object_count outside
 // 0..max_object_count, noise_mm negative or not finite, hole_fraction outside 0..1, camera_distance_mm outside
 // 300..6000, an unknown sensor, or threads negative.
-Scene generate(const SceneOptions& options);
+PYRSEG_SYNTHETIC_EXPORT Scene generate(const SceneOptions& options);
 
 // Pairs of objects (ids a < b, sorted) that no depth data can tell apart: two upright boxes whose top faces lie in
 // one plane (within 0.05 mm) and touch along a side (within 0.05 mm), as identical parts packed side by side in a
 // bin. Their visible surfaces meet with no depth step and no crease, so any segmentation from depth alone sees one
 // surface there; `pyrseg eval` reports its merge rates with and without these pairs (docs/quality.md).
-std::vector<std::array<std::uint32_t, 2>> flush_pairs(const Scene& scene);
+PYRSEG_SYNTHETIC_EXPORT std::vector<std::array<std::uint32_t, 2>> flush_pairs(const Scene& scene);
 
 // "structured-light", "kinect-v1", "realsense-d435", "azure-kinect"; nullptr for a value outside the enum.
-const char* sensor_name(Sensor sensor);
+PYRSEG_SYNTHETIC_EXPORT const char* sensor_name(Sensor sensor);
 // The sensor of that name (as sensor_name writes it); nullopt for any other string.
-std::optional<Sensor> sensor_from_name(std::string_view name);
+PYRSEG_SYNTHETIC_EXPORT std::optional<Sensor> sensor_from_name(std::string_view name);
 
 // The random depth error (sigma, mm) before quantization at depth z (mm) is
 //   sqrt(polynomial(z)^2 + (z^2 / (f b) * disparity_sigma_px)^2),
@@ -129,7 +131,7 @@ struct SensorModel {
 };
 
 // The parameters of a sensor. structured_light describes the PhoXi-like default (its noise is noise_mm).
-SensorModel sensor_model(Sensor sensor);
+PYRSEG_SYNTHETIC_EXPORT SensorModel sensor_model(Sensor sensor);
 
 // Fillable masks whose one region winds across the whole frame, the worst cases of fills that carry labels a step
 // at a time: corridors 8 pixels wide between 8-pixel walls (so that they survive to level N - 2), 1 = fillable.
@@ -139,8 +141,8 @@ struct FillMask {
     std::vector<std::uint8_t> fillable;  // W*H, row-major
 };
 // A square spiral from the border inwards; each lap turns four times.
-FillMask spiral_mask(int width, int height);
+PYRSEG_SYNTHETIC_EXPORT FillMask spiral_mask(int width, int height);
 // A perfect maze (depth-first from the top-left cell, seeded) on a grid of 16-pixel cells.
-FillMask maze_mask(int width, int height, std::uint32_t seed = 12345);
+PYRSEG_SYNTHETIC_EXPORT FillMask maze_mask(int width, int height, std::uint32_t seed = 12345);
 
 }  // namespace pyrseg::synthetic

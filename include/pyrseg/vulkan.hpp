@@ -16,6 +16,7 @@
 #include <span>
 
 #include "pyrseg/depth.hpp"
+#include "pyrseg/export.hpp"
 #include "pyrseg/params.hpp"
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -47,8 +48,8 @@ struct Device {
 // Destroying the Segmenter waits for the frames pyrseg itself submitted (its own fences) but not for command
 // buffers the application recorded with `record`: those must have completed (or been freed) first, since they use
 // the Segmenter's pipelines, descriptor set and buffers.
-[[nodiscard]] Segmenter make_segmenter(int width, int height, const Device& device, const Params& params = {},
-                                       const Outputs& outputs = {});
+[[nodiscard]] PYRSEG_EXPORT Segmenter make_segmenter(int width, int height, const Device& device,
+                                                     const Params& params = {}, const Outputs& outputs = {});
 
 // Vulkan cannot tell a VkBuffer's size, so each buffer below comes with the size the application created it with
 // (`*_bytes`: the whole buffer, not what is left after the offset); the frame must fit from the offset on. The
@@ -106,8 +107,10 @@ struct LabelBuffers {
 // a command buffer recorded here must be submitted before the Segmenter's next host frame. Nothing is recorded when
 // a check fails (a pyrseg::Error names the problem). Outputs other than the labels (mask, normals, raw labels,
 // statistics) are host results and are not produced; Segmenter::last_timings() is empty after it.
-void record(Segmenter& segmenter, VkCommandBuffer commands, const CloudBuffers& cloud, const LabelBuffers& out);
-void record(Segmenter& segmenter, VkCommandBuffer commands, const DepthBuffer& depth, const LabelBuffers& out);
+PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const CloudBuffers& cloud,
+                          const LabelBuffers& out);
+PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const DepthBuffer& depth,
+                          const LabelBuffers& out);
 
 // Records one frame, as `record` does, into a command buffer of pyrseg's own and submits it on the Segmenter's
 // queue (vkQueueSubmit: see Device on synchronising the queue), after the semaphores in `wait` (each at the stages
@@ -119,11 +122,13 @@ void record(Segmenter& segmenter, VkCommandBuffer commands, const DepthBuffer& d
 // `fence`, when given, must be unsignalled; pyrseg submits an empty batch with it right after the frame's batch, so
 // it signals once the frame and everything submitted to the queue before it have completed. Nothing is submitted
 // when a check fails (a pyrseg::Error names the problem).
-void submit(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
-            std::span<const VkSemaphore> wait = {}, std::span<const VkPipelineStageFlags> wait_stages = {},
-            std::span<const VkSemaphore> signal = {}, VkFence fence = VK_NULL_HANDLE);
-void submit(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,
-            std::span<const VkSemaphore> wait = {}, std::span<const VkPipelineStageFlags> wait_stages = {},
-            std::span<const VkSemaphore> signal = {}, VkFence fence = VK_NULL_HANDLE);
+PYRSEG_EXPORT void submit(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
+                          std::span<const VkSemaphore> wait = {},
+                          std::span<const VkPipelineStageFlags> wait_stages = {},
+                          std::span<const VkSemaphore> signal = {}, VkFence fence = VK_NULL_HANDLE);
+PYRSEG_EXPORT void submit(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,
+                          std::span<const VkSemaphore> wait = {},
+                          std::span<const VkPipelineStageFlags> wait_stages = {},
+                          std::span<const VkSemaphore> signal = {}, VkFence fence = VK_NULL_HANDLE);
 
 }  // namespace pyrseg::vulkan

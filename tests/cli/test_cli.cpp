@@ -29,7 +29,7 @@ using pyrseg::cli_test::run;
 using pyrseg::cli_test::run_with_env;
 
 fs::path temp_dir() {
-    const fs::path dir = fs::temp_directory_path() / ("pyrseg_cli_test_" + std::to_string(::getpid()));
+    fs::path dir = fs::temp_directory_path() / ("pyrseg_cli_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     return dir;
 }
@@ -45,7 +45,11 @@ TEST(Cli, EveryCommandExplainsItselfWithHelp) {
         EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << command << "\n" << r.output;
     }
-    EXPECT_NE(run("segment --help").output.find("--unit-mm"), std::string::npos);
+    const std::string help = run("segment --help").output;
+    for (const char* option : {"--unit-mm U", "--metres-per-unit M", "--depth-scale S", "--pcd OUT.pcd",
+                               "Units:", "With no output option it writes nothing"}) {
+        EXPECT_NE(help.find(option), std::string::npos) << option;
+    }
 }
 
 // The defaults --help states are the library's (the normal radius once read 1 after the default became 2).
@@ -71,9 +75,10 @@ TEST(Cli, UsageErrorsExitWithTwoAndSayWhat) {
     r = run("segment x.pcd --bogus");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("unknown option --bogus"), std::string::npos) << r.output;
+    // Without an output option the input is still read (and only summarized): a missing one is a file error.
     r = run("segment x.pcd");
-    EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.output.find("nothing to write"), std::string::npos) << r.output;
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.output.find("x.pcd: cannot open"), std::string::npos) << r.output;
 }
 
 TEST(Cli, FileAndParameterErrorsNameTheProblem) {
@@ -116,7 +121,7 @@ TEST(Cli, NoOpenclPlatformIsExplainedAndAnError) {
     const std::string listing = run("backends").output;
     const std::size_t entry = listing.find("opencl  ");
     ASSERT_NE(entry, std::string::npos) << listing;
-    const std::string opencl = listing.substr(entry, listing.find("\n", listing.find("\n", entry) + 1) - entry);
+    const std::string opencl = listing.substr(entry, listing.find('\n', listing.find('\n', entry) + 1) - entry);
     if (opencl.find("not built") != std::string::npos || opencl.find("disabled") != std::string::npos) {
         GTEST_SKIP() << "this build has no OpenCL backend: " << opencl;
     }
@@ -142,7 +147,7 @@ TEST(Cli, NoVulkanDriverIsExplainedAndAnError) {
     const std::string listing = run("backends").output;
     const std::size_t entry = listing.find("vulkan  ");
     ASSERT_NE(entry, std::string::npos) << listing;
-    const std::string vulkan = listing.substr(entry, listing.find("\n", listing.find("\n", entry) + 1) - entry);
+    const std::string vulkan = listing.substr(entry, listing.find('\n', listing.find('\n', entry) + 1) - entry);
     if (vulkan.find("not built") != std::string::npos || vulkan.find("disabled") != std::string::npos) {
         GTEST_SKIP() << "this build has no Vulkan backend: " << vulkan;
     }
@@ -177,7 +182,7 @@ TEST(Cli, DepthImagesNeedIntrinsicsAndSegment) {
     EXPECT_NE(r.output.find("depth image, 640 x 480"), std::string::npos) << r.output;
     const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(dir / "d.npy");
     ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-    r = run("segment " + depth.string() + " --intrinsics 575.93,576.41,315.15,230.59 --depth-scale 1000" + out);
+    r = run("segment " + depth.string() + " --intrinsics 575.93,576.41,315.15,230.59 --metres-per-unit 0.001" + out);
     EXPECT_EQ(r.status, 0) << r.output;
     r = run("segment " + depth.string() + out);
     EXPECT_EQ(r.status, 1) << r.output;
@@ -234,7 +239,7 @@ TEST(Cli, BatchOfFiftyFramesReportsProgressFailuresAndASummary) {
     const fs::path in = dir / "frames";
     fs::create_directories(in);
     for (int i = 0; i < 50; ++i) {
-        const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(96, 72, std::uint64_t(i + 1), 4);
+        const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(96, 72, std::uint64_t(i) + 1, 4);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%02d.pcd", i);
         pyrseg::io::write_pcd(in / name, cloud, pyrseg::io::PcdEncoding::binary);
@@ -283,7 +288,7 @@ TEST(Cli, MugScanTableIsOneSegmentAndTheMugAnother) {
     const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
     ASSERT_EQ(npy.dtype, "<u4");
     ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-    std::vector<std::uint32_t> labels(640 * 480);
+    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
     std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
     const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
     std::map<std::uint32_t, std::size_t> sizes;
@@ -327,7 +332,7 @@ void expect_scene_segmented(const fs::path& scan, const std::string& options, co
     ASSERT_EQ(r.status, 0) << r.output;
     const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
     ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-    std::vector<std::uint32_t> labels(640 * 480);
+    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
     std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
     const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
     const std::uint32_t surface = at(e.surface[0].first, e.surface[0].second);
@@ -574,3 +579,253 @@ TEST(Cli, BenchReportWritesRatiosAndPlots) {
     EXPECT_NE(bad.output.find("not.json"), std::string::npos) << bad.output;
     fs::remove_all(dir);
 }
+
+// Issue 17: what a new user trips over, each fixed and kept fixed.
+namespace {
+
+std::vector<std::uint32_t> read_labels(const fs::path& path) {
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(path);
+    std::vector<std::uint32_t> labels(npy.bytes.size() / 4);
+    std::memcpy(labels.data(), npy.bytes.data(), npy.bytes.size());
+    return labels;
+}
+
+std::size_t files_in(const fs::path& dir) {
+    return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+
+// A cloud in metres without --unit-mm is read as metres, saying so (once per run), and segments like the same
+// cloud in millimetres; an explicit --unit-mm always wins, with a warning when it makes the depths implausible.
+TEST(Cli, CloudInMetresIsReadAsMetresAndSaysSo) {
+    const fs::path dir = temp_dir();
+    const pyrseg::io::PointCloud mm = pyrseg::cli_test::scene_cloud(160, 120, 5);
+    pyrseg::io::PointCloud metres = mm;
+    for (float& v : metres.points) v /= 1000.0f;
+    pyrseg::io::write_pcd(dir / "mm.pcd", mm, pyrseg::io::PcdEncoding::binary);
+    pyrseg::io::write_pcd(dir / "m.pcd", metres, pyrseg::io::PcdEncoding::binary);
+    CliRun r = run("segment " + (dir / "mm.pcd").string() + " --backend cpu --labels " + (dir / "mm.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("metres"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "m.pcd").string() + " --backend cpu --labels " + (dir / "m.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("so the cloud is read as metres (--unit-mm 1000); pass --unit-mm 1 if it is in "
+                            "millimetres"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("m.pcd: PCD in metres, 160 x 120"), std::string::npos) << r.output;
+    const std::vector<std::uint32_t> from_mm = read_labels(dir / "mm.npy");
+    const std::vector<std::uint32_t> from_metres = read_labels(dir / "m.npy");
+    ASSERT_EQ(from_mm.size(), from_metres.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < from_mm.size(); ++i) differ += from_mm[i] != from_metres[i] ? 1 : 0;
+    EXPECT_LT(differ, from_mm.size() / 100) << "metres read as metres segment like millimetres";
+    EXPECT_GT(*std::max_element(from_metres.begin(), from_metres.end()), 3u);
+
+    // --unit-mm wins, in both directions; an implausible one is segmented as asked, with a warning.
+    r = run("segment " + (dir / "m.pcd").string() + " --backend cpu --unit-mm 1000 --labels " +
+            (dir / "m2.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("warning:"), std::string::npos) << r.output;
+    EXPECT_EQ(read_labels(dir / "m2.npy"), from_metres);
+    r = run("segment " + (dir / "m.pcd").string() + " --backend cpu --unit-mm 1 --labels " + (dir / "m3.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("read as metres"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("warning: " + (dir / "m.pcd").string() + ": with --unit-mm 1 the median depth is"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("is --unit-mm right?"), std::string::npos) << r.output;
+    EXPECT_NE(read_labels(dir / "m3.npy"), from_metres) << "metres read as millimetres segment differently";
+
+    // A batch of clouds in metres: each read as metres, the note given once.
+    fs::create_directories(dir / "frames");
+    for (const char* name : {"a.pcd", "b.pcd", "c.pcd"}) {
+        pyrseg::io::write_pcd(dir / "frames" / name, metres, pyrseg::io::PcdEncoding::binary);
+    }
+    r = run("segment " + (dir / "frames").string() + " --out-dir " + (dir / "out").string() +
+            " --write labels --progress lines --backend cpu");
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::size_t notes = 0;
+    for (std::size_t at = r.output.find("read as metres"); at != std::string::npos;
+         at = r.output.find("read as metres", at + 1)) {
+        ++notes;
+    }
+    EXPECT_EQ(notes, 1u) << r.output;
+    EXPECT_EQ(read_labels(dir / "out" / "c.labels.npy"), from_metres);
+    fs::remove_all(dir);
+}
+
+// The depth unit is stated as SDKs state it (--metres-per-unit: RealSense's depth scale); the old --depth-scale
+// (its inverse) still works with a warning saying what to pass; a unit that puts the frame at an implausible
+// distance is refused with the unit that fits, and writes nothing.
+TEST(Cli, DepthUnitIsMetresPerUnitAndImplausibleUnitsAreRefused) {
+    const fs::path dir = temp_dir();
+    pyrseg::synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    const pyrseg::synthetic::Scene scene = pyrseg::synthetic::generate(o);
+    std::vector<std::uint16_t> mm(std::size_t(o.width) * std::size_t(o.height));
+    std::vector<float> float_mm(mm.size());
+    for (std::size_t i = 0; i < mm.size(); ++i) {
+        const float z = scene.points[3 * i + 2];
+        mm[i] = std::isfinite(z) ? std::uint16_t(std::lround(z)) : std::uint16_t(0);
+        float_mm[i] = float(mm[i]);  // the same samples as floats: the same segments
+    }
+    pyrseg::io::write_png_gray16(dir / "depth.png", mm.data(), o.width, o.height);
+    pyrseg::io::write_tiff_float(dir / "depth_mm.tif", float_mm.data(), o.width, o.height);
+    const std::string k = " --backend cpu --intrinsics " + std::to_string(scene.fx) + "," + std::to_string(scene.fy) +
+                          "," + std::to_string(scene.cx) + "," + std::to_string(scene.cy);
+    const std::string png = "segment " + (dir / "depth.png").string() + k;
+
+    CliRun r = run(png + " --labels " + (dir / "default.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run(png + " --metres-per-unit 0.001 --labels " + (dir / "mpu.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_labels(dir / "mpu.npy"), read_labels(dir / "default.npy"));
+    EXPECT_GT(r.output.find(" segments"), 0u);
+    // The old flag, as it was meant: the same result, and a warning naming the new one.
+    r = run(png + " --depth-scale 1000 --labels " + (dir / "old.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("--depth-scale is deprecated"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--depth-scale 1000 is --metres-per-unit 0.001"), std::string::npos) << r.output;
+    EXPECT_EQ(read_labels(dir / "old.npy"), read_labels(dir / "default.npy"));
+    // A RealSense user's depth scale given to the old flag: refused (it once gave 0 segments), saying what to pass.
+    r = run(png + " --depth-scale 0.001 --labels " + (dir / "rs.npy").string());
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("depth.png: with --depth-scale 0.001 (depth units per metre: 1000 m per unit) the median "
+                            "depth is"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("outside any depth sensor's range"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--metres-per-unit 0.001 makes the median sample"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "rs.npy"));
+    // The same mistake the other way round, and float samples in millimetres read as the default metres.
+    r = run(png + " --metres-per-unit 1000 --labels " + (dir / "rs.npy").string());
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("--metres-per-unit 0.001 makes"), std::string::npos) << r.output;
+    r = run("segment " + (dir / "depth_mm.tif").string() + k + " --labels " + (dir / "rs.npy").string());
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("with float samples read as metres (the default) the median depth is"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("--metres-per-unit 0.001 makes"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "rs.npy"));
+    r = run("segment " + (dir / "depth_mm.tif").string() + k + " --metres-per-unit 0.001 --labels " +
+            (dir / "tif.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_labels(dir / "tif.npy"), read_labels(dir / "default.npy"));
+    // Nonsense and contradictions are usage errors.
+    r = run(png + " --metres-per-unit 0 --labels " + (dir / "x.npy").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--metres-per-unit must be a number > 0"), std::string::npos) << r.output;
+    r = run(png + " --metres-per-unit 0.001 --depth-scale 1000 --labels " + (dir / "x.npy").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "x.npy"));
+    fs::remove_all(dir);
+}
+
+// Output names must say the format written: a wrong extension is a usage error naming the accepted ones, checked
+// before anything is read or written; the extension's case does not matter.
+TEST(Cli, OutputExtensionsAreCheckedBeforeAnythingIsWritten) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "scene.pcd", pyrseg::cli_test::scene_cloud(96, 72, 2), pyrseg::io::PcdEncoding::binary);
+    const std::string segment = "segment " + (dir / "scene.pcd").string() + " --backend cpu ";
+    const struct {
+        std::string options, message;
+    } refused[] = {
+        {"--png " + (dir / "out.jpg").string(), "out.jpg: the name must end in .png (the segments in colour, as PNG)"},
+        {"--labels " + (dir / "out.txt").string(), "out.txt: the name must end in .npy or .png"},
+        {"--labels " + (dir / "out.pcd").string(), "for a cloud with a label field, give --pcd OUT.pcd"},
+        {"--mask-png " + (dir / "mask").string(), "--mask-png " + (dir / "mask").string() + ": the name must end in"},
+        {"--figure " + (dir / "f.tif").string(), "must end in .png"},
+        {"--ply " + (dir / "c.pcd").string(), "must end in .ply"},
+        {"--pcd " + (dir / "c.ply").string(), "must end in .pcd"},
+        {"--stats " + (dir / "s.txt").string(), "must end in .json or .csv"},
+        {"--pcl-png " + (dir / "p.jpg").string(), "must end in .png"},
+        // One bad name among good ones: nothing at all is written.
+        {"--labels " + (dir / "ok.npy").string() + " --png " + (dir / "ok.png").string() + " --stats " +
+             (dir / "s.yaml").string(),
+         "s.yaml: the name must end in .json or .csv"},
+    };
+    for (const auto& c : refused) {
+        const CliRun r = run(segment + c.options);
+        EXPECT_EQ(r.status, 2) << c.options << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.message), std::string::npos) << c.options << "\n" << r.output;
+        EXPECT_EQ(files_in(dir), 1u) << c.options;
+    }
+    const CliRun r = run(segment + "--png " + (dir / "OUT.PNG").string() + " --stats " + (dir / "S.Json").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(pyrseg::io::read_png(dir / "OUT.PNG").channels, 3);
+    EXPECT_TRUE(fs::exists(dir / "S.Json"));
+    fs::remove_all(dir);
+}
+
+// With no output option, segment prints what it found (count, time, sizes) and writes nothing.
+TEST(Cli, NoOutputPrintsASummaryAndWritesNothing) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "scene.pcd", pyrseg::cli_test::scene_cloud(160, 120, 4),
+                          pyrseg::io::PcdEncoding::binary);
+    const CliRun r = run("segment " + (dir / "scene.pcd").string() + " --backend cpu");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(files_in(dir), 1u);
+    EXPECT_NE(r.output.find("scene.pcd: PCD, 160 x 120, normals estimated, "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(" ms on cpu"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("nothing written"), std::string::npos) << r.output;
+    ASSERT_EQ(
+        run("segment " + (dir / "scene.pcd").string() + " --backend cpu --labels " + (dir / "l.npy").string()).status,
+        0);
+    const std::vector<std::uint32_t> labels = read_labels(dir / "l.npy");
+    std::map<std::uint32_t, std::size_t> sizes;
+    std::size_t labelled = 0;
+    for (const std::uint32_t l : labels) {
+        if (l == 0) continue;
+        ++sizes[l];
+        ++labelled;
+    }
+    std::size_t largest = 0;
+    for (const auto& [label, size] : sizes) largest = std::max(largest, size);
+    EXPECT_NE(r.output.find(", " + std::to_string(sizes.size()) + " segments, "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("segment sizes in pixels, largest first: " + std::to_string(largest) + ", "),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("labelled: " + std::to_string(labelled) + " of 19200 pixels"), std::string::npos)
+        << r.output;
+    fs::remove_all(dir);
+}
+
+// Labelled PCD for PCL users: x y z label (PointXYZL), binary, organized, the labels those of --labels, the points
+// those of the input; in a batch NAME.labels.pcd. (tests/io reads it with PCL's own loadPCDFile.)
+TEST(Cli, LabelledPcdIsPointXYZLWithTheSameLabels) {
+    const fs::path dir = temp_dir();
+    const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(96, 72, 6);
+    pyrseg::io::write_pcd(dir / "scene.pcd", cloud, pyrseg::io::PcdEncoding::binary_compressed);
+    const CliRun r = run("segment " + (dir / "scene.pcd").string() + " --backend cpu --pcd " +
+                         (dir / "out.pcd").string() + " --labels " + (dir / "l.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream file(dir / "out.pcd", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    for (const char* line :
+         {"\nFIELDS x y z label\n", "\nSIZE 4 4 4 4\n", "\nTYPE F F F U\n", "\nWIDTH 96\n", "\nHEIGHT 72\n"}) {
+        EXPECT_NE(bytes.find(line), std::string::npos) << line;
+    }
+    const std::string data = "\nDATA binary\n";
+    const std::size_t body = bytes.find(data);
+    ASSERT_NE(body, std::string::npos);
+    const std::size_t n = std::size_t{96} * 72;
+    ASSERT_EQ(bytes.size(), body + data.size() + 16 * n);
+    const std::vector<std::uint32_t> labels = read_labels(dir / "l.npy");
+    for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t label = 0;
+        std::memcpy(&label, bytes.data() + body + data.size() + 16 * i + 12, 4);
+        ASSERT_EQ(label, labels[i]) << "point " << i;
+    }
+    const pyrseg::io::PointCloud back = pyrseg::io::read_pcd(dir / "out.pcd");
+    ASSERT_EQ(back.points.size(), cloud.points.size());
+    EXPECT_EQ(std::memcmp(back.points.data(), cloud.points.data(), cloud.points.size() * sizeof(float)), 0);
+    const CliRun batch = run("segment " + (dir / "scene.pcd").string() + " --out-dir " + (dir / "out").string() +
+                             " --write pcd --progress none --backend cpu");
+    ASSERT_EQ(batch.status, 0) << batch.output;
+    EXPECT_EQ(pyrseg::io::read_pcd(dir / "out" / "scene.labels.pcd").width, 96);
+    fs::remove_all(dir);
+}
+
+}  // namespace

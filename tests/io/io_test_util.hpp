@@ -74,7 +74,8 @@ inline PointCloud make_cloud(int width, int height, bool normals) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (std::size_t i = 0; i < n; ++i) {
         const float x = static_cast<float>(i % static_cast<std::size_t>(width)) * 0.01f - 0.3f;
-        const float y = static_cast<float>(i / static_cast<std::size_t>(width)) * 0.013f - 0.2f;
+        const std::size_t row = i / static_cast<std::size_t>(width);
+        const float y = static_cast<float>(row) * 0.013f - 0.2f;
         const bool invalid = i % 7 == 3;
         c.points[3 * i] = invalid ? nan : x;
         c.points[3 * i + 1] = invalid ? nan : y;
