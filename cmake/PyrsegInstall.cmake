@@ -92,6 +92,11 @@ function(_pyrseg_pc name description library requires requires_private libs_priv
   if(NOT BUILD_SHARED_LIBS)
     set(PC_REQUIRES_PRIVATE "${requires_private}")
     set(PC_LIBS_PRIVATE "${libs_private}")
+    # Instrumented static libraries need the sanitizers' runtimes wherever they are linked (the CMake package has
+    # them through pyrseg_build_flags' link options).
+    if(PYRSEG_SANITIZE)
+      string(STRIP "${PC_LIBS_PRIVATE} -fsanitize=address,undefined" PC_LIBS_PRIVATE)
+    endif()
   endif()
   # A static library's export macros are empty (cmake/PyrsegLibraries.cmake), as they are in its own build.
   get_target_property(type ${library} TYPE)

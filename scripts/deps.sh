@@ -14,6 +14,9 @@ packages=(
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd  # the OpenCL backend, and PoCL to run it on in CI
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers  # the Vulkan backend, lavapipe, the validation layer
   doxygen                                       # the API reference (scripts/api-docs.sh)
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest  # the Python module and its tests
+  python3-setuptools python3-wheel python3-venv python3-pip  # pip install --no-build-isolation . (offline)
+  python3-opencv python3-open3d                 # the Python examples (examples/python)
 )
 
 missing=()

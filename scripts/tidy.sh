@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build/release}"
 [ -f "$build/compile_commands.json" ] || scripts/build.sh release
-mapfile -t files < <(git ls-files 'core/*.cpp' 'backends/*.cpp' 'tools/*.cpp' 'io/*.cpp' 'synthetic/*.cpp' 'peers/*.cpp')
+mapfile -t files < <(git ls-files 'core/*.cpp' 'backends/*.cpp' 'tools/*.cpp' 'io/*.cpp' 'synthetic/*.cpp' 'peers/*.cpp' 'python/*.cpp')
 # "N warnings generated" counts the suppressed system-header warnings: noise, so it is filtered out.
 clang-tidy -p "$build" --quiet --warnings-as-errors='*' "${files[@]}" 2> >(grep -v "warnings generated" >&2)
 echo "clang-tidy: ${#files[@]} files clean"

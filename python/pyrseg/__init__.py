@@ -1,0 +1,50 @@
+"""pyrseg: fast bridgeless pyramid segmentation of organized point clouds and depth images.
+
+    import numpy as np, pyrseg
+    seg = pyrseg.Segmenter(640, 480, preset="realsense-d435", unit_mm=1000)   # a cloud in metres
+    result = seg.segment(points)            # H x W x 3 float32
+    result.labels, result.segment_count
+
+See docs/python.md for the whole API.
+"""
+
+from ._pyrseg import (  # noqa: F401
+    BackendInfo,
+    Error,
+    ErrorCode,
+    Result,
+    Segmenter,
+    __version__,
+    backends,
+    choose_backend,
+    default_params,
+    io,
+    measure_frame_noise,
+    preset,
+    presets,
+    segment_stats_dtype,
+    synthetic,
+)
+
+import sys as _sys
+
+# `import pyrseg.io` and `from pyrseg.synthetic import generate` as with any package's submodules.
+_sys.modules[__name__ + ".io"] = io
+_sys.modules[__name__ + ".synthetic"] = synthetic
+
+__all__ = [
+    "BackendInfo",
+    "Error",
+    "ErrorCode",
+    "Result",
+    "Segmenter",
+    "backends",
+    "choose_backend",
+    "default_params",
+    "io",
+    "measure_frame_noise",
+    "preset",
+    "presets",
+    "segment_stats_dtype",
+    "synthetic",
+]

@@ -1,0 +1,551 @@
+// pyrseg.Segmenter, its parameters and results, pyrseg.Error, the backends and presets.
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "bindings.hpp"
+#include "device.hpp"
+#include "pyrseg/backend.hpp"
+#include "pyrseg/error.hpp"
+#include "pyrseg/presets.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/version.hpp"
+
+namespace pyrseg::python {
+namespace {
+
+// Python objects made once when the module is imported and kept for the process's life: a frame then makes only
+// its result arrays and tuple, through Python's allocator, and nothing through operator new (the tests count it).
+struct Cached {
+    PyObject* error = nullptr;         // pyrseg.Error
+    PyObject* empty = nullptr;         // numpy.empty
+    PyObject* result_type = nullptr;   // pyrseg.Result (a named tuple)
+    PyObject* backend_type = nullptr;  // pyrseg.BackendInfo (a named tuple)
+    PyObject* stats_dtype = nullptr;   // pyrseg.segment_stats_dtype
+    PyObject* uint32 = nullptr;
+    PyObject* uint8 = nullptr;
+    PyObject* float32 = nullptr;
+};
+Cached cached;  // NOLINT: set once at import, as pybind11 modules keep their types
+
+py::handle obj(PyObject* p) {
+    return {p};
+}
+
+py::array new_array(PyObject* dtype, int height, int width, int channels = 0) {
+    py::object shape =
+        channels > 0 ? py::object(py::make_tuple(height, width, channels)) : py::object(py::make_tuple(height, width));
+    return py::reinterpret_borrow<py::array>(obj(cached.empty)(shape, obj(dtype)));
+}
+
+// --- parameters -------------------------------------------------------------------------------------------------
+
+std::string known_presets() {
+    std::string s;
+    for (const SensorKind k : sensor_kinds()) s += (s.empty() ? "" : ", ") + std::string(sensor_kind_name(k));
+    return s;
+}
+
+SensorKind preset_kind(const std::string& name) {
+    const auto kind = sensor_kind_from_name(name);
+    if (!kind) raise(ErrorCode::invalid_parameter, "unknown preset '" + name + "'; presets: " + known_presets());
+    return *kind;
+}
+
+// One keyword argument onto Params; false when `key` is not a parameter.
+bool set_param(Params& p, const std::string& key, const py::handle& v) {
+    const auto optional_int = [&](std::optional<int>& field) {
+        field = v.is_none() ? std::nullopt : std::optional<int>(v.cast<int>());
+    };
+    if (key == "ct") {
+        p.ct = v.cast<double>();
+    } else if (key == "dt") {
+        p.dt = v.cast<double>();
+    } else if (key == "unit_mm") {
+        p.unit_mm = v.cast<double>();
+    } else if (key == "bridge_levels") {
+        optional_int(p.bridge_levels);
+    } else if (key == "unjoinable_gap") {
+        optional_int(p.unjoinable_gap);
+    } else if (key == "label_edges") {
+        p.label_edges = v.cast<bool>();
+    } else if (key == "edge_rounds") {
+        p.edge_rounds = v.cast<int>();
+    } else if (key == "compact") {
+        p.compact = v.cast<bool>();
+    } else if (key == "normal_radius") {
+        p.normal_radius = v.cast<int>();
+    } else if (key == "metric") {
+        const auto m = v.cast<std::string>();
+        if (m != "paper" && m != "robust") {
+            raise(ErrorCode::invalid_parameter, "metric must be 'paper' or 'robust', got '" + m + "'");
+        }
+        p.metric = m == "robust" ? Metric::robust : Metric::paper;
+    } else if (key == "normal_window") {
+        p.normal_window = v.cast<int>();
+    } else if (key == "curvature_stride") {
+        p.curvature_stride = v.cast<int>();
+    } else if (key == "dt_per_m2") {
+        p.dt_per_m2 = v.cast<double>();
+    } else if (key == "ct_growth_per_m2") {
+        p.ct_growth_per_m2 = v.cast<double>();
+    } else {
+        return false;
+    }
+    return true;
+}
+
+Outputs outputs_from(const py::handle& names) {
+    Outputs o;
+    if (py::isinstance<py::str>(names)) throw py::type_error("outputs must be a sequence of names, not a string");
+    for (const py::handle& n : names) {
+        const auto name = n.cast<std::string>();
+        if (name == "raw_labels") {
+            o.raw_labels = true;
+        } else if (name == "fillable_mask") {
+            o.fillable_mask = true;
+        } else if (name == "normals") {
+            o.normals = true;
+        } else if (name == "segment_stats") {
+            o.segment_stats = true;
+        } else {
+            throw py::value_error("unknown output '" + name +
+                                  "'; outputs: raw_labels, fillable_mask, normals, segment_stats");
+        }
+    }
+    return o;
+}
+
+// preset= first (it sets every parameter, in unit_mm), then each parameter given over it.
+Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_stream) {
+    double unit_mm = 1.0;
+    if (kwargs.contains("unit_mm")) unit_mm = kwargs["unit_mm"].cast<double>();
+    Params p;
+    if (kwargs.contains("preset") && !kwargs["preset"].is_none()) {
+        p = sensor_preset(preset_kind(kwargs["preset"].cast<std::string>()), unit_mm);
+    }
+    for (const auto& [k, v] : kwargs) {
+        const auto key = k.cast<std::string>();
+        if (key == "preset") continue;
+        if (key == "outputs") {
+            outputs = outputs_from(v);
+        } else if (key == "cuda_stream") {
+            cuda_stream = py::reinterpret_borrow<py::object>(v);
+        } else if (!set_param(p, key, v)) {
+            throw py::type_error("Segmenter() got an unexpected keyword argument '" + key +
+                                 "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
+                                 "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
+                                 "dt_per_m2, ct_growth_per_m2; and preset, outputs, cuda_stream");
+        }
+    }
+    return p;
+}
+
+// --- the Segmenter ----------------------------------------------------------------------------------------------
+
+class PySegmenter {
+public:
+    PySegmenter(int width, int height, const py::object& backend, const py::kwargs& kwargs) {
+        py::object cuda_stream = py::none();
+        params_ = params_from(kwargs, outputs_, cuda_stream);
+        const std::string requested = backend.is_none() ? std::string() : backend.cast<std::string>();
+        // The device-array path needs the Segmenter pyrseg/cuda.hpp makes on a stream; it segments host frames
+        // too, so every CUDA Segmenter is made that way.
+        const std::string name = resolve_backend_name(requested);
+        if (name == "cuda" && DeviceFrames::built()) {
+            device_.emplace(cuda_stream);
+        } else if (!cuda_stream.is_none()) {
+            throw py::value_error("cuda_stream= is for the cuda backend; this Segmenter runs " + name);
+        }
+        // A GPU backend's setup (devices, kernels, buffers) can take a while: other Python threads go on meanwhile.
+        const py::gil_scoped_release nogil;
+        if (device_) {
+            segmenter_.emplace(device_->make_segmenter(width, height, params_, outputs_));
+        } else {
+            segmenter_.emplace(width, height, params_, name, outputs_);
+        }
+    }
+
+    py::object segment(const py::object& points, const py::object& normals, const py::object& out,
+                       const py::object& count) {
+        if (is_device_array(points)) {
+            device().segment_cloud(*segmenter_, points, normals, out, count);
+            return out;
+        }
+        no_count(count);
+        const CloudInput input(points, normals, width(), height());
+        return run(input, out, [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment(input.view(s), r); });
+    }
+
+    py::object segment_depth(const py::object& depth, double fx, double fy, double cx, double cy,
+                             double metres_per_unit, const py::object& out, const py::object& count) {
+        DepthView camera;
+        camera.fx = fx;
+        camera.fy = fy;
+        camera.cx = cx;
+        camera.cy = cy;
+        camera.metres_per_unit = metres_per_unit;
+        if (is_device_array(depth)) {
+            device().segment_depth(*segmenter_, depth, camera, out, count);
+            return out;
+        }
+        no_count(count);
+        const DepthInput input(depth);
+        return run(input, out, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
+            DepthView v = input.view(s);
+            v.fx = camera.fx;
+            v.fy = camera.fy;
+            v.cx = camera.cx;
+            v.cy = camera.cy;
+            v.metres_per_unit = camera.metres_per_unit;
+            seg.segment(v, r);
+        });
+    }
+
+    py::object segment_mask(const py::object& mask, const py::object& valid, const py::object& out) {
+        const MaskInput input(mask, valid);
+        return run(input, out, [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment_mask(input.view(s), r); });
+    }
+
+    [[nodiscard]] int width() const { return segmenter_->width(); }
+    [[nodiscard]] int height() const { return segmenter_->height(); }
+    [[nodiscard]] const std::string& backend() const { return segmenter_->backend_name(); }
+    [[nodiscard]] py::dict params() const { return params_to_dict(segmenter_->params()); }
+    [[nodiscard]] py::tuple outputs() const {
+        py::list names;
+        if (outputs_.raw_labels) names.append("raw_labels");
+        if (outputs_.fillable_mask) names.append("fillable_mask");
+        if (outputs_.normals) names.append("normals");
+        if (outputs_.segment_stats) names.append("segment_stats");
+        return py::tuple(names);
+    }
+    [[nodiscard]] bool last_input_copied() const { return last_copied_; }
+    [[nodiscard]] py::dict timings() {
+        std::vector<PassTiming> copy;
+        {
+            // Without the GIL first: a frame holding the lock may be waiting for it.
+            const py::gil_scoped_release nogil;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            copy = segmenter_->last_timings();
+        }
+        py::dict d;
+        for (const PassTiming& t : copy) d[t.pass] = t.milliseconds;
+        return d;
+    }
+    [[nodiscard]] std::string repr() const {
+        return "pyrseg.Segmenter(" + std::to_string(width()) + ", " + std::to_string(height()) + ", backend='" +
+               backend() + "')";
+    }
+
+private:
+    DeviceFrames& device() {
+        if (!device_) {
+            raise(ErrorCode::invalid_argument,
+                  "a CUDA device array (__cuda_array_interface__) was given but this Segmenter runs the " + backend() +
+                      " backend: create it with backend='cuda', or copy the array to the host (cupy: .get(), "
+                      "torch: .cpu().numpy())");
+        }
+        return *device_;
+    }
+
+    static void no_count(const py::object& count) {
+        if (!count.is_none()) throw py::value_error("count= is for device frames; a host frame's is segment_count");
+    }
+
+    // One host frame: the result arrays made with the GIL, the frame and the copies into them without it.
+    template <class Input, class Frame>
+    py::object run(const Input& input, const py::object& out, const Frame& frame) {
+        const int w = width(), h = height();
+        py::array labels = out.is_none() ? new_array(cached.uint32, h, w) : check_labels_out(out, w, h);
+        py::object raw = py::none(), mask = py::none(), normals = py::none(), segments = py::none();
+        void* raw_data = nullptr;
+        void* mask_data = nullptr;
+        void* normals_data = nullptr;
+        if (outputs_.raw_labels) {
+            auto a = new_array(cached.uint32, h, w);
+            raw_data = a.mutable_data();
+            raw = std::move(a);
+        }
+        if (outputs_.fillable_mask) {
+            auto a = new_array(cached.uint8, h, w);
+            mask_data = a.mutable_data();
+            mask = std::move(a);
+        }
+        if (outputs_.normals) {
+            auto a = new_array(cached.float32, h, w, 3);
+            normals_data = a.mutable_data();
+            normals = std::move(a);
+        }
+        std::uint32_t count = 0;
+        const std::size_t pixels = std::size_t(w) * std::size_t(h);
+        {
+            const py::gil_scoped_release nogil;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            frame(scratch_, *segmenter_, result_);
+            last_copied_ = input.copies();
+            copy_labels(result_.labels.data(), labels);
+            if (raw_data != nullptr) std::memcpy(raw_data, result_.raw_labels.data(), pixels * 4);
+            if (mask_data != nullptr) std::memcpy(mask_data, result_.fillable_mask.data(), pixels);
+            if (normals_data != nullptr) std::memcpy(normals_data, result_.normals.data(), pixels * 12);
+            count = result_.segment_count;
+            if (outputs_.segment_stats) {
+                // Under the lock, so that another thread's frame cannot overwrite the statistics being read.
+                const py::gil_scoped_acquire gil;
+                const auto k = py::ssize_t(result_.segments.size());
+                auto a =
+                    py::reinterpret_steal<py::array>(PyObject_CallFunction(cached.empty, "nO", k, cached.stats_dtype));
+                if (!a) throw py::error_already_set();
+                if (k > 0)
+                    std::memcpy(a.mutable_data(), result_.segments.data(), std::size_t(k) * sizeof(SegmentStats));
+                segments = std::move(a);
+            }
+        }
+        return obj(cached.result_type)(labels, count, segments, normals, mask, raw);
+    }
+
+    Params params_;
+    Outputs outputs_;
+    std::optional<DeviceFrames> device_;  // before segmenter_: the Segmenter is destroyed first, on its stream
+    std::optional<Segmenter> segmenter_;
+    Result result_;
+    Scratch scratch_;
+    std::atomic<bool> last_copied_{false};
+    std::mutex mutex_;  // one frame at a time: Python threads may share a Segmenter, and run without the GIL
+};
+
+// The package pyrseg re-exports its extension _pyrseg's names: its types say pyrseg.X, as users import them.
+std::string public_name(const py::module_& m) {
+    const auto name = m.attr("__name__").cast<std::string>();
+    return name == "_pyrseg" || name == "pyrseg._pyrseg" ? "pyrseg" : name;
+}
+
+// --- module-level functions -------------------------------------------------------------------------------------
+
+py::object stats_dtype() {
+    py::list names, formats, offsets;
+    const auto field = [&](const char* name, const char* format, std::size_t offset) {
+        names.append(name);
+        formats.append(format);
+        offsets.append(offset);
+    };
+    field("label", "<u4", offsetof(SegmentStats, label));
+    field("pixel_count", "<u4", offsetof(SegmentStats, pixel_count));
+    field("x_min", "<i4", offsetof(SegmentStats, x_min));
+    field("y_min", "<i4", offsetof(SegmentStats, y_min));
+    field("x_max", "<i4", offsetof(SegmentStats, x_max));
+    field("y_max", "<i4", offsetof(SegmentStats, y_max));
+    field("point_sum", "(3,)<i8", offsetof(SegmentStats, point_sum));
+    field("normal_sum", "(3,)<i8", offsetof(SegmentStats, normal_sum));
+    field("point_shift", "<i4", offsetof(SegmentStats, point_shift));
+    field("centroid", "(3,)<f8", offsetof(SegmentStats, centroid));
+    field("mean_normal", "(3,)<f8", offsetof(SegmentStats, mean_normal));
+    py::dict spec;
+    spec["names"] = names;
+    spec["formats"] = formats;
+    spec["offsets"] = offsets;
+    spec["itemsize"] = sizeof(SegmentStats);
+    return py::module_::import("numpy").attr("dtype")(spec);
+}
+
+py::list backends() {
+    py::list l;
+    for (const BackendInfo& b : list_backends()) {
+        l.append(obj(cached.backend_type)(b.name, b.available, b.reason, py::cast(b.devices), b.emulated,
+                                          b.emulated_device));
+    }
+    return l;
+}
+
+}  // namespace
+
+void bind_segmenter(py::module_& m) {
+    m.attr("__version__") = kVersion;
+    const py::object numpy = py::module_::import("numpy");
+    const py::object namedtuple = py::module_::import("collections").attr("namedtuple");
+    const py::str module_name(public_name(m));
+    const auto keep = [](const py::object& o) { return o.inc_ref().ptr(); };
+    cached.empty = keep(numpy.attr("empty"));
+    cached.uint32 = keep(numpy.attr("dtype")("uint32"));
+    cached.uint8 = keep(numpy.attr("dtype")("uint8"));
+    cached.float32 = keep(numpy.attr("dtype")("float32"));
+    cached.stats_dtype = keep(stats_dtype());
+    m.attr("segment_stats_dtype") = obj(cached.stats_dtype);
+    cached.result_type = keep(namedtuple(
+        "Result", py::make_tuple("labels", "segment_count", "segments", "normals", "fillable_mask", "raw_labels"),
+        py::arg("module") = module_name));
+    m.attr("Result") = obj(cached.result_type);
+    m.attr("Result").attr("__doc__") =
+        "One frame's results. labels: H x W uint32 (the out= array when given), 0 for no segment; segment_count: "
+        "K; segments: K entries of segment_stats_dtype, segment k at k - 1 (outputs 'segment_stats', else None); "
+        "normals: H x W x 3 float32, fillable_mask: H x W uint8, raw_labels: H x W uint32 (each None unless asked "
+        "for in outputs=).";
+    cached.backend_type = keep(namedtuple(
+        "BackendInfo", py::make_tuple("name", "available", "reason", "devices", "emulated", "emulated_device"),
+        py::arg("module") = module_name));
+    m.attr("BackendInfo") = obj(cached.backend_type);
+
+    py::class_<PySegmenter>(m, "Segmenter", kLocal, R"(A segmenter for one backend and one frame size.
+
+Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, **params)
+
+backend: "cpu", "cuda", "vulkan", "opencl", "auto", or None for $PYRSEG_BACKEND (else "auto").
+preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it.
+params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
+metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2 (docs/algorithm.md).
+outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
+cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
+stream; None is the legacy default stream.)")
+        .def(py::init<int, int, const py::object&, const py::kwargs&>(), py::arg("width"), py::arg("height"),
+             py::arg("backend") = py::none())
+        .def("segment", &PySegmenter::segment, py::arg("points"), py::arg("normals") = py::none(),
+             py::arg("out") = py::none(), py::arg("count") = py::none(),
+             R"(Segments an organized cloud and returns a pyrseg.Result.
+
+points: H x W x 3 (xyz), H x W x 4 (xyz and a pad, PCL's PointXYZ) or H x W x 6 (xyz then normals), float32 (read in
+place, any strides) or float64 (converted); normals: None (estimated) or H x W x 3. out: an H x W uint32 array
+to write the labels into. A CUDA device array (backend "cuda") is segmented on the device, asynchronously on the
+Segmenter's stream: out= (an H x W uint32 device array) is then required and returned, and count= (a uint32 device
+array) receives the segment count.)")
+        .def("segment_depth", &PySegmenter::segment_depth, py::arg("depth"), py::arg("fx"), py::arg("fy"),
+             py::arg("cx"), py::arg("cy"), py::arg("metres_per_unit"), py::arg("out") = py::none(),
+             py::arg("count") = py::none(),
+             R"(Segments a depth image (H x W uint16 or float32; float64 converted) back-projected with the pinhole
+intrinsics; metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 for float metres).)")
+        .def("segment_mask", &PySegmenter::segment_mask, py::arg("mask"), py::arg("valid") = py::none(),
+             py::arg("out") = py::none(),
+             "Labels a caller-made fillable mask (H x W bool or uint8); valid: which other pixels edge labelling "
+             "may label (None: all).")
+        .def_property_readonly("width", &PySegmenter::width)
+        .def_property_readonly("height", &PySegmenter::height)
+        .def_property_readonly("backend", &PySegmenter::backend)
+        .def_property_readonly("params", &PySegmenter::params)
+        .def_property_readonly("outputs", &PySegmenter::outputs)
+        .def_property_readonly("timings", &PySegmenter::timings,
+                               "Milliseconds of each pass of the last host frame, in pass order.")
+        .def_property_readonly("last_input_copied", &PySegmenter::last_input_copied,
+                               "Whether the last host frame had to be converted (float64, or a layout pyrseg's views "
+                               "cannot describe) rather than read in place.")
+        .def("__repr__", &PySegmenter::repr);
+
+    m.def("backends", &backends, "Every backend pyrseg knows, in preference order, and whether it can run here.");
+    m.def(
+        "choose_backend",
+        [](const py::object& requested) {
+            const BackendChoice c = choose_backend(requested.is_none() ? std::string() : requested.cast<std::string>());
+            return py::make_tuple(c.name, c.reason);
+        },
+        py::arg("requested") = py::none(), "The backend a request resolves to, and why: (name, reason).");
+    m.def(
+        "presets",
+        [] {
+            py::dict d;
+            for (const SensorKind k : sensor_kinds()) d[sensor_kind_name(k)] = sensor_kind_summary(k);
+            return d;
+        },
+        "The sensor presets: name -> what it suits.");
+    m.def(
+        "preset",
+        [](const std::string& name, double unit_mm) {
+            return params_to_dict(sensor_preset(preset_kind(name), unit_mm));
+        },
+        py::arg("name"), py::arg("unit_mm") = 1.0, "A sensor preset's parameters, for clouds in units of unit_mm mm.");
+    m.def(
+        "default_params", [] { return params_to_dict(Params{}); }, "The algorithm contract's default parameters.");
+    m.def(
+        "measure_frame_noise",
+        [](const py::object& points, double unit_mm) {
+            const CloudInput input(points, py::none(), -1, -1);
+            Scratch scratch;
+            FrameNoise n;
+            {
+                const py::gil_scoped_release nogil;
+                n = measure_frame_noise(input.view(scratch), unit_mm);
+            }
+            py::dict d;
+            d["samples"] = n.samples;
+            d["median_depth_mm"] = n.median_depth_mm;
+            d["second_difference_mm"] = n.second_difference_mm;
+            d["suggested"] = sensor_kind_name(n.suggested);
+            d["reason"] = n.reason;
+            return d;
+        },
+        py::arg("points"), py::arg("unit_mm") = 1.0,
+        "How noisy a frame's depth is, and which preset it suggests (pyrseg/presets.hpp).");
+}
+
+void bind_errors(py::module_& m) {
+    py::enum_<ErrorCode>(m, "ErrorCode", kLocal)
+        .value("invalid_argument", ErrorCode::invalid_argument)
+        .value("invalid_parameter", ErrorCode::invalid_parameter)
+        .value("size_mismatch", ErrorCode::size_mismatch)
+        .value("image_too_large", ErrorCode::image_too_large)
+        .value("backend_unavailable", ErrorCode::backend_unavailable)
+        .value("out_of_memory", ErrorCode::out_of_memory)
+        .value("io", ErrorCode::io)
+        .value("format", ErrorCode::format)
+        .value("internal", ErrorCode::internal);
+    const std::string qualified = public_name(m) + ".Error";
+    cached.error = PyErr_NewExceptionWithDoc(qualified.c_str(),
+                                             "A pyrseg failure: .code (pyrseg.ErrorCode) and .message, as the C++ "
+                                             "pyrseg::Error carries them.",
+                                             PyExc_RuntimeError, nullptr);
+    if (cached.error == nullptr) throw py::error_already_set();
+    m.attr("Error") = obj(cached.error);
+    // NOLINTNEXTLINE(performance-unnecessary-value-param): pybind11 takes void(*)(std::exception_ptr)
+    py::register_local_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Error& e) {
+            const py::object instance = obj(cached.error)(e.what());
+            instance.attr("code") = py::cast(e.code());
+            instance.attr("message") = e.what();
+            PyErr_SetObject(cached.error, instance.ptr());
+        }
+    });
+}
+
+namespace {
+
+const char* metric_name(Metric m) {
+    return m == Metric::robust ? "robust" : "paper";
+}
+
+}  // namespace
+
+py::dict params_to_dict(const Params& p) {
+    py::dict d;
+    d["ct"] = p.ct;
+    d["dt"] = p.dt;
+    d["unit_mm"] = p.unit_mm;
+    d["bridge_levels"] = p.bridge_levels ? py::object(py::int_(*p.bridge_levels)) : py::object(py::none());
+    d["unjoinable_gap"] = p.unjoinable_gap ? py::object(py::int_(*p.unjoinable_gap)) : py::object(py::none());
+    d["label_edges"] = p.label_edges;
+    d["edge_rounds"] = p.edge_rounds;
+    d["compact"] = p.compact;
+    d["normal_radius"] = p.normal_radius;
+    d["metric"] = metric_name(p.metric);
+    d["normal_window"] = p.normal_window;
+    d["curvature_stride"] = p.curvature_stride;
+    d["dt_per_m2"] = p.dt_per_m2;
+    d["ct_growth_per_m2"] = p.ct_growth_per_m2;
+    return d;
+}
+
+py::dtype segment_stats_dtype() {
+    return py::reinterpret_borrow<py::dtype>(obj(cached.stats_dtype));
+}
+
+void raise(ErrorCode code, const std::string& message) {
+    throw Error(code, message);
+}
+
+}  // namespace pyrseg::python

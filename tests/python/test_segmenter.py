@@ -1,0 +1,266 @@
+"""The Python API over pyrseg::Segmenter: inputs in place or converted, results, outputs, errors, threads."""
+
+import threading
+import time
+
+import numpy as np
+import pyrseg
+import pytest
+
+
+def reference(scene, **kw):
+    seg = pyrseg.Segmenter(scene.points.shape[1], scene.points.shape[0], "cpu", **kw)
+    return seg.segment(np.ascontiguousarray(scene.points)).labels
+
+
+def test_result(scene):
+    h, w, _ = scene.points.shape
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    r = seg.segment(scene.points)
+    assert isinstance(r, pyrseg.Result)
+    assert r.labels.shape == (h, w) and r.labels.dtype == np.uint32 and r.labels.flags.c_contiguous
+    assert r.segment_count == len(np.unique(r.labels[r.labels > 0])) > 1
+    assert r.segments is None and r.normals is None and r.fillable_mask is None and r.raw_labels is None
+    assert not seg.last_input_copied
+    assert seg.width == w and seg.height == h and seg.backend == "cpu"
+    assert "labels" in seg.timings
+
+
+@pytest.mark.parametrize(
+    "layout",
+    ["pcl_padded", "strided_rows", "pointnormal_slices", "six_channels"],
+)
+def test_layouts_read_in_place(scene, layout):
+    """Layouts a CloudView describes are read where they are, and give the packed cloud's labels."""
+    h, w, _ = scene.points.shape
+    want_kw = {}
+    normals = None
+    if layout == "pcl_padded":
+        buf = np.zeros((h, w, 4), np.float32)
+        buf[..., :3] = scene.points
+        points = buf
+    elif layout == "strided_rows":
+        # Every other row of a frame twice as tall: rows 2 * 12 * W bytes apart.
+        tall = np.zeros((2 * h, w, 3), np.float32)
+        tall[::2] = scene.points
+        points = tall[::2]
+    elif layout == "pointnormal_slices":
+        # PCL's PointNormal: x y z pad nx ny nz curvature pad -> two views into one buffer.
+        buf = np.zeros((h, w, 8), np.float32)
+        buf[..., :3] = scene.points
+        buf[..., 4:7] = scene.normals
+        points, normals = buf[..., :3], buf[..., 4:7]
+        want_kw = {"normals": scene.normals}
+    else:
+        points = np.concatenate([scene.points, scene.normals], axis=2)
+        want_kw = {"normals": scene.normals}
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    want = seg.segment(np.ascontiguousarray(scene.points), **want_kw).labels
+    got = seg.segment(points, normals=normals).labels
+    assert not seg.last_input_copied, layout
+    np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("layout", ["float64", "fortran", "flipped", "list"])
+def test_other_inputs_are_converted(scene, layout):
+    h, w, _ = scene.points.shape
+    small = scene.points[:8, :8]
+    if layout == "float64":
+        points = scene.points.astype(np.float64)
+    elif layout == "fortran":
+        points = np.asfortranarray(scene.points)
+    elif layout == "flipped":
+        points = np.flip(scene.points, 0)  # negative row strides: no CloudView describes them
+    else:
+        points = small.tolist()
+        w = h = 8
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    want = seg.segment(np.ascontiguousarray(np.asarray(points, np.float32))).labels
+    got = seg.segment(points).labels
+    if layout != "list":
+        assert seg.last_input_copied
+    np.testing.assert_array_equal(got, want)
+
+
+def test_out_array_is_written_and_returned(scene):
+    h, w, _ = scene.points.shape
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    out = np.full((h, w), 7, np.uint32)
+    r = seg.segment(scene.points, out=out)
+    assert r.labels is out
+    np.testing.assert_array_equal(out, reference(scene))
+    # A strided out: the columns of a wider array.
+    wide = np.zeros((h, 2 * w), np.uint32)
+    seg.segment(scene.points, out=wide[:, ::2])
+    np.testing.assert_array_equal(wide[:, ::2], out)
+    assert not wide[:, 1::2].any()
+    with pytest.raises(TypeError, match="uint32"):
+        seg.segment(scene.points, out=np.zeros((h, w), np.int32))
+    with pytest.raises(ValueError, match="shape"):
+        seg.segment(scene.points, out=np.zeros((h, w + 1), np.uint32))
+    ro = np.zeros((h, w), np.uint32)
+    ro.flags.writeable = False
+    with pytest.raises(ValueError, match="read-only"):
+        seg.segment(scene.points, out=ro)
+
+
+def test_outputs_and_statistics(scene):
+    h, w, _ = scene.points.shape
+    seg = pyrseg.Segmenter(w, h, "cpu", outputs=("segment_stats", "normals", "fillable_mask", "raw_labels"))
+    r = seg.segment(scene.points)
+    assert r.normals.shape == (h, w, 3) and r.normals.dtype == np.float32
+    assert r.fillable_mask.shape == (h, w) and r.fillable_mask.dtype == np.uint8
+    assert set(np.unique(r.fillable_mask)) <= {0, 1}
+    assert r.raw_labels.shape == (h, w) and r.raw_labels.dtype == np.uint32
+    s = r.segments
+    assert s.dtype == pyrseg.segment_stats_dtype and len(s) == r.segment_count
+    np.testing.assert_array_equal(s["label"], np.arange(1, r.segment_count + 1))
+    np.testing.assert_array_equal(s["pixel_count"], np.bincount(r.labels.ravel(), minlength=r.segment_count + 1)[1:])
+    for row in s[:3]:
+        ys, xs = np.nonzero(r.labels == row["label"])
+        assert (row["x_min"], row["y_min"], row["x_max"], row["y_max"]) == (xs.min(), ys.min(), xs.max(), ys.max())
+        pts = scene.points[ys, xs].astype(np.float64)
+        np.testing.assert_allclose(row["centroid"], np.nanmean(pts, axis=0), atol=0.1)
+        assert abs(np.linalg.norm(row["mean_normal"]) - 1) < 1e-6
+
+
+def test_params_presets_and_errors(scene):
+    h, w, _ = scene.points.shape
+    assert set(pyrseg.presets()) == {"structured-light", "kinect-v1", "realsense-d435", "azure-kinect"}
+    p = pyrseg.preset("realsense-d435", unit_mm=1000)
+    seg = pyrseg.Segmenter(w, h, "cpu", preset="realsense-d435", unit_mm=1000, edge_rounds=5)
+    assert seg.params == dict(p, edge_rounds=5)
+    assert pyrseg.Segmenter(w, h, "cpu").params == pyrseg.default_params()
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(w, h, "cpu", ct=-1)
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "ct" in e.value.message
+    assert isinstance(e.value, RuntimeError)
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(w, h, "cpu", preset="phoxi")
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "kinect-v1" in str(e.value)
+    with pytest.raises(TypeError, match="ctt"):
+        pyrseg.Segmenter(w, h, "cpu", ctt=0.3)
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(w, h, "no-such-backend")
+    assert e.value.code == pyrseg.ErrorCode.backend_unavailable
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    with pytest.raises(pyrseg.Error) as e:
+        seg.segment(scene.points[:, :-1])
+    assert e.value.code == pyrseg.ErrorCode.size_mismatch
+    with pytest.raises(TypeError, match="float32 or float64"):
+        seg.segment(np.nan_to_num(scene.points).astype(np.int32))
+    with pytest.raises(ValueError, match="H x W x 3"):
+        seg.segment(scene.points[..., :2])
+    with pytest.raises(ValueError, match="twice"):
+        seg.segment(np.concatenate([scene.points, scene.normals], 2), normals=scene.normals)
+
+
+def test_backends_and_choice():
+    infos = pyrseg.backends()
+    assert infos[-1].name == "cpu" and infos[-1].available
+    for b in infos:
+        assert b.available or b.reason
+    name, reason = pyrseg.choose_backend("cpu")
+    assert name == "cpu"
+    assert pyrseg.choose_backend()[0] in {b.name for b in infos if b.available}
+
+
+def test_depth_frames(scene):
+    h, w, _ = scene.points.shape
+    z = scene.points[..., 2]
+    depth = np.where(np.isfinite(z), np.round(z), 0).astype(np.uint16)
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    k = dict(fx=scene.fx, fy=scene.fy, cx=scene.cx, cy=scene.cy)
+    r = seg.segment_depth(depth, metres_per_unit=0.001, **k)
+    assert not seg.last_input_copied and r.segment_count > 1
+    # Strided rows in place; a column-strided view converted; float32 metres and float64 metres agree.
+    tall = np.zeros((2 * h, w), np.uint16)
+    tall[::2] = depth
+    np.testing.assert_array_equal(seg.segment_depth(tall[::2], metres_per_unit=0.001, **k).labels, r.labels)
+    assert not seg.last_input_copied
+    wide = np.zeros((h, 2 * w), np.uint16)
+    wide[:, ::2] = depth
+    np.testing.assert_array_equal(seg.segment_depth(wide[:, ::2], metres_per_unit=0.001, **k).labels, r.labels)
+    assert seg.last_input_copied
+    metres = depth.astype(np.float32) / 1000
+    a = seg.segment_depth(metres, metres_per_unit=1.0, **k).labels
+    b = seg.segment_depth(metres.astype(np.float64), metres_per_unit=1.0, **k).labels
+    np.testing.assert_array_equal(a, b)
+    with pytest.raises(pyrseg.Error) as e:
+        seg.segment_depth(depth, metres_per_unit=0, **k)
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter
+    with pytest.raises(TypeError, match="uint16"):
+        seg.segment_depth(depth.astype(np.int32), metres_per_unit=0.001, **k)
+
+
+def test_mask_frames():
+    mask = np.zeros((64, 96), bool)
+    mask[4:30, 4:40] = True
+    mask[36:60, 50:90] = True
+    seg = pyrseg.Segmenter(96, 64, "cpu", outputs=("segment_stats",))
+    r = seg.segment_mask(mask)
+    assert r.segment_count == 2
+    assert len(np.unique(r.labels[mask])) == 2
+    assert np.isnan(r.segments["centroid"]).all()  # a mask has no points
+    # uint8 with a valid mask in another layout (converted): nothing outside `valid` joins a segment.
+    valid = np.zeros((64, 96), np.uint8)
+    r2 = seg.segment_mask(mask.astype(np.uint8), valid=np.asfortranarray(valid))
+    assert seg.last_input_copied
+    assert (r2.labels[~mask] == 0).all() and r2.segment_count == 2
+    with pytest.raises(TypeError, match="bool or uint8"):
+        seg.segment_mask(mask.astype(np.float32))
+
+
+def test_frame_noise_suggests_a_preset():
+    s = pyrseg.synthetic.generate(160, 120, sensor="kinect-v1")
+    n = pyrseg.measure_frame_noise(s.points)
+    assert n["suggested"] in pyrseg.presets() and n["samples"] > 1000 and n["reason"]
+
+
+def test_gil_is_released_while_segmenting():
+    """Another Python thread runs while a frame is segmented: the frame takes the GIL only around its arrays."""
+    s = pyrseg.synthetic.generate(1280, 960, seed=5)
+    seg = pyrseg.Segmenter(1280, 960, "cpu")
+    seg.segment(s.points)
+    inside = []
+    done = threading.Event()
+
+    def work():
+        t0 = time.perf_counter()
+        seg.segment(s.points)
+        inside.append((t0, time.perf_counter()))
+        done.set()
+
+    ticks = []
+    t = threading.Thread(target=work)
+    t.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+    t.join()
+    (t0, t1), = inside
+    # The middle of the frame, well clear of the conversions at either end, which hold the GIL.
+    lo, hi = t0 + 0.2 * (t1 - t0), t1 - 0.2 * (t1 - t0)
+    during = sum(lo < x < hi for x in ticks)
+    # Held through the frame, the GIL would let this thread run not once in that span (a busy machine aside, it
+    # runs thousands of times).
+    assert during > 10, f"{during} steps of the main thread during a {1000 * (t1 - t0):.0f} ms frame"
+
+
+def test_threads_share_a_segmenter(scene):
+    h, w, _ = scene.points.shape
+    seg = pyrseg.Segmenter(w, h, "cpu")
+    want = reference(scene)
+    results = []
+
+    def work():
+        for _ in range(10):
+            results.append(seg.segment(scene.points).labels)
+
+    threads = [threading.Thread(target=work) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(results) == 30
+    for r in results:
+        np.testing.assert_array_equal(r, want)
