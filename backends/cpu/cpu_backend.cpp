@@ -675,13 +675,31 @@ private:
     template <class Changed>
     static bool column_step_marked(uint32_t* row, uint64_t* bits, const std::uint8_t* from_mask, const uint32_t* from,
                                    size_t w, const Changed& changed) {
+        // Word by word, bit by bit without branching on the pixels (whether a marked pixel takes its neighbour's
+        // label is as good as random: a branch on it mispredicts), then the callback for the pixels that did.
         bool any = false;
-        for (size_t x = next_bit(bits, 0, w, true); x < w; x = next_bit(bits, x + 1, w, true)) {
-            if ((from_mask[x] & PYR_MASK_FILLABLE) == 0 || from[x] == 0) continue;
-            row[x] = from[x];
-            bits[x / 64] &= ~(uint64_t{1} << (x % 64));
-            changed(x, from[x]);
+        const size_t words = (w + 63) / 64;
+        for (size_t i = 0; i < words; ++i) {
+            uint64_t marked = bits[i];
+            if (marked == 0) continue;
+            const size_t base = i * 64;
+            uint64_t took = 0;
+            while (marked != 0) {
+                const auto k = unsigned(std::countr_zero(marked));
+                marked &= marked - 1;
+                const size_t x = base + k;
+                const uint32_t label = from[x];
+                const bool take = ((from_mask[x] & PYR_MASK_FILLABLE) != 0) & (label != 0);
+                row[x] = take ? label : row[x];
+                took |= uint64_t(take) << k;
+            }
+            if (took == 0) continue;
+            bits[i] &= ~took;
             any = true;
+            for (uint64_t t = took; t != 0; t &= t - 1) {
+                const size_t x = base + unsigned(std::countr_zero(t));
+                changed(x, row[x]);
+            }
         }
         return any;
     }
