@@ -23,6 +23,7 @@
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "support/cpu_targets.hpp"
 #include "support/oracle.hpp"
 
 namespace pyrseg::test {
@@ -47,43 +48,6 @@ std::vector<std::uint32_t> to_words(const std::vector<QuantPixel>& pixels) {
         ::pyrseg::cpu::store_quant(words.data() + kQuantWords * i, p.q[0], p.q[1], p.q[2], p.valid, p.z);
     }
     return words;
-}
-
-// PYRSEG_CPU_SIMD for the lifetime of the object (the executor reads it when a Segmenter is made).
-class ScopedSimd {
-public:
-    explicit ScopedSimd(const std::string& value) {
-        const char* old = std::getenv("PYRSEG_CPU_SIMD");
-        had_old_ = old != nullptr;
-        if (had_old_) old_ = old;
-        setenv("PYRSEG_CPU_SIMD", value.c_str(), 1);
-    }
-    ~ScopedSimd() {
-        if (had_old_) {
-            setenv("PYRSEG_CPU_SIMD", old_.c_str(), 1);
-        } else {
-            unsetenv("PYRSEG_CPU_SIMD");
-        }
-    }
-    ScopedSimd(const ScopedSimd&) = delete;
-    ScopedSimd& operator=(const ScopedSimd&) = delete;
-
-private:
-    bool had_old_ = false;
-    std::string old_;
-};
-
-std::vector<std::string> target_names() {
-    std::vector<std::string> names;
-    for (const simd::RowKernels* k : simd::available_targets()) names.emplace_back(k->name);
-    return names;
-}
-
-const simd::RowKernels& kernels_named(const std::string& name) {
-    for (const simd::RowKernels* k : simd::available_targets()) {
-        if (name == k->name) return *k;
-    }
-    throw std::runtime_error("no target " + name);
 }
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -632,7 +596,7 @@ std::vector<Frame> frames() {
 }
 
 Result segment_with(const std::string& mode, const Frame& f) {
-    const ScopedSimd env(mode);
+    const ScopedEnv env("PYRSEG_CPU_SIMD", mode);
     Segmenter segmenter(f.w, f.h, f.params, "cpu", everything());
     CloudView view;
     view.points = f.points.data();
@@ -684,7 +648,7 @@ TEST_P(CpuSimdFrames, StridedCloudsMatchTheReference) {
         const pyrseg_ref::Output ref = pyrseg_ref::segment(scene.points.data(), given ? scene.normals.data() : nullptr,
                                                            o.width, o.height, to_reference({}));
         ASSERT_TRUE(ref.ok);
-        const ScopedSimd env(GetParam());
+        const ScopedEnv env("PYRSEG_CPU_SIMD", GetParam());
         Segmenter segmenter(o.width, o.height, {}, "cpu", everything());
         CloudView view;
         view.points = l.floats.data();
@@ -712,7 +676,7 @@ TEST(CpuSimd, ListsTheScalarPathAndTheTargets) {
 }
 
 TEST(CpuSimd, AnUnknownTargetIsAnError) {
-    const ScopedSimd env("no_such_target");
+    const ScopedEnv env("PYRSEG_CPU_SIMD", "no_such_target");
     try {
         Segmenter segmenter(16, 16, {}, "cpu");
         FAIL() << "PYRSEG_CPU_SIMD=no_such_target was accepted";

@@ -15,6 +15,7 @@
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "support/cpu_targets.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -22,44 +23,6 @@ namespace {
 namespace simd = ::pyrseg::cpu::simd;
 namespace kernels = ::pyrseg::cpu::kernels;
 using ::pyrseg::cpu::PassContext;
-
-std::vector<std::string> target_names() {
-    std::vector<std::string> names;
-    for (const simd::RowKernels* k : simd::available_targets()) names.emplace_back(k->name);
-    return names;
-}
-
-const simd::RowKernels& kernels_named(const std::string& name) {
-    for (const simd::RowKernels* k : simd::available_targets()) {
-        if (name == k->name) return *k;
-    }
-    throw std::runtime_error("no target " + name);
-}
-
-// PYRSEG_CPU_SIMD (and optionally another variable) for the lifetime of the object.
-class ScopedEnv {
-public:
-    ScopedEnv(const char* name, const std::string& value) : name_(name) {
-        const char* old = std::getenv(name);
-        had_old_ = old != nullptr;
-        if (had_old_) old_ = old;
-        setenv(name, value.c_str(), 1);
-    }
-    ~ScopedEnv() {
-        if (had_old_) {
-            setenv(name_, old_.c_str(), 1);
-        } else {
-            unsetenv(name_);
-        }
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-private:
-    const char* name_;
-    bool had_old_ = false;
-    std::string old_;
-};
 
 const std::uint32_t kWidths[] = {1, 2, 3, 4, 5, 7, 8, 15, 16, 17, 31, 32, 33, 63, 64, 65, 66, 127, 129, 130, 257, 1000};
 

@@ -5,13 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "backends/cpu/simd/cpu_simd.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "support/cpu_targets.hpp"
 #include "support/oracle.hpp"
 
 namespace pyrseg {
@@ -19,36 +18,9 @@ namespace {
 
 using test::same_bytes;
 using test::same_segments;
+using test::ScopedEnv;
+using test::target_names;
 using test::to_reference;
-
-// An environment variable for the lifetime of the object (a Segmenter reads PYRSEG_THREADS and PYRSEG_CPU_SIMD
-// when it is made).
-class ScopedEnv {
-public:
-    ScopedEnv(const char* name, const std::string& value) : name_(name) {
-        if (const char* old = std::getenv(name)) old_ = old;
-        setenv(name, value.c_str(), 1);
-    }
-    ~ScopedEnv() {
-        if (old_) {
-            setenv(name_, old_->c_str(), 1);
-        } else {
-            unsetenv(name_);
-        }
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-private:
-    const char* name_;
-    std::optional<std::string> old_;
-};
-
-std::vector<std::string> target_names() {
-    std::vector<std::string> names;
-    for (const cpu::simd::RowKernels* k : cpu::simd::available_targets()) names.emplace_back(k->name);
-    return names;
-}
 
 struct Case {
     int width;
