@@ -31,10 +31,10 @@ using std::uint32_t;
 
 constexpr size_t kColumnBlock = 64;  // the narrowest strip of columns swept together, row by row
 
-// The largest level a fixed-point fill runs on: N-1, or N itself for the tiny-image fallback.
+// Union-find scratch for the largest level a fixed-point fill runs on: N-1, or N itself for the tiny-image fallback.
 size_t fill_scratch_size(const core::Plan& plan) {
     const PyrLevel& lv = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
-    return size_t(lv.width) * lv.height;
+    return union_find_scratch_size(lv.width, lv.height);
 }
 
 // PYRSEG_CPU_FILL=sweeps runs steps 2 and 4 as repeated row/column sweeps of the shared relaxation (the GPU
@@ -53,8 +53,7 @@ public:
           mask_(plan.total_texels),
           labels_(plan.total_texels),
           lut_(plan.lut_size()),
-          parent_(fill_scratch_size(plan)),
-          best_(fill_scratch_size(plan)),
+          fill_scratch_(fill_scratch_size(plan)),
           stats_(plan.stats_words()),
           simd_(simd::kernels_from_environment()),
           sweeps_(use_sweeps_for_fixed_points()) {}
@@ -315,7 +314,7 @@ public:
                 ++fill_rounds_;
             } while (sweep(lv, false));
         } else {
-            union_find_fill(pool_, lv, mask_.data(), labels_.data(), parent_.data(), best_.data());
+            union_find_fill(pool_, lv, mask_.data(), labels_.data(), anchor_max != 0, fill_scratch_.data());
         }
     }
 
@@ -386,6 +385,7 @@ public:
             std::fill(lut_.begin(), lut_.end(), 0u);
             rows(size_t(plan_.height), [&](size_t y) { mark_row(y); });
         }
+        lut_[0] = 0;  // mark_labels marks 0 as well
         uint32_t count = 0;
         for (uint32_t& entry : lut_) {
             if (entry != 0) entry = ++count;
@@ -417,19 +417,22 @@ public:
         uint32_t* labels = out.labels.data();
         const bool compacted = compacted_;
         const size_t width = size_t(plan_.width);
-        rows(size_t(plan_.height), [&](size_t y) {
-            uint32_t previous_raw = 0;  // labels come in runs: a run is looked up once
-            uint32_t previous = 0;
-            const uint32_t* in = raw + y * width;
-            uint32_t* to = labels + y * width;
-            for (size_t x = 0; x < width; ++x) {
-                if (in[x] != previous_raw) {
-                    previous_raw = in[x];
-                    previous = compacted ? kernels::pyr_compact_label(c, previous_raw) : previous_raw;
+        if (!compacted) {
+            std::copy_n(raw, pixels, labels);
+        } else {
+            // lut_[0] is 0 (compact): every pixel is one lookup.
+            const uint32_t* lut = c.lut;
+            const bool vector = simd_ != nullptr && lut_.size() <= (size_t{1} << 31);
+            rows(size_t(plan_.height), [&](size_t y) {
+                const uint32_t* in = raw + y * width;
+                uint32_t* to = labels + y * width;
+                if (vector) {
+                    simd_->compact_row(in, lut, uint32_t(width), to);
+                } else {
+                    for (size_t x = 0; x < width; ++x) to[x] = lut[in[x]];
                 }
-                to[x] = previous;
-            }
-        });
+            });
+        }
         if (outputs.raw_labels) {
             out.raw_labels.assign(raw, raw + pixels);
         } else {
@@ -489,11 +492,17 @@ private:
         mark_labels(labels_.data() + plan_.full().offset + y * size_t(plan_.width), plan_.width);
     }
 
+    // lut_[0] is set too: compact clears it. A label is stored once per run of it and only while unmarked: the
+    // other stores go to a local instead of a branch on it (which mispredicts on fragmented masks), and not to the
+    // table, whose lines would then move between the threads' caches for every label both of them see.
     void mark_labels(const uint32_t* row, size_t w) {
-        uint32_t previous = 0;  // labels come in runs: a run is marked once
+        uint32_t previous = 0;
+        uint32_t sink = 0;
         for (size_t x = 0; x < w; ++x) {
             const uint32_t l = row[x];
-            if (l != 0 && l != previous) std::atomic_ref<uint32_t>(lut_[l]).store(1u, std::memory_order_relaxed);
+            const bool unmarked = std::atomic_ref<uint32_t>(lut_[l]).load(std::memory_order_relaxed) == 0;
+            uint32_t* entry = l != previous && unmarked ? &lut_[l] : &sink;
+            std::atomic_ref<uint32_t>(*entry).store(1u, std::memory_order_relaxed);
             previous = l;
         }
     }
@@ -627,81 +636,10 @@ private:
     // over the rows runs step 5 with a vector kernel that also marks those pixels in a bitmap, and steps 6 a and the
     // downward sweep then touch only the marked pixels; the upward sweep visits the pixels still marked, bottom up.
 
-    // The first pixel at or after x whose bit is `set` (w when none).
-    static size_t next_bit(const uint64_t* bits, size_t x, size_t w, bool set) {
-        if (x >= w) return w;
-        const uint64_t flip = set ? 0 : ~uint64_t{0};
-        size_t i = x / 64;
-        uint64_t word = (bits[i] ^ flip) & (~uint64_t{0} << (x % 64));
-        const size_t words = (w + 63) / 64;
-        while (word == 0) {
-            if (++i == words) return w;
-            word = bits[i] ^ flip;
-        }
-        return std::min(w, i * 64 + size_t(std::countr_zero(word)));
-    }
-
-    static void clear_bits(uint64_t* bits, size_t x0, size_t x1) {
-        for (size_t x = x0; x < x1;) {
-            const size_t end = std::min(x1, (x / 64 + 1) * 64);
-            const size_t n = end - x;
-            const uint64_t span = n == 64 ? ~uint64_t{0} : ((uint64_t{1} << n) - 1) << (x % 64);
-            bits[x / 64] &= ~span;
-            x = end;
-        }
-    }
-
-    // Step 6a on a row whose unlabelled fillable pixels are marked: each run of them, there and back.
-    static void fill_row_runs(const std::uint8_t* mask, uint32_t* row, uint64_t* bits, size_t w) {
-        for (size_t x = next_bit(bits, 0, w, true); x < w; x = next_bit(bits, x, w, true)) {
-            const size_t end = next_bit(bits, x, w, false);
-            uint32_t label = 0;  // a fillable pixel next to the run is not in it, so it is labelled
-            if (x > 0 && (mask[x - 1] & PYR_MASK_FILLABLE) != 0) {
-                label = row[x - 1];
-            } else if (end < w && (mask[end] & PYR_MASK_FILLABLE) != 0) {
-                label = row[end];
-            }
-            if (label != 0) {
-                std::fill(row + x, row + end, label);
-                clear_bits(bits, x, end);
-            }
-            x = end;
-        }
-    }
-
-    // One step of a column sweep on the marked pixels of a row, from the row before it in the sweep (pyr_fill_once:
-    // an unlabelled fillable pixel takes the label of a fillable neighbour, maybe 0). changed(x, label) is called
-    // for each pixel labelled. Returns whether one was.
-    template <class Changed>
-    static bool column_step_marked(uint32_t* row, uint64_t* bits, const std::uint8_t* from_mask, const uint32_t* from,
-                                   size_t w, const Changed& changed) {
-        // Word by word, bit by bit without branching on the pixels (whether a marked pixel takes its neighbour's
-        // label is as good as random: a branch on it mispredicts), then the callback for the pixels that did.
-        bool any = false;
-        const size_t words = (w + 63) / 64;
-        for (size_t i = 0; i < words; ++i) {
-            uint64_t marked = bits[i];
-            if (marked == 0) continue;
-            const size_t base = i * 64;
-            uint64_t took = 0;
-            while (marked != 0) {
-                const auto k = unsigned(std::countr_zero(marked));
-                marked &= marked - 1;
-                const size_t x = base + k;
-                const uint32_t label = from[x];
-                const bool take = ((from_mask[x] & PYR_MASK_FILLABLE) != 0) & (label != 0);
-                row[x] = take ? label : row[x];
-                took |= uint64_t(take) << k;
-            }
-            if (took == 0) continue;
-            bits[i] &= ~took;
-            any = true;
-            for (uint64_t t = took; t != 0; t &= t - 1) {
-                const size_t x = base + unsigned(std::countr_zero(t));
-                changed(x, row[x]);
-            }
-        }
-        return any;
+    [[nodiscard]] static bool any_bits(const uint64_t* bits, size_t words) {
+        uint64_t any = 0;
+        for (size_t i = 0; i < words; ++i) any |= bits[i];
+        return any != 0;
     }
 
     // Row y's validity bytes: the mask's own, else from the quantized pixels into scratch.
@@ -728,6 +666,7 @@ private:
         const size_t h = lv.height;
         const size_t words = (w + 63) / 64;
         if (unlabelled_.size() < h * words) unlabelled_.resize(h * words);  // once per Segmenter
+        if (pending_.size() < h) pending_.resize(h);
         // Bands of rows run in parallel; the column sweeps cross their borders afterwards, in order.
         const size_t bands = std::min(h, size_t(pool_.size()) * 2);
         if (edges && c.mask_valid == nullptr && valid_scratch_.size() < bands * w) valid_scratch_.resize(bands * w);
@@ -735,6 +674,15 @@ private:
         const auto row_of = [&](size_t y) { return c.labels + lv.offset + y * w; };
         const auto mask_of = [&](size_t y) { return c.mask + lv.offset + y * w; };
         const auto bits_of = [&](size_t y) { return unlabelled_.data() + y * words; };
+        // One column step of row y from row `from` (y - 1 down, y + 1 up).
+        const auto step = [&](size_t y, size_t from) {
+            return simd_->column_step(mask_of(from), row_of(from), row_of(y), bits_of(y), uint32_t(w));
+        };
+        // A row is pending when marked pixels remain in it after the band pass: only those can change later, so the
+        // edges next to them wait for the end, and the others' edges are final during the band pass.
+        const auto settled = [&](size_t y) {
+            return ((pending_[y] | (y > 0 ? pending_[y - 1] : 0) | (y + 1 < h ? pending_[y + 1] : 0)) & kPending) == 0;
+        };
         pool_.parallel_for(bands, 1, [&](size_t b0, size_t b1) {
             for (size_t b = b0; b < b1; ++b) {
                 const size_t y0 = band_begin(b);
@@ -743,48 +691,57 @@ private:
                 for (size_t y = y0; y < y1; ++y) {
                     uint32_t* row = row_of(y);
                     const std::uint8_t* m = mask_of(y);
-                    if (simd_->inherit_row(m, c.labels + parent.offset + (y >> 1) * parent.width, uint32_t(w), row,
-                                           bits_of(y))) {
-                        fill_row_runs(m, row, bits_of(y), w);
-                        if (y > y0)
-                            column_step_marked(row, bits_of(y), mask_of(y - 1), row_of(y - 1), w,
-                                               [](size_t, uint32_t) {});
+                    bool marks = simd_->inherit_row(m, c.labels + parent.offset + (y >> 1) * parent.width, uint32_t(w),
+                                                    row, bits_of(y));
+                    if (marks) marks = simd_->row_runs(m, row, bits_of(y), uint32_t(w));
+                    if (marks && y > y0) {
+                        simd_->column_step(mask_of(y - 1), row_of(y - 1), row, bits_of(y), uint32_t(w));
+                        marks = any_bits(bits_of(y), words);
                     }
-                    // Edges read rows y - 2 .. y: all of this band's, and each only ever gains labels later.
-                    if (edges && y >= y0 + 2) edge_row(c, lv, y - 1, scratch);
+                    pending_[y] = marks ? kPending : 0;
+                    // Edges read rows y - 2 .. y: all of this band's.
+                    if (edges && y >= y0 + 2 && settled(y - 1)) edge_row(c, lv, y - 1, scratch);
                 }
             }
         });
-        // What a pixel labels from here on reaches the edge pixels next to it: their minimum is taken again.
-        const auto reach_edges = [&](size_t x, size_t y, uint32_t label) {
-            if (!edges) return;
-            const auto touch = [&](size_t p) {
-                const size_t i = lv.offset + p;
-                if ((c.mask[i] & PYR_MASK_FILLABLE) != 0) return;
-                const bool valid =
-                    c.mask_valid != nullptr ? c.mask_valid[p] != 0 : (c.quant[kQuantWords * p + 1] >> 16) != 0;
-                if (valid && (c.labels[i] == 0 || label < c.labels[i])) c.labels[i] = label;
-            };
-            const size_t p = y * w + x;
-            if (x > 0) touch(p - 1);
-            if (x + 1 < w) touch(p + 1);
-            if (y > 0) touch(p - w);
-            if (y + 1 < h) touch(p + w);
-        };
         // The downward sweep across each band's top, down as far as it changes something.
         for (size_t b = 1; b < bands; ++b) {
-            for (size_t y = band_begin(b); y < h; ++y) {
-                const bool changed = column_step_marked(row_of(y), bits_of(y), mask_of(y - 1), row_of(y - 1), w,
-                                                        [&](size_t x, uint32_t l) { reach_edges(x, y, l); });
-                if (!changed) break;
+            for (size_t y = band_begin(b); y < h && step(y, y - 1); ++y) {
             }
         }
-        // The upward sweep: only marked pixels can change.
-        for (size_t y = h - 1; y-- > 0;) {
-            column_step_marked(row_of(y), bits_of(y), mask_of(y + 1), row_of(y + 1), w,
-                               [&](size_t x, uint32_t l) { reach_edges(x, y, l); });
+        // The upward sweep: inside each band in parallel (each band's last row aside), then across the bands' bottoms
+        // from the last band up, each as far as it changes something. A row stepped again from a row that gained
+        // labels meanwhile ends as one step from that row's final labels would leave it: labels only ever appear.
+        // The edges the band pass left wait for the first part: after it only the rows the crossings reach change.
+        pool_.parallel_for(bands, 1, [&](size_t b0, size_t b1) {
+            for (size_t b = b0; b < b1; ++b) {
+                const size_t y0 = band_begin(b);
+                const size_t y1 = band_begin(b + 1);
+                std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data() + b * w;
+                for (size_t y = y1 - 1; y-- > y0;) {
+                    if (pending_[y] != 0) step(y, y + 1);
+                    if (edges && y + 2 < y1 && !settled(y + 1)) edge_row(c, lv, y + 1, scratch);
+                }
+            }
+        });
+        for (size_t b = bands; b-- > 1;) {
+            for (size_t y = band_begin(b); y-- > 0 && step(y, y + 1);) pending_[y] |= kLate;
         }
         if (!edges) return;
+        // Edges again next to the rows the upward crossings changed, in parallel inside each band, then the bands'
+        // first and last rows, which read their neighbour bands' rows. edge_row takes the minimum again: a row done
+        // twice comes out the same.
+        const auto late = [&](size_t y) {
+            return ((pending_[y] | (y > 0 ? pending_[y - 1] : 0) | (y + 1 < h ? pending_[y + 1] : 0)) & kLate) != 0;
+        };
+        pool_.parallel_for(bands, 1, [&](size_t b0, size_t b1) {
+            for (size_t b = b0; b < b1; ++b) {
+                std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data() + b * w;
+                for (size_t y = band_begin(b) + 1; y + 1 < band_begin(b + 1); ++y) {
+                    if (late(y)) edge_row(c, lv, y, scratch);
+                }
+            }
+        });
         std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data();
         for (size_t b = 0; b < bands; ++b) {
             edge_row(c, lv, band_begin(b), scratch);
@@ -809,12 +766,17 @@ private:
     std::vector<std::uint8_t> mask_;        // all levels
     std::vector<uint32_t> labels_;          // all levels
     std::vector<uint32_t> lut_;             // raw label -> compacted label
-    std::vector<uint32_t> parent_;          // union-find scratch
-    std::vector<uint32_t> best_;
+    // Union-find scratch (union_find_scratch_size).
+    std::vector<uint32_t> fill_scratch_;
     std::vector<std::uint64_t> unlabelled_;    // final_fill_rows: the pixels step 6 can change, a bit each
     std::vector<std::uint8_t> valid_scratch_;  // final_fill_rows: validity rows, when they are in the quant words
-    bool edges_fused_ = false;                 // final_fill_rows labelled the edges too
-    std::vector<uint32_t> stats_;              // per-segment statistics words, when asked for
+    // final_fill_rows, per row: kPending when marked pixels remain after the band pass, kLate when the upward
+    // crossing changed it.
+    std::vector<std::uint8_t> pending_;
+    static constexpr std::uint8_t kPending = 1;
+    static constexpr std::uint8_t kLate = 2;
+    bool edges_fused_ = false;     // final_fill_rows labelled the edges too
+    std::vector<uint32_t> stats_;  // per-segment statistics words, when asked for
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::RowKernels* simd_;
@@ -839,7 +801,7 @@ size_t memory_needed(const core::Plan& plan) {
     return pixels * (kQuantWords * sizeof(uint32_t) + 1 + 3 * sizeof(float)) +             // quant, validity, normals
            size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +         // masks, labels
            (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                               // compaction table
-           2 * fill_scratch_size(plan) * sizeof(uint32_t) +                                // union-find
+           fill_scratch_size(plan) * sizeof(uint32_t) +                                    // union-find
            plan.stats_words() * sizeof(uint32_t) +                                         // statistics
            (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0) +  // robust normals' texels
            (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0);             // edge rounds' labels

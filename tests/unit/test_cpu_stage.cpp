@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <deque>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,8 @@
 
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
+#include "backends/cpu/thread_pool.hpp"
+#include "backends/cpu/union_find_fill.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "support/cpu_targets.hpp"
 
@@ -68,6 +71,122 @@ TEST_P(CpuStageRows, InheritRowMatchesTheSharedFunction) {
             }
             EXPECT_EQ(bits.back(), 0xffffffffffffffffu) << "a word past the row was written, width " << w;
             EXPECT_EQ(any, expected_any) << "width " << w;
+        }
+    }
+}
+
+// column_step against pyr_fill_step (once) pixel by pixel on the marked pixels: marks anywhere in the words (whole
+// words, single bits, none), neighbours fillable or not, labelled or not; the marks of the pixels that took a label
+// are cleared and no word past the row is touched.
+TEST_P(CpuStageRows, ColumnStepMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(23);
+    for (const std::uint32_t w : kWidths) {
+        for (int trial = 0; trial < 8; ++trial) {
+            const std::size_t words = (w + 63) / 64;
+            std::vector<std::uint8_t> from_mask(w);
+            std::vector<std::uint32_t> from(w);
+            std::vector<std::uint32_t> row(w);
+            std::vector<std::uint64_t> marked(words + 1, 0);
+            marked.back() = 0x0123456789abcdefu;
+            for (std::uint32_t x = 0; x < w; ++x) {
+                from_mask[x] = std::uint8_t(rng() % 256);
+                from[x] = rng() % 3 == 0 ? 0u : std::uint32_t(rng() % 100000 + 1);
+                const bool mark = trial == 0 || (trial != 1 && rng() % std::uint32_t(trial) == 0);
+                row[x] = mark ? 0u : std::uint32_t(rng() % 100000 + 1);
+                if (mark) marked[x / 64] |= std::uint64_t{1} << (x % 64);
+            }
+            std::vector<std::uint32_t> expected = row;
+            std::vector<std::uint64_t> expected_marks = marked;
+            bool expected_took = false;
+            for (std::uint32_t x = 0; x < w; ++x) {
+                if (((marked[x / 64] >> (x % 64)) & 1u) == 0) continue;
+                expected[x] = kernels::pyr_fill_step(row[x], PYR_MASK_FILLABLE, from[x], from_mask[x], 1u);
+                if (expected[x] != 0) {
+                    expected_marks[x / 64] &= ~(std::uint64_t{1} << (x % 64));
+                    expected_took = true;
+                }
+            }
+            const bool took = k.column_step(from_mask.data(), from.data(), row.data(), marked.data(), w);
+            ASSERT_EQ(row, expected) << "width " << w << " trial " << trial;
+            ASSERT_EQ(marked, expected_marks) << "width " << w << " trial " << trial;
+            EXPECT_EQ(took, expected_took) << "width " << w << " trial " << trial;
+        }
+    }
+}
+
+// row_runs against the contract's step 6a written out (docs/algorithm.md section 5: left to right, then right to
+// left, an unlabelled fillable pixel takes the label of a fillable, labelled neighbour, visible to the next pixel),
+// on rows marked as inherit_row leaves them: runs of every length, across words, at the row's ends, whole rows.
+TEST_P(CpuStageRows, RowRunsMatchTheContractsRowSweeps) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(31);
+    for (const std::uint32_t w : kWidths) {
+        for (int trial = 0; trial < 10; ++trial) {
+            std::vector<std::uint8_t> mask(w);
+            std::vector<std::uint32_t> row(w);
+            for (std::uint32_t x = 0; x < w; ++x) {
+                const std::uint32_t hole_odds = trial < 3 ? 2u : std::uint32_t(trial);
+                const bool fillable = trial >= 8 || rng() % 4 != 0;  // 8, 9: runs across words, whole rows
+                mask[x] = std::uint8_t((fillable ? PYR_MASK_FILLABLE : 0) | (rng() % 2 << 1));
+                const bool hole = trial == 9 || (trial == 8 ? rng() % 150 != 0 : rng() % hole_odds == 0);
+                row[x] = hole ? 0u : std::uint32_t(rng() % 100000 + 1);
+                if ((mask[x] & PYR_MASK_FILLABLE) == 0) row[x] = rng() % 2 == 0 ? 0u : 7u;  // not read
+            }
+            const auto marks_of = [&](const std::vector<std::uint32_t>& labels) {
+                std::vector<std::uint64_t> bits((w + 63) / 64 + 1, 0);
+                for (std::uint32_t x = 0; x < w; ++x) {
+                    if ((mask[x] & PYR_MASK_FILLABLE) != 0 && labels[x] == 0)
+                        bits[x / 64] |= std::uint64_t{1} << (x % 64);
+                }
+                return bits;
+            };
+            std::vector<std::uint32_t> expected = row;
+            const auto labelled_fillable = [&](std::uint32_t x) {
+                return (mask[x] & PYR_MASK_FILLABLE) != 0 && expected[x] != 0;
+            };
+            for (std::uint32_t x = 1; x < w; ++x) {
+                if ((mask[x] & PYR_MASK_FILLABLE) != 0 && expected[x] == 0 && labelled_fillable(x - 1))
+                    expected[x] = expected[x - 1];
+            }
+            for (std::uint32_t x = w; x-- > 1;) {
+                if ((mask[x - 1] & PYR_MASK_FILLABLE) != 0 && expected[x - 1] == 0 && labelled_fillable(x))
+                    expected[x - 1] = expected[x];
+            }
+            std::vector<std::uint64_t> marked = marks_of(row);
+            marked.back() = 0x0123456789abcdefu;
+            std::vector<std::uint64_t> expected_marks = marks_of(expected);
+            expected_marks.back() = marked.back();
+            bool expected_remain = false;
+            for (std::size_t i = 0; i + 1 < expected_marks.size(); ++i) expected_remain |= expected_marks[i] != 0;
+            const bool remain = k.row_runs(mask.data(), row.data(), marked.data(), w);
+            ASSERT_EQ(row, expected) << "width " << w << " trial " << trial;
+            ASSERT_EQ(marked, expected_marks) << "width " << w << " trial " << trial;
+            EXPECT_EQ(remain, expected_remain) << "width " << w << " trial " << trial;
+        }
+    }
+}
+
+// compact_row against the table lookup: long runs of one label (many vectors' worth), short ones, zeros inside runs,
+// a new label at every pixel.
+TEST_P(CpuStageRows, CompactRowMatchesTheTable) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(29);
+    std::vector<std::uint32_t> lut(4096);
+    for (std::size_t i = 1; i < lut.size(); ++i) lut[i] = std::uint32_t(rng());
+    lut[0] = 0;
+    for (const std::uint32_t w : kWidths) {
+        for (int trial = 0; trial < 4; ++trial) {
+            std::vector<std::uint32_t> raw(w);
+            std::uint32_t label = 0;
+            for (std::uint32_t x = 0; x < w; ++x) {
+                if (trial == 3 || rng() % std::uint32_t(trial == 0 ? 40 : 3) == 0) label = rng() % 4096;
+                raw[x] = trial == 2 && x % 5 == 0 ? 0u : label;
+            }
+            std::vector<std::uint32_t> out(w + 1, 0xabababab);
+            k.compact_row(raw.data(), lut.data(), w, out.data());
+            for (std::uint32_t x = 0; x < w; ++x) ASSERT_EQ(out[x], lut[raw[x]]) << "width " << w << " x " << x;
+            EXPECT_EQ(out[w], 0xababababu) << "written past the row, width " << w;
         }
     }
 }
@@ -248,6 +367,102 @@ TEST(CpuStageFill, UnionFindMatchesTheSweeps) {
             ASSERT_EQ(uf.raw_labels, sweeps.raw_labels);
         }
     }
+}
+
+// The contract of steps 2 and 4 by flood fill: each 4-connected component of fillable, non-anchored texels takes the
+// smallest non-zero label inside it or on an anchored texel next to it (0 when there is none).
+std::vector<std::uint32_t> flood_fill_reference(std::uint32_t w, std::uint32_t h, const std::uint8_t* mask,
+                                                const std::uint32_t* labels) {
+    const auto eligible = [&](std::size_t i) {
+        return (mask[i] & (PYR_MASK_FILLABLE | PYR_MASK_ANCHORED)) == PYR_MASK_FILLABLE;
+    };
+    const std::size_t n = std::size_t(w) * h;
+    std::vector<std::uint32_t> out(labels, labels + n);
+    std::vector<char> seen(n, 0);
+    std::vector<std::size_t> component;
+    for (std::size_t start = 0; start < n; ++start) {
+        if (seen[start] != 0 || !eligible(start)) continue;
+        component.clear();
+        std::deque<std::size_t> queue{start};
+        seen[start] = 1;
+        std::uint32_t best = 0;
+        const auto take = [&](std::uint32_t label) {
+            if (label != 0 && (best == 0 || label < best)) best = label;
+        };
+        while (!queue.empty()) {
+            const std::size_t i = queue.front();
+            queue.pop_front();
+            component.push_back(i);
+            take(labels[i]);
+            const std::uint32_t x = std::uint32_t(i % w);
+            const std::uint32_t y = std::uint32_t(i / w);
+            const std::size_t next[4] = {x > 0 ? i - 1 : i, x + 1 < w ? i + 1 : i, y > 0 ? i - w : i,
+                                         y + 1 < h ? i + w : i};
+            for (const std::size_t j : next) {
+                if (j == i) continue;
+                if ((mask[j] & PYR_MASK_ANCHORED) != 0) take(labels[j]);
+                if (seen[j] == 0 && eligible(j)) {
+                    seen[j] = 1;
+                    queue.push_back(j);
+                }
+            }
+        }
+        for (const std::size_t i : component) out[i] = best;
+    }
+    return out;
+}
+
+// union_find_fill against the flood fill on noise (many short runs, so every row's run lists interleave and the
+// merge walks and the stripes' border joins see every kind of overlap), with anchored texels, at sizes that cut
+// the bit words and the stripes anywhere, with 1, 2 and 3 threads.
+TEST(CpuStageFill, UnionFindMatchesAFloodFillOnNoise) {
+    const std::uint32_t sizes[][2] = {{1, 1},   {1, 97},  {97, 1},   {2, 2},     {3, 50},   {63, 17},   {64, 31},
+                                      {65, 40}, {127, 9}, {129, 64}, {200, 150}, {4100, 6}, {5000, 23}, {7, 900}};
+    std::mt19937 rng(1234);
+    std::uint64_t texels = 0;
+    for (const unsigned threads : {1u, 2u, 3u}) {
+        ::pyrseg::cpu::ThreadPool pool(threads);
+        for (const auto& size : sizes) {
+            const std::uint32_t w = size[0];
+            const std::uint32_t h = size[1];
+            const std::size_t n = std::size_t(w) * h;
+            for (int trial = 0; trial < 6; ++trial) {
+                const bool anchors = trial % 2 == 1;
+                const std::uint32_t eligible_percent = trial < 2 ? 55 : (trial < 4 ? 70 : 90);
+                const std::uint32_t label_range = trial < 4 ? 20 : 1000000;
+                // The level lies at an offset of a larger buffer, as the pyramid's levels do.
+                const std::uint32_t offset = 5;
+                std::vector<std::uint8_t> mask(offset + n + 3, 0xff);
+                std::vector<std::uint32_t> labels(offset + n + 3, 0xdeadbeef);
+                for (std::size_t i = offset; i < offset + n; ++i) {
+                    const std::uint32_t roll = rng() % 100;
+                    // Bits 2..7 are the edge rounds' and must not matter.
+                    std::uint8_t m = std::uint8_t(rng() % 64 << 2);
+                    if (roll < eligible_percent) {
+                        m |= PYR_MASK_FILLABLE;
+                    } else if (anchors && roll < eligible_percent + 5) {
+                        m |= PYR_MASK_FILLABLE | PYR_MASK_ANCHORED;
+                    }
+                    mask[i] = m;
+                    labels[i] = rng() % 3 == 0 ? 0u : 1u + rng() % label_range;
+                }
+                const std::vector<std::uint32_t> expected =
+                    flood_fill_reference(w, h, mask.data() + offset, labels.data() + offset);
+                // Scratch from a larger level and full of garbage: the fill must not rely on either.
+                std::vector<std::uint32_t> scratch(::pyrseg::cpu::union_find_scratch_size(w + 1, h + 1), 0xabababab);
+                ::pyrseg::cpu::union_find_fill(pool, PyrLevel{w, h, offset}, mask.data(), labels.data(), anchors,
+                                               scratch.data());
+                for (std::size_t i = 0; i < n; ++i) {
+                    ASSERT_EQ(labels[offset + i], expected[i])
+                        << w << "x" << h << " trial " << trial << " threads " << threads << " texel " << i;
+                }
+                for (std::uint32_t i = 0; i < offset; ++i) ASSERT_EQ(labels[i], 0xdeadbeef);
+                for (std::size_t i = offset + n; i < labels.size(); ++i) ASSERT_EQ(labels[i], 0xdeadbeef);
+                texels += n;
+            }
+        }
+    }
+    EXPECT_GT(texels, 1000000u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, CpuStageFrames, ::testing::ValuesIn(simd::accepted_names()),

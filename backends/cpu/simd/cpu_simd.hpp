@@ -67,6 +67,21 @@ struct RowKernels {
     // from `samples`, with the row's ku[0..w-1] and kv; 3 * w floats out, packed.
     void (*depth_row)(const void* samples, std::uint32_t format, std::uint32_t w, float scale, const float* ku,
                       float kv, float* out) = nullptr;
+    // One step of step 6b's column sweeps on a row of the full level: each pixel marked in `marked` ((w + 63) / 64
+    // words, bit x % 64 of word x / 64; the pixels step 6 can still change) takes the label of pixel x of the row
+    // the sweep comes from (`from`, its mask `from_mask`) when that pixel is fillable and labelled, and its mark is
+    // cleared; other pixels keep theirs. Returns whether a pixel took a label.
+    bool (*column_step)(const std::uint8_t* from_mask, const std::uint32_t* from, std::uint32_t* row,
+                        std::uint64_t* marked, std::uint32_t w) = nullptr;
+    // Compaction's lookup over a row: out[x] = lut[raw[x]] for x < w. lut[0] must be 0, and every raw label below
+    // 2^31 (the vector targets index the table with signed 32-bit lanes).
+    void (*compact_row)(const std::uint32_t* raw, const std::uint32_t* lut, std::uint32_t w,
+                        std::uint32_t* out) = nullptr;
+    // Step 6a on a row of the full level whose pixels step 6 can change are marked (as inherit_row leaves them; bits
+    // past w clear): each run of marked pixels takes the label of the pixel left of it when that one is fillable
+    // (so labelled), else of the one right of it, and its marks are cleared; else it stays as it is. That is the
+    // contract's sweep there and back along the row. Returns whether marks remain.
+    bool (*row_runs)(const std::uint8_t* mask, std::uint32_t* row, std::uint64_t* marked, std::uint32_t w) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
