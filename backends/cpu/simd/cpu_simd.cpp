@@ -742,23 +742,32 @@ void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const st
         return hn::Or(hn::Sub(hn::LoadU(du, l), one), not_fillable);
     };
     std::size_t x = 1;
-    // Pixels 1 .. w - 2 by vectors of bytes; a vector with no valid non-fillable pixel (most of a frame) is skipped.
-    if (n8 % n == 0) {
+    // Pixels 1 .. w - 2 by vectors of bytes; a vector with no valid non-fillable pixel (most of a frame) is skipped,
+    // and so is each part of one, as wide as a vector of labels, that has none (on fragmented masks most vectors of
+    // bytes have one, few parts do).
+    if (n8 % n == 0 && n8 <= 64) {
         const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
+        const std::uint64_t part = n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
         for (; x + n8 + 1 <= w; x += n8) {
             const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
             const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
-            if (hn::AllFalse(d8, hn::AndNot(invalid, not_fillable))) continue;
-            for (std::size_t s = x; s < x + n8; s += n) {
+            const auto edge = hn::AndNot(invalid, not_fillable);
+            if (hn::AllFalse(d8, edge)) continue;
+            std::uint8_t bytes[8] = {};
+            hn::StoreMaskBits(d8, edge, bytes);
+            std::uint64_t edges = 0;
+            std::memcpy(&edges, bytes, sizeof edges);
+            for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
+                const std::uint64_t bits = edges & part;
+                if (bits == 0) continue;
+                std::uint8_t lane_bytes[8] = {};
+                std::memcpy(lane_bytes, &bits, sizeof bits);  // lanes are little-endian bits on every target
                 const VU own = hn::LoadU(du, labels + s);
                 VU best = hn::Min(hn::Sub(own, one), hn::Min(candidate(labels + s - 1, mask + s - 1),
                                                              candidate(labels + s + 1, mask + s + 1)));
                 if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
                 if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
-                const VU m = hn::PromoteTo(du, hn::LoadU(d8q, mask + s));
-                const VU v = hn::PromoteTo(du, hn::LoadU(d8q, valid + s));
-                const auto is_edge = hn::AndNot(hn::Eq(v, hn::Zero(du)), hn::Eq(hn::And(m, one), hn::Zero(du)));
-                hn::StoreU(hn::IfThenElse(is_edge, hn::Add(best, one), own), du, labels + s);
+                hn::StoreU(hn::IfThenElse(hn::LoadMaskBits(du, lane_bytes), hn::Add(best, one), own), du, labels + s);
             }
         }
     }
