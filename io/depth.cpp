@@ -110,23 +110,28 @@ void write_tiff_float(const std::filesystem::path& path, const float* depth, int
     }
     TIFFSetErrorHandler(nullptr);
     TIFFSetWarningHandler(nullptr);
-    const std::unique_ptr<TIFF, TiffCloser> tiff(TIFFOpen(path.c_str(), "w"));
-    if (!tiff) fail(ErrorCode::io, path, "cannot open for writing");
-    TIFFSetField(tiff.get(), TIFFTAG_IMAGEWIDTH, std::uint32_t(width));
-    TIFFSetField(tiff.get(), TIFFTAG_IMAGELENGTH, std::uint32_t(height));
-    TIFFSetField(tiff.get(), TIFFTAG_SAMPLESPERPIXEL, std::uint16_t(1));
-    TIFFSetField(tiff.get(), TIFFTAG_BITSPERSAMPLE, std::uint16_t(32));
-    TIFFSetField(tiff.get(), TIFFTAG_SAMPLEFORMAT, std::uint16_t(SAMPLEFORMAT_IEEEFP));
-    TIFFSetField(tiff.get(), TIFFTAG_PHOTOMETRIC, std::uint16_t(PHOTOMETRIC_MINISBLACK));
-    TIFFSetField(tiff.get(), TIFFTAG_PLANARCONFIG, std::uint16_t(PLANARCONFIG_CONTIG));
-    TIFFSetField(tiff.get(), TIFFTAG_ROWSPERSTRIP, std::uint32_t(1));
-    std::vector<float> row(static_cast<std::size_t>(width));
-    for (int y = 0; y < height; ++y) {
-        std::memcpy(row.data(), depth + std::size_t(y) * std::size_t(width), row.size() * sizeof(float));
-        if (TIFFWriteScanline(tiff.get(), row.data(), std::uint32_t(y), 0) != 1) {
-            fail(ErrorCode::io, path, "writing row " + std::to_string(y) + " failed");
+    // Into a temporary file renamed over `path` once complete: a failure leaves the old file or none.
+    detail::write_atomically(path, [&](const std::filesystem::path& temporary) {
+        const std::unique_ptr<TIFF, TiffCloser> tiff(TIFFOpen(temporary.c_str(), "w"));
+        if (!tiff) fail(ErrorCode::io, path, "cannot open for writing");
+        TIFFSetField(tiff.get(), TIFFTAG_IMAGEWIDTH, std::uint32_t(width));
+        TIFFSetField(tiff.get(), TIFFTAG_IMAGELENGTH, std::uint32_t(height));
+        TIFFSetField(tiff.get(), TIFFTAG_SAMPLESPERPIXEL, std::uint16_t(1));
+        TIFFSetField(tiff.get(), TIFFTAG_BITSPERSAMPLE, std::uint16_t(32));
+        TIFFSetField(tiff.get(), TIFFTAG_SAMPLEFORMAT, std::uint16_t(SAMPLEFORMAT_IEEEFP));
+        TIFFSetField(tiff.get(), TIFFTAG_PHOTOMETRIC, std::uint16_t(PHOTOMETRIC_MINISBLACK));
+        TIFFSetField(tiff.get(), TIFFTAG_PLANARCONFIG, std::uint16_t(PLANARCONFIG_CONTIG));
+        TIFFSetField(tiff.get(), TIFFTAG_ROWSPERSTRIP, std::uint32_t(1));
+        std::vector<float> row(static_cast<std::size_t>(width));
+        for (int y = 0; y < height; ++y) {
+            std::memcpy(row.data(), depth + std::size_t(y) * std::size_t(width), row.size() * sizeof(float));
+            if (TIFFWriteScanline(tiff.get(), row.data(), std::uint32_t(y), 0) != 1) {
+                fail(ErrorCode::io, path, "writing row " + std::to_string(y) + " failed");
+            }
         }
-    }
+        // TIFFClose reports nothing: the directory and the buffered rows are written here, where a failure shows.
+        if (TIFFFlush(tiff.get()) != 1) fail(ErrorCode::io, path, "writing the image failed");
+    });
 }
 
 PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit) {
