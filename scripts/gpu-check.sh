@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # One command verifies every GPU backend on a GPU machine. GPU time is rare and short, so everything is built
-# beforehand, on a machine without a GPU, into a self-contained folder that travels with the checkout:
+# beforehand, on a machine without a GPU, into a self-contained folder that travels with the checkout (all but the
+# Python module, which is compiled there for that machine's Python, against shared libraries built here):
 #
-#   scripts/gpu-check.sh prepare            here: builds build/gpu/ (binaries, the .so files they need, test data)
+#   scripts/gpu-check.sh prepare            here: builds build/gpu/ (binaries, the .so files they need, pyrseg's
+#                                           shared libraries and headers for the Python module, test data)
 #   scripts/gpu-check.sh run [REPORT_DIR]   there: versions, conformance, the CUDA interop (device pointers on an
-#                                           application's stream, graph capture), compute-sanitizer, bench, CuPy's
-#                                           label, Vulkan and OpenCL on the NVIDIA driver; summary.md and logs in
-#                                           REPORT_DIR ($PYRSEG_GPU_REPORT, default build/gpu-report/)
+#                                           application's stream, graph capture), the Python module (CuPy arrays),
+#                                           compute-sanitizer, bench, CuPy's label, Vulkan and OpenCL on the NVIDIA
+#                                           driver; summary.md and logs in REPORT_DIR ($PYRSEG_GPU_REPORT, default
+#                                           build/gpu-report/)
 #   scripts/gpu-check.sh run --rehearse [REPORT_DIR]
 #                                           the same steps with the cpu backend standing in for the GPU ones, to
 #                                           test this script where there is no GPU; it checks nothing about GPUs
@@ -31,12 +34,18 @@ say() { printf 'gpu-check: %s\n' "$*"; }
 die() { printf 'gpu-check: %s\n' "$1" >&2; exit "${2:-1}"; }
 
 usage() {
-  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
 }
 
 # The newest glibc symbol version any of the given ELF files asks for (e.g. 2.34).
 glibc_needed() {
   objdump -T "$@" 2>/dev/null | grep -o 'GLIBC_[0-9][0-9.]*' | sed 's/GLIBC_//' | sort -V | tail -n 1
+}
+
+# The backends a configure log says are built, on one line (e.g. "cpu cuda vulkan opencl").
+built_backends() {
+  grep -E '^-- pyrseg backend' <<<"$1" | grep -o 'backend [a-z]*: built' |
+    awk '{printf "%s%s", sep, substr($2, 1, length($2) - 1); sep=" "}'
 }
 
 prepare() {
@@ -51,6 +60,16 @@ prepare() {
   grep -E "^-- pyrseg" <<<"$log" || true
   (cd "$root" && cmake --build --preset gpu-check)
   (cd "$root" && cmake --build --preset gpu-check --target "${extra_targets[@]}")
+  # The same configuration as shared libraries (cpu and cuda backends only), for the Python module that `run` builds
+  # there with that machine's Python and pybind11 (scripts/gpu_check/python/CMakeLists.txt).
+  local shared="$root/build/gpu-shared" shared_log
+  if ! shared_log=$(cd "$root" && cmake --preset gpu-check-shared 2>&1); then
+    echo "$shared_log"
+    die "configuring the gpu-check-shared preset failed"
+  fi
+  (cd "$root" && cmake --build --preset gpu-check-shared)
+  rm -rf "$shared/stage"
+  cmake --install "$shared" --prefix "$shared/stage" >/dev/null
 
   rm -rf "$bundle"
   mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/data"
@@ -58,20 +77,30 @@ prepare() {
     cp "$build/$b" "$bundle/bin/"
   done
   strip --strip-unneeded "$bundle"/bin/*
+  # The shared libraries as installed (the real file and its soname and development links, relative), their CMake
+  # package and headers (the generated export headers among them): the bundle is their install prefix, so the
+  # module built there finds them with find_package(pyrseg) and loads them through its RPATH to lib/. Not the
+  # pkg-config files or the documents.
+  cp -P "$shared"/stage/lib/libpyrseg*.so* "$bundle/lib/"
+  mkdir -p "$bundle/lib/cmake"
+  cp -R "$shared/stage/lib/cmake/pyrseg" "$bundle/lib/cmake/"
+  cp -R "$shared/stage/include" "$bundle/"
   # Every shared library the binaries load, except glibc's own (any Linux has them): the GPU machine has none of
   # Debian's libraries (libpng, libtiff, OpenCV core, liblzf, Google Benchmark, the Vulkan and OpenCL loaders).
   # libstdc++ travels too, so an older one there cannot stop the binaries. The binaries' RPATH is $ORIGIN/../lib
   # (the preset), as DT_RPATH so that it also serves the libraries' own dependencies.
-  local lib name
+  # The shared pyrseg libraries' own dependencies too (their RPATH is $ORIGIN: the bundle's lib/).
+  local lib name pyrseg_libs
+  mapfile -t pyrseg_libs < <(find "$bundle/lib" -maxdepth 1 -type f -name 'libpyrseg*')
   while read -r lib; do
     name="$(basename "$lib")"
     case "$name" in
       libc.so.* | libm.so.* | libdl.so.* | libpthread.so.* | librt.so.* | libresolv.so.* | ld-linux*) continue ;;
+      libpyrseg*) continue ;;
     esac
     cp -L "$lib" "$bundle/lib/$name"
-  done < <(ldd "$bundle"/bin/* | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u)
-  chmod u+w "$bundle"/lib/*
-  strip --strip-unneeded "$bundle"/lib/*
+  done < <(ldd "$bundle"/bin/* "${pyrseg_libs[@]}" | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u)
+  find "$bundle/lib" -maxdepth 1 -type f -exec chmod u+w {} + -exec strip --strip-unneeded {} +
   # Libraries a GPU machine most likely has already, and whose own copy should win there: the C++ runtime (Debian's
   # needs glibc 2.36) and glvnd's GLX with X11 (OpenCV core links them; NVIDIA's Vulkan driver uses glvnd too).
   # `run` uses these copies only for those its machine lacks.
@@ -81,10 +110,10 @@ prepare() {
   done
   # Output captured before grep: `ldd | grep -q` under pipefail fails when grep stops reading first.
   local resolved
-  resolved="$(ldd "$bundle"/bin/*)"
+  resolved="$(env -u LD_LIBRARY_PATH ldd "$bundle"/bin/* "${pyrseg_libs[@]}")"
   if grep -q "not found" <<<"$resolved"; then
     grep "not found" <<<"$resolved" >&2
-    die "a library the binaries need was not found"
+    die "a library the binaries or the shared pyrseg libraries need was not found"
   fi
 
   local data="${PYRSEG_SHARED_DATA_DIR:-$root/../shared/data}" missing=()
@@ -107,15 +136,16 @@ prepare() {
     echo "glibc needed: $glibc"
     echo "libstdc++ needed: $glibcxx"
     echo "glibc needed by lib/fallback: $(glibc_needed "$bundle"/lib/fallback/*)"
-    echo "backends built: $(grep -E '^-- pyrseg backend' <<<"$log" | grep -o 'backend [a-z]*: built' |
-      awk '{printf "%s%s", sep, substr($2, 1, length($2) - 1); sep=" "}')"
+    echo "backends built: $(built_backends "$log")"
+    echo "shared libraries for the Python module: $(cd "$bundle/lib" &&
+      find . -maxdepth 1 -type l -name 'libpyrseg*.so.*' -printf '%f ')(backends $(built_backends "$shared_log"))"
   } >"$bundle/MANIFEST.txt"
 
   local bytes mib
   bytes=$(du -sb "$bundle" | cut -f1)
   mib=$(awk -v b="$bytes" 'BEGIN {printf "%.1f", b / 1048576}')
   say "bundle $bundle: $mib MiB (limit $bundle_limit_mib MiB); glibc >= $glibc needed"
-  du -sh "$bundle"/bin "$bundle"/lib "$bundle"/data | sed 's/^/  /'
+  du -sh "$bundle"/bin "$bundle"/lib "$bundle"/include "$bundle"/data | sed 's/^/  /'
   if ((bytes >= bundle_limit_mib * 1048576)); then
     die "the bundle is over $bundle_limit_mib MiB: it would slow every copy to the GPU machine"
   fi
@@ -389,6 +419,110 @@ run_interop() {
     "memcheck: $memcheck$counted"
 }
 
+# The Python module (issue 17): objects with __cuda_array_interface__ (CuPy's arrays) on the CUDA backend in place.
+# Built here, with this machine's python3, Python headers and pybind11, from the checkout's python/ sources against
+# the bundle's shared pyrseg libraries (scripts/gpu_check/python/CMakeLists.txt); then tests/python/smoke.py (it
+# imports, loads the libraries from the bundle, and segments a frame on each backend) and the tests of tests/python
+# that need neither pyrseg_testing (the test-only module: the test suite's internals) nor what the bundle lacks:
+# test_cuda.py (CuPy device arrays, labels identical to the host path), test_segmenter.py and test_io.py. One summary
+# row, "python module", which fails when test_cuda.py's device test skipped on a GPU. A rehearsal runs all of it
+# with the cpu backend (test_cuda.py's device test then skips) and fails when the module does not build or import.
+python_tests=(tests/python/test_cuda.py tests/python/test_segmenter.py tests/python/test_io.py)
+
+# The interpreter for the module: $PYRSEG_GPU_PYTHON, else the first of python3 on the PATH and /usr/bin/python3 that
+# imports numpy, pybind11 and pytest (a pyenv's python3 often has none of them).
+find_python() {
+  local py
+  for py in ${PYRSEG_GPU_PYTHON:-python3 /usr/bin/python3}; do
+    if command -v "$py" >/dev/null && "$py" -c 'import numpy, pybind11, pytest' >/dev/null 2>&1; then
+      command -v "$py"
+      return 0
+    fi
+  done
+  return 1
+}
+
+python_not_run() {
+  echo "not run: $1" >"$work/python.status"
+  say "python module: not run, $1"
+}
+
+# The bundle has the shared libraries but this machine cannot build the module: on a GPU machine that is "not run";
+# a rehearsal fails instead, since it would otherwise have rehearsed nothing of this step.
+python_cannot_build() {
+  local rehearse="$1" why="$2"
+  if [ "$rehearse" = 1 ]; then
+    echo "not built: $why" >"$work/python.status"
+    run_case_xml "$work/xml/python_build.xml" module_build failed "$why"
+    say "python module: FAILED, $why"
+  else
+    python_not_run "$why"
+  fi
+}
+
+run_python() {
+  local rehearse="$1" start=$SECONDS xml="$work/xml" py limit rc=0 log="$work/logs/python.log"
+  if [ ! -f "$bundle/lib/cmake/pyrseg/pyrsegConfig.cmake" ]; then
+    python_not_run "the bundle has no shared pyrseg libraries (prepare it again)"
+    return 0
+  fi
+  if ! py="$(find_python)"; then
+    python_cannot_build "$rehearse" "no python3 with numpy, pybind11 and pytest (PYRSEG_GPU_PYTHON names one)"
+    return 0
+  fi
+  command -v cmake >/dev/null || { python_cannot_build "$rehearse" "cmake is not on the PATH"; return 0; }
+  limit=$(step_limit 240)
+  if ((limit < 30)); then
+    python_not_run "out of time"
+    return 0
+  fi
+  local generator=() build="$work/python-build" package="$work/python"
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  {
+    echo "=== python module: built with $py against $bundle/lib ==="
+    timeout "$limit" cmake -S "$root/scripts/gpu_check/python" -B "$build" "${generator[@]}" \
+      -DCMAKE_BUILD_TYPE=Release -Dpyrseg_DIR="$bundle/lib/cmake/pyrseg" \
+      -Dpybind11_DIR="$("$py" -m pybind11 --cmakedir)" -DPython_EXECUTABLE="$py" \
+      -DPYRSEG_PYTHON_PACKAGE_DIR="$package/pyrseg" &&
+      timeout "$((limit - (SECONDS - start) > 1 ? limit - (SECONDS - start) : 1))" cmake --build "$build" -j "$(nproc)"
+  } >"$log" 2>&1 || rc=$?
+  local built
+  built="$(sed -n 's/^-- pyrseg Python module (gpu-check): //p' "$log")"
+  if ((rc)); then
+    echo "not built (${built:-configure failed})" >"$work/python.status"
+    run_case_xml "$xml/python_build.xml" module_build failed \
+      "exit $rc: $( (grep -m 1 -A 2 -iE 'error|not found' "$log" || tail -n 1 "$log") | tr -s ' \n' ' ')"
+  else
+    echo "$built" >"$work/python.status"
+    run_case_xml "$xml/python_build.xml" module_build passed ""
+    local backends=(--backend cpu)
+    [ "$rehearse" = 1 ] || backends+=(--backend cuda)
+    echo "=== tests/python/smoke.py ${backends[*]} ===" >>"$log"
+    rc=0
+    PYTHONPATH="$package" PYTHONDONTWRITEBYTECODE=1 timeout "$(step_limit 60)" "$py" "$root/tests/python/smoke.py" \
+      --shared-from "$bundle/lib" "${backends[@]}" >>"$log" 2>&1 || rc=$?
+    if ((rc)); then
+      run_case_xml "$xml/python_smoke.xml" smoke failed "exit $rc: $(tail -n 1 "$log")"
+    else
+      run_case_xml "$xml/python_smoke.xml" smoke passed ""
+    fi
+    echo "=== pytest ${python_tests[*]} ===" >>"$log"
+    rc=0
+    # From $work, with no cache and no bytecode: nothing is written into the checkout. No plugins (that machine's
+    # pytest has many): the tests need none.
+    (cd "$work" && PYTHONPATH="$package" PYTHONDONTWRITEBYTECODE=1 PYTEST_DISABLE_PLUGIN_AUTOLOAD=1 \
+      timeout "$(step_limit 120)" "$py" -m pytest -q -rs -p no:cacheprovider --junitxml="$xml/python_pytest.xml" \
+      "${python_tests[@]/#/$root/}") >>"$log" 2>&1 || rc=$?
+    if [ ! -s "$xml/python_pytest.xml" ]; then
+      run_case_xml "$xml/python_pytest.xml" pytest failed "exit $rc and no results (crashed or timed out?)"
+    fi
+  fi
+  echo "$((SECONDS - start))" >"$work/time_python"
+  cat "$log" >>"$report/conformance.log"
+  say "python module: $((SECONDS - start)) s; $(cat "$work/python.status");" \
+    "$(grep -E '(passed|failed|skipped|error).* in [0-9.]+s' "$log" | tail -n 1)"
+}
+
 # A report must come back whole from a machine that returns files of at most 16 MiB: a log over 8 MiB (a backend
 # failing every test, say) keeps its first 6 MiB and its last 1 MiB.
 cap_logs() {
@@ -514,6 +648,7 @@ run() {
   { echo "=== unit tests, every available backend ($((SECONDS - start)) s) ==="; cat "$work/logs/unit.log"; } \
     >>"$report/conformance.log"
   run_interop "$rehearse"
+  run_python "$rehearse"
   if [ "$rehearse" = 1 ]; then
     run_bench bench_rehearsal cpu 640x480 0.01 60
   else

@@ -3,8 +3,9 @@
 
     summarize.py --work WORK_DIR --report REPORT_DIR [--rehearsal]
 
-Reads WORK/backends, WORK/suites, WORK/environment.txt, WORK/xml/*.xml (Google Test), WORK/time_*,
-WORK/sanitizer_*.status and logs, and from REPORT bench_*.json (Google Benchmark) and cupy_label.json. Only the Python standard library is used.
+Reads WORK/backends, WORK/suites, WORK/environment.txt, WORK/xml/*.xml (Google Test; the python step's are pytest's
+JUnit XML), WORK/time_*, WORK/python.status, WORK/sanitizer_*.status and logs, and from REPORT bench_*.json (Google
+Benchmark) and cupy_label.json. Only the Python standard library is used.
 """
 import argparse
 import glob
@@ -127,9 +128,14 @@ def main():
     out.append("| suite | passed | failed | skipped | seconds |")
     out.append("|---|---:|---:|---:|---:|")
     all_failures = []
-    for suite in read(os.path.join(work, "suites")).split():
+    suites = read(os.path.join(work, "suites")).split()
+    for suite in suites:
         b = suite.removeprefix("conformance_")
-        xmls = sorted(glob.glob(os.path.join(work, "xml", f"{suite}_*.xml")))
+        # Not another suite's files whose name starts with this one's (conformance_cuda_graphs_0.xml is not
+        # conformance_cuda's).
+        longer = [o for o in suites if o != suite and o.startswith(suite + "_")]
+        xmls = sorted(x for x in glob.glob(os.path.join(work, "xml", f"{suite}_*.xml"))
+                      if not any(os.path.basename(x).startswith(o + "_") for o in longer))
         p, f, s, fails = gtest_results(xmls)
         seconds = read(os.path.join(work, f"time_{suite}")).strip()
         out.append(f"| conformance, {b} | {p} | {f} | {s} | {seconds} |")
@@ -145,12 +151,51 @@ def main():
     all_failures += fails
     if f:
         problems.append(f"{f} unit test failures")
+    # The Python module built on this machine against the bundle's shared libraries (gpu-check.sh's run_python):
+    # its build, tests/python/smoke.py and the tests of tests/python it runs. On a GPU, test_cuda.py's device-array
+    # test must have run: a skip there (no CuPy, CUDA unavailable to the module) is a failure of the check.
+    python_status = read(os.path.join(work, "python.status")).strip()
+    python_skips = []
+    if python_status.startswith("not run"):
+        out.append(f"| python module | | | | {python_status} |")
+        not_run.append(f"the python module ({python_status[len('not run: '):]})")
+    elif python_status:
+        xmls = sorted(glob.glob(os.path.join(work, "xml", "python_*.xml")))
+        p, f, s, fails = gtest_results(xmls)
+        seconds = read(os.path.join(work, "time_python")).strip()
+        built = python_status if python_status.startswith("not built") else f"built here: {python_status}"
+        out.append(f"| python module ({built}) | {p} | {f} | {s} | {seconds} |")
+        all_failures += fails
+        if f:
+            problems.append(f"{f} python module failures")
+        elif p == 0:
+            problems.append("no python module test passed")
+        device_test = None
+        for path in xmls:
+            try:
+                for case in ET.parse(path).getroot().iter("testcase"):
+                    skipped = case.find("skipped")
+                    if skipped is not None:
+                        name = f"{case.get('classname')}.{case.get('name')}"
+                        python_skips.append(f"`{name}`: {skipped.get('message', '')}")
+                    if case.get("name") == "test_device_frames_match_host_frames":
+                        device_test = "skipped" if skipped is not None else "ran"
+            except (ET.ParseError, OSError):
+                pass
+        if not args.rehearsal and device_test != "ran":
+            problems.append("the python module's CUDA device-array test (test_cuda.py) "
+                            + ("skipped" if device_test else "did not run") + " on this GPU machine")
     if all_failures:
         out.append("")
         out.append(f"Failures ({len(all_failures)}; first 40, details in conformance.log):")
         out.append("")
         for name, message in all_failures[:40]:
             out.append(f"- `{name}`: {message[:200]}")
+    if python_skips:
+        out.append("")
+        out.append("Python module, skipped:")
+        out.append("")
+        out.extend(f"- {line[:240]}" for line in python_skips)
     out.append("")
 
     if not args.rehearsal:

@@ -25,6 +25,9 @@ grep -q "using the bundle's own libpyrseg_rehearsal_only.so.0" "$work/rehearsal.
 grep -q '^\*\*REHEARSAL PASS' "$summary" || { cat "$summary"; echo "no REHEARSAL PASS verdict"; exit 1; }
 grep -Eq '^\| conformance, cpu \| [1-9][0-9]* \| 0 \|' "$summary" || { cat "$summary"; echo "no cpu conformance"; exit 1; }
 grep -q '^| stage/cpu/640x480 |' "$summary" || { cat "$summary"; echo "no bench table"; exit 1; }
+# This bundle has no shared pyrseg libraries (only `prepare` makes them): the python step says it did not run.
+grep -q '^| python module | .*not run: the bundle has no shared pyrseg libraries' "$summary" ||
+  { cat "$summary"; echo "no python module row"; exit 1; }
 for f in run.log conformance.log bench_rehearsal.json cupy_label.json; do
   [ -s "$work/report/$f" ] || { echo "the report lacks $f"; exit 1; }
 done
