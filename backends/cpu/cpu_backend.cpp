@@ -804,7 +804,9 @@ size_t memory_needed(const core::Plan& plan) {
            fill_scratch_size(plan) * sizeof(uint32_t) +                                    // union-find
            plan.stats_words() * sizeof(uint32_t) +                                         // statistics
            (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0) +  // robust normals' texels
-           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0);             // edge rounds' labels
+           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0) +            // edge rounds' labels
+           PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,              // its rows, per thread
+                                       ThreadPool::default_size());
 }
 
 }  // namespace

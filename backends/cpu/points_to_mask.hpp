@@ -1,10 +1,13 @@
 #pragma once
 // The CPU backend's fused front end: normals (paper metric, when estimated), quantize and the paper metric as one
 // pass over bands of rows. Each thread produces a row's quantized pixels just before the metric of the row above
-// reads them, in a window of a few rows that stays in its L2 cache, so the frame's normals and quantized pixels
+// reads them, in a window of three rows that stays in its L2 cache, so the frame's normals and quantized pixels
 // need never travel to memory and back (the separate passes write and re-read 12 bytes a pixel twice); estimated
-// normals go from their integer form straight to quantize's words (RowKernels::normals_to_row). The row functions
-// are the vector kernels of backends/cpu/simd: the bytes are those of the separate passes.
+// normals go from their integer form straight to quantized pixels. The window's rows are unpacked (simd::QuantRow:
+// structures of arrays, with the sums the metric's neighbourhoods share), so that each row is unpacked once, not
+// once for each of the three metric rows that read it; estimated normals read the point rows split the same way
+// (simd::PointRow), each point row split once, not deinterleaved for each of the five normals that read it. The row
+// functions are the vector kernels of backends/cpu/simd: the bytes are those of the separate passes.
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
@@ -34,17 +37,25 @@ class PointsToMask {
 public:
     void run(ThreadPool& pool, const simd::RowKernels& kernels, const PointsToMaskFrame& frame);
 
+    // Bytes of the per-thread scratch run allocates on the first frame, for `threads` threads.
+    [[nodiscard]] static std::size_t scratch_bytes(std::uint32_t width, std::uint32_t normal_radius,
+                                                   std::size_t threads);
+
 private:
     struct Scratch {
-        std::vector<std::uint32_t> window;  // consecutive rows of quantized pixels
+        std::vector<std::int32_t> ints;  // the window's integer arrays, then the point rows' validity
+        std::vector<float> floats;       // the window's depths, then the point rows' components
+        simd::QuantRow window[3];        // row y in window[y % 3]
+        std::vector<simd::PointRow> points;
+        std::vector<std::uint32_t> point_rows;  // the row each of `points` holds (kNoRow: none)
     };
     // Each running chunk takes a free scratch; at most pool.size() run at once. Allocated on the first frame.
     Scratch& acquire(std::size_t& slot);
     void release(std::size_t slot);
+    void allocate(Scratch& s, std::uint32_t width, std::uint32_t normal_radius) const;
     void run_rows(const simd::RowKernels& kernels, const PointsToMaskFrame& f, std::uint32_t y0, std::uint32_t y1,
                   Scratch& s) const;
 
-    std::size_t window_rows_ = 0;
     std::vector<Scratch> scratch_;
     std::vector<bool> busy_;
     std::mutex mutex_;

@@ -35,6 +35,10 @@ bool spin_until(const Done& done) {
 
 }  // namespace
 
+unsigned ThreadPool::default_size() {
+    return default_threads();
+}
+
 ThreadPool::ThreadPool(unsigned threads) {
     const unsigned total = threads == 0 ? default_threads() : threads;
     workers_.reserve(total - 1);

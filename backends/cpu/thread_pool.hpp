@@ -19,6 +19,8 @@ public:
     ThreadPool& operator=(const ThreadPool&) = delete;
 
     [[nodiscard]] unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
+    // The size of a ThreadPool made with threads = 0.
+    [[nodiscard]] static unsigned default_size();
 
     // Calls body(begin, end) on disjoint chunks of [0, count) of at most `grain` items, in parallel, and returns
     // when all are done. The body must not throw: workers may still be running chunks of it while an exception

@@ -16,7 +16,11 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
@@ -320,9 +324,316 @@ TEST_P(CpuSimdRows, QuantizeMatchesTheSharedFunction) {
     }
 }
 
-// pyr_metric_fillable against metric_row over a whole image; returns how many pixels are fillable.
+// ---- The fused front end's rows (simd::PointRow, simd::QuantRow)
+
+// Floats at the very end of a readable mapping whose next page is not readable: a read past the last one faults.
+class GuardedFloats {
+public:
+    explicit GuardedFloats(const std::vector<float>& values) {
+        const auto page = std::size_t(sysconf(_SC_PAGESIZE));
+        const std::size_t bytes = values.size() * sizeof(float);
+        size_ = (bytes + page - 1) / page * page + page;
+        void* map = mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (map == MAP_FAILED) throw std::runtime_error("mmap failed");
+        base_ = static_cast<unsigned char*>(map);
+        unsigned char* guard = base_ + size_ - page;
+        if (mprotect(guard, page, PROT_NONE) != 0) throw std::runtime_error("mprotect failed");
+        data_ = reinterpret_cast<float*>(guard - bytes);
+        std::memcpy(data_, values.data(), bytes);
+    }
+    ~GuardedFloats() { munmap(base_, size_); }
+    GuardedFloats(const GuardedFloats&) = delete;
+    GuardedFloats& operator=(const GuardedFloats&) = delete;
+    GuardedFloats(GuardedFloats&&) = delete;
+    GuardedFloats& operator=(GuardedFloats&&) = delete;
+
+    [[nodiscard]] const float* data() const { return data_; }
+
+private:
+    unsigned char* base_ = nullptr;
+    std::size_t size_ = 0;
+    float* data_ = nullptr;
+};
+
+// A layout's floats up to its last point's third, all a cloud must hold.
+std::vector<float> cloud_floats(const Layout& l, int w, int h) {
+    const std::size_t used = (std::size_t(h) - 1) * l.row_floats + (std::size_t(w) - 1) * l.point_floats + 3;
+    return {l.floats.begin(), l.floats.begin() + std::ptrdiff_t(used)};
+}
+
+// Rows of the fused front end with storage of their own, w wide, every element junk at first.
+struct RowStore {
+    std::vector<float> floats;
+    std::vector<std::int32_t> ints;
+    std::vector<simd::PointRow> points;
+    std::vector<simd::QuantRow> quant;
+
+    RowStore(std::size_t rows, std::uint32_t w) : floats(4 * rows * w, -555.0f), ints(9 * rows * w, 0x5a5a5a5a) {
+        float* f = floats.data();
+        std::int32_t* i = ints.data();
+        const auto next_float = [&] { return std::exchange(f, f + w); };
+        const auto next_int = [&] { return std::exchange(i, i + w); };
+        for (std::size_t r = 0; r < rows; ++r) {
+            simd::PointRow p;
+            p.x = next_float();
+            p.y = next_float();
+            p.z = next_float();
+            p.valid = next_int();
+            points.push_back(p);
+            simd::QuantRow q;
+            for (std::int32_t*& c : q.q) c = next_int();
+            q.valid = next_int();
+            q.z = next_float();
+            for (std::int32_t*& s : q.sum) s = next_int();
+            quant.push_back(q);
+        }
+    }
+};
+
+std::uint32_t bits_of(float f) {
+    std::uint32_t b = 0;
+    std::memcpy(&b, &f, sizeof b);
+    return b;
+}
+
+// The first difference between a split row and its points (`stride` floats apart), or "".
+std::string split_difference(const float* points, std::size_t stride, std::uint32_t w, const simd::PointRow& row) {
+    for (std::size_t x = 0; x < w; ++x) {
+        const float* p = points + x * stride;
+        const std::int32_t valid = kernels::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
+        if (bits_of(row.x[x]) != bits_of(p[0]) || bits_of(row.y[x]) != bits_of(p[1]) ||
+            bits_of(row.z[x]) != bits_of(p[2]) || row.valid[x] != valid) {
+            return "point " + std::to_string(x);
+        }
+    }
+    return "";
+}
+
+// The first difference between an unpacked row and the w pixels whose store_quant words are `words` (QuantRow's
+// contract: qn and depth of the valid ones, +infinity for the depth of the others, the sums), or "".
+std::string unpacked_difference(const std::uint32_t* words, std::uint32_t w, const simd::QuantRow& row) {
+    std::vector<std::int32_t> fields[4];
+    for (std::vector<std::int32_t>& f : fields) f.assign(w, 0);
+    for (std::size_t x = 0; x < w; ++x) {
+        const std::uint32_t valid = words[kQuantWords * x + 1] >> 16;
+        for (int c = 0; c < 3; ++c) {
+            fields[c][x] = valid != 0 ? ::pyrseg::cpu::quant_component(words, x, c) : 0;
+            if (row.q[c][x] != fields[c][x]) return "qn " + std::to_string(c) + " of pixel " + std::to_string(x);
+        }
+        fields[3][x] = std::int32_t(valid);
+        if (row.valid[x] != fields[3][x]) return "validity of pixel " + std::to_string(x);
+        const float z = valid != 0 ? from_bits(words[kQuantWords * x + 2]) : kInf;
+        if (bits_of(row.z[x]) != bits_of(z)) return "depth of pixel " + std::to_string(x);
+    }
+    for (std::size_t x = 1; x + 1 < w; ++x) {
+        for (int f = 0; f < 4; ++f) {
+            if (row.sum[f][x] != fields[f][x - 1] + fields[f][x] + fields[f][x + 1]) {
+                return "sum " + std::to_string(f) + " of pixel " + std::to_string(x);
+            }
+        }
+    }
+    return "";
+}
+
+// split_points_row against the points and pyr_point_valid, on clouds that end at their last point's third float
+// (the padding of PCL's points is never read past it).
+TEST_P(CpuSimdRows, SplitPointsMatchTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::uint32_t seed = 200;
+    for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 131, 1000}) {
+        for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{7}}) {
+            const std::vector<float> packed = make_points(w, 1, seed % 2 == 0 ? 1.0f : 1e-38f, 0.2, seed);
+            ++seed;
+            const GuardedFloats cloud(cloud_floats(lay_out(packed, w, 1, pf, 0), w, 1));
+            RowStore store(1, std::uint32_t(w));
+            k.split_points_row(cloud.data(), pf, std::uint32_t(w), store.points[0]);
+            ASSERT_EQ(split_difference(cloud.data(), pf, std::uint32_t(w), store.points[0]), "")
+                << "width " << w << " stride " << pf;
+        }
+    }
+}
+
+// normals_quant_row, on rows split by split_points_row, against pyr_normal_q and pyr_quantize pixel by pixel:
+// normals, quantize's words, validity bytes and the unpacked row, every size, radius, scale and layout.
+TEST_P(CpuSimdRows, FusedNormalsMatchTheSharedFunctions) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::uint32_t seed = 300;
+    std::size_t defined = 0;
+    std::size_t pixels = 0;
+    for (const Size s : kSizes) {
+        for (const int r : {1, 2, 5, 40}) {
+            for (const float scale : {1.0f, 1e30f, 1e-38f}) {
+                for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{7}}) {
+                    const double specials = seed % 3 == 0 ? 0.0 : 0.08;
+                    const bool all_outputs = seed % 2 == 0;
+                    const std::vector<float> packed = make_points(s.w, s.h, scale, specials, seed++);
+                    const Layout l = lay_out(packed, s.w, s.h, pf, pf == 3 ? 0 : 5);
+                    const GuardedFloats cloud(cloud_floats(l, s.w, s.h));
+                    PassContext c;
+                    c.points = cloud.data();
+                    c.point_floats = l.point_floats;
+                    c.row_floats = l.row_floats;
+                    const auto w = std::uint32_t(s.w);
+                    const auto h = std::uint32_t(s.h);
+                    const auto ur = std::uint32_t(r);
+                    const std::size_t pixel_count = std::size_t(w) * h;
+                    std::vector<float> expected_normals(3 * pixel_count);
+                    std::vector<std::uint32_t> expected_words(kQuantWords * pixel_count);
+                    std::vector<std::uint8_t> expected_valid(pixel_count);
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        for (std::uint32_t x = 0; x < w; ++x) {
+                            const std::size_t i = std::size_t(y) * w + x;
+                            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, ur);
+                            float* n = &expected_normals[3 * i];
+                            n[0] = float(q.x) * PYR_NORMAL_UNIT;
+                            n[1] = float(q.y) * PYR_NORMAL_UNIT;
+                            n[2] = float(q.z) * PYR_NORMAL_UNIT;
+                            const float* p = c.points + y * c.row_floats + x * c.point_floats;
+                            const PyrQuant v = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                            ::pyrseg::cpu::store_quant(&expected_words[kQuantWords * i], v.qx, v.qy, v.qz, v.valid,
+                                                       p[2]);
+                            expected_valid[i] = std::uint8_t(v.valid);
+                            defined += v.valid;
+                        }
+                    }
+                    pixels += pixel_count;
+                    RowStore store(h, w);
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        k.split_points_row(c.points + y * c.row_floats, pf, w, store.points[y]);
+                        ASSERT_EQ(split_difference(c.points + y * c.row_floats, pf, w, store.points[y]), "");
+                    }
+                    std::vector<float> normals(3 * pixel_count, 99.0f);
+                    std::vector<std::uint32_t> words(kQuantWords * pixel_count, 0xcdcdcdcd);
+                    std::vector<std::uint8_t> valid(pixel_count, 0x77);
+                    // Reading ahead anywhere in the cloud changes nothing.
+                    simd::ReadAhead ahead;
+                    ahead.at[0] = cloud.data();
+                    ahead.bytes = cloud_floats(l, s.w, s.h).size() * sizeof(float);
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        const simd::PointRow& row = store.points[y];
+                        const simd::PointRow& up = y >= ur ? store.points[y - ur] : row;
+                        const simd::PointRow& down = y + ur < h ? store.points[y + ur] : row;
+                        const std::size_t i = std::size_t(y) * w;
+                        k.normals_quant_row(c, up, row, down, w, h, y, ur, all_outputs ? &normals[3 * i] : nullptr,
+                                            all_outputs ? &words[kQuantWords * i] : nullptr,
+                                            all_outputs ? &valid[i] : nullptr, store.quant[y], ahead);
+                        ASSERT_EQ(unpacked_difference(&expected_words[kQuantWords * i], w, store.quant[y]), "")
+                            << s.w << "x" << s.h << " r=" << r << " scale=" << scale << " stride=" << pf << " row "
+                            << y;
+                    }
+                    if (!all_outputs) continue;
+                    ASSERT_EQ(first_difference(normals.data(), expected_normals.data(), normals.size() * sizeof(float),
+                                               3 * sizeof(float)),
+                              "")
+                        << s.w << "x" << s.h << " r=" << r << " scale=" << scale << " stride=" << pf;
+                    ASSERT_EQ(
+                        first_difference(words.data(), expected_words.data(), words.size() * sizeof(std::uint32_t),
+                                         kQuantWords * sizeof(std::uint32_t)),
+                        "")
+                        << s.w << "x" << s.h << " r=" << r << " scale=" << scale << " stride=" << pf;
+                    ASSERT_EQ(first_difference(valid.data(), expected_valid.data(), valid.size(), 1), "")
+                        << s.w << "x" << s.h << " r=" << r << " scale=" << scale << " stride=" << pf;
+                }
+            }
+        }
+    }
+    EXPECT_GT(defined, pixels / 4) << "too few pixels with a normal to test much";
+}
+
+// quantize_quant_row against pyr_quantize: quantize's words, validity bytes and the unpacked row, on special points
+// and normals, ties, components past +-1 and layouts (clouds that end at their last point's third float).
+TEST_P(CpuSimdRows, FusedQuantizeMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::uint32_t seed = 400;
+    for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 18, 31, 33, 64, 65, 131, 1000}) {
+        for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{12}}) {
+            for (const std::size_t nf : {std::size_t{3}, std::size_t{4}, std::size_t{5}}) {
+                const bool all_outputs = seed % 2 == 0;
+                const std::vector<float> points = make_points(w, 1, seed % 2 == 0 ? 1.0f : 1e-38f, 0.2, seed);
+                const std::vector<float> normals = make_normals(std::size_t(w), 0.2, seed + 7);
+                ++seed;
+                const GuardedFloats lp(cloud_floats(lay_out(points, w, 1, pf, 0), w, 1));
+                const GuardedFloats ln(cloud_floats(lay_out(normals, w, 1, nf, 0), w, 1));
+                std::vector<std::uint32_t> expected(kQuantWords * std::size_t(w), 0xabababab);
+                std::vector<std::uint8_t> expected_valid(std::size_t(w), 0);
+                for (std::size_t x = 0; x < std::size_t(w); ++x) {
+                    const float* p = lp.data() + x * pf;
+                    const float* n = ln.data() + x * nf;
+                    const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                    ::pyrseg::cpu::store_quant(expected.data() + kQuantWords * x, q.qx, q.qy, q.qz, q.valid, p[2]);
+                    expected_valid[x] = std::uint8_t(q.valid);
+                }
+                std::vector<std::uint32_t> actual(kQuantWords * std::size_t(w), 0xcdcdcdcd);
+                std::vector<std::uint8_t> valid(std::size_t(w), 0x77);
+                RowStore store(1, std::uint32_t(w));
+                k.quantize_quant_row(lp.data(), pf, ln.data(), nf, std::uint32_t(w),
+                                     all_outputs ? actual.data() : nullptr, all_outputs ? valid.data() : nullptr,
+                                     store.quant[0]);
+                ASSERT_EQ(unpacked_difference(expected.data(), std::uint32_t(w), store.quant[0]), "")
+                    << "width " << w << " point stride " << pf << " normal stride " << nf;
+                if (!all_outputs) continue;
+                ASSERT_EQ(first_difference(actual.data(), expected.data(), actual.size() * sizeof(std::uint32_t),
+                                           kQuantWords * sizeof(std::uint32_t)),
+                          "")
+                    << "width " << w << " point stride " << pf << " normal stride " << nf;
+                ASSERT_EQ(first_difference(valid.data(), expected_valid.data(), valid.size(), 1), "")
+                    << "width " << w << " point stride " << pf << " normal stride " << nf;
+            }
+        }
+    }
+}
+
+// metric_quant_row against pyr_metric_fillable on the same pixels made into points and normals (qn / 2^13, which
+// quantizes back to qn; a tiny normal for a valid qn of 0, none for a pixel that is not valid) and quantized by
+// quantize_quant_row, a row at a time as the fused front end does; the expected bytes come from pyr_quantize's words
+// of the same points and normals (a pixel whose depth is not a valid point's is then not valid either).
+void check_fused_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h,
+                        const std::vector<QuantPixel>& quant, std::int32_t tc, float dt) {
+    std::vector<float> points(3 * quant.size());
+    std::vector<float> normals(3 * quant.size());
+    std::vector<std::uint32_t> words(kQuantWords * quant.size());
+    for (std::size_t i = 0; i < quant.size(); ++i) {
+        const QuantPixel& p = quant[i];
+        float* point = &points[3 * i];
+        float* normal = &normals[3 * i];
+        point[0] = 0.5f;
+        point[1] = -0.25f;
+        point[2] = p.z;
+        for (int c = 0; c < 3; ++c) normal[c] = p.valid != 0 ? float(p.q[c]) / 8192.0f : 0.0f;
+        if (p.valid != 0 && p.q[0] == 0 && p.q[1] == 0 && p.q[2] == 0) normal[0] = 1e-7f;
+        const PyrQuant q = kernels::pyr_quantize(point[0], point[1], point[2], normal[0], normal[1], normal[2]);
+        ::pyrseg::cpu::store_quant(&words[kQuantWords * i], q.qx, q.qy, q.qz, q.valid, point[2]);
+    }
+    PassContext c;
+    c.quant = words.data();
+    RowStore store(h, w);
+    for (std::uint32_t y = 0; y < h; ++y) {
+        const std::size_t i = std::size_t(y) * w;
+        k.quantize_quant_row(&points[3 * i], 3, &normals[3 * i], 3, w, nullptr, nullptr, store.quant[y]);
+    }
+    std::vector<std::uint8_t> expected(quant.size());
+    std::vector<std::uint8_t> actual(quant.size(), 0x55);
+    simd::ReadAhead ahead;  // reading ahead anywhere in the points changes nothing
+    ahead.at[0] = points.data();
+    ahead.at[1] = normals.data();
+    ahead.bytes = points.size() * sizeof(float);
+    for (std::uint32_t y = 0; y < h; ++y) {
+        for (std::uint32_t x = 0; x < w; ++x) {
+            expected[std::size_t(y) * w + x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+        }
+        k.metric_quant_row(y > 0 ? &store.quant[y - 1] : nullptr, store.quant[y],
+                           y + 1 < h ? &store.quant[y + 1] : nullptr, w, tc, dt, actual.data() + std::size_t(y) * w,
+                           ahead);
+    }
+    const std::string diff = first_difference(actual.data(), expected.data(), actual.size(), 1);
+    EXPECT_EQ(diff, "") << "fused, " << w << "x" << h << " tc=" << tc << " dt=" << dt;
+}
+
+// pyr_metric_fillable against metric_row over a whole image (and against metric_quant_row: check_fused_metric);
+// returns how many pixels are fillable.
 int check_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h, const std::vector<QuantPixel>& quant,
                  std::int32_t tc, float dt) {
+    check_fused_metric(k, w, h, quant, tc, dt);
     const std::vector<std::uint32_t> words = to_words(quant);
     PassContext c;
     c.quant = words.data();

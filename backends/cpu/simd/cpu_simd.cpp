@@ -4,9 +4,9 @@
 //
 // Bit-identity with the shared scalar functions (shaders/pyr_*.h), which every backend and the reference match:
 //  - every float operation is the scalar code's: IEEE add, sub, mul, div and sqrt are correctly rounded on every
-//    Highway target; no MulAdd (the project compiles with -ffp-contract=off); Min/Max only where both operands are
-//    finite (they then equal the scalar code's comparisons); Round is round-half-to-even like nearbyint in the
-//    default rounding mode;
+//    Highway target; no MulAdd (the project compiles with -ffp-contract=off); Min/Max, in the lanes whose result is
+//    used, only on operands that are finite or +infinity, never NaN or zeros of both signs (they then equal the
+//    scalar code's comparisons); Round is round-half-to-even like nearbyint in the default rounding mode;
 //  - integer arithmetic is the scalar code's, in lanes of the same width; every bound the scalar code states (no
 //    int32 overflow) holds in every lane, including lanes whose result is thrown away (those are kept in range on
 //    purpose, so that Highway's one-lane target, which uses plain C++ integers, has no undefined behaviour);
@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -206,23 +207,31 @@ HWY_INLINE VI unit_component(VI d, VI len) {
     return hn::IfThenElse(hn::Lt(d, hn::Zero(di)), hn::Neg(q), q);
 }
 
-// pyr_unit_normal_from_tangents; `defined` clear where the scalar code returns (0, 0, 0) before it gets here.
-HWY_INLINE void unit_normal(VI ux, VI uy, VI uz, VI vx, VI vy, VI vz, VF px, VF py, VF pz, MI defined, VI& qx, VI& qy,
-                            VI& qz) {
+// pyr_unit_normal_from_tangents in two halves (the fused front end runs them as two loops over a few vectors, so that
+// more of their long chains of dependent operations overlap). The first: the cross product with its largest
+// component's top bit at 14 (d), and `some` where the result is not (0, 0, 0); `defined` clear where the scalar code
+// returns (0, 0, 0) before it gets here.
+HWY_INLINE void normal_direction(VI ux, VI uy, VI uz, VI vx, VI vy, VI vz, MI defined, VI& dx, VI& dy, VI& dz,
+                                 MI& some) {
     const DI di;
-    const DU du;
     // |u|, |v| < 2^15: each product < 2^30, each difference < 2^31.
     const VI cx = hn::Sub(hn::Mul(uy, vz), hn::Mul(uz, vy));
     const VI cy = hn::Sub(hn::Mul(uz, vx), hn::Mul(ux, vz));
     const VI cz = hn::Sub(hn::Mul(ux, vy), hn::Mul(uy, vx));
     const VI m = hn::Max(hn::Max(hn::Abs(cx), hn::Abs(cy)), hn::Abs(cz));
-    const MI some = hn::And(defined, hn::Gt(m, hn::Zero(di)));
+    some = hn::And(defined, hn::Gt(m, hn::Zero(di)));
     // Lanes with m == 0 give (0, 0, 0); they compute with m = 1 (then d = 0, len = 0, taken as 1 below) so that
     // no lane shifts by an out-of-range count or divides by zero.
     const VI s = hn::Sub(msb(hn::Max(m, hn::Set(di, 1))), hn::Set(di, 14));
-    const VI dx = shift_magnitude(cx, s);
-    const VI dy = shift_magnitude(cy, s);
-    const VI dz = shift_magnitude(cz, s);
+    dx = shift_magnitude(cx, s);
+    dy = shift_magnitude(cy, s);
+    dz = shift_magnitude(cz, s);
+}
+
+// The second half: q from d, toward the camera seen from the point P.
+HWY_INLINE void normal_from_direction(VI dx, VI dy, VI dz, MI some, VF px, VF py, VF pz, VI& qx, VI& qy, VI& qz) {
+    const DI di;
+    const DU du;
     const VU n = hn::Add(hn::Add(hn::BitCast(du, hn::Mul(dx, dx)), hn::BitCast(du, hn::Mul(dy, dy))),
                          hn::BitCast(du, hn::Mul(dz, dz)));
     const VI len = hn::Max(hn::BitCast(di, isqrt_floor(n)), hn::Set(di, 1));
@@ -245,23 +254,15 @@ void store_normal(const PyrIVec3& q, float* out) {
     out[2] = float(q.z) * PYR_NORMAL_UNIT;
 }
 
-// pyr_normal_q for the pixels x .. x + n - 1 of row y, all with both horizontal neighbours inside the image, and
-// their points' z. up / down: the rows y - r / y + r, or row y itself where that row is outside the image (has_up /
-// has_down clear).
-HWY_INLINE void normal_q_vector(const float* row, const float* up, const float* down, std::size_t pf, std::size_t x,
-                                std::size_t r, MI has_up_row, MI has_down_row, VI& qx, VI& qy, VI& qz, VF& z) {
+// pyr_normal_q for n pixels, all with both horizontal neighbours inside the image, from their points (c) and those
+// of their neighbours: right (x + r), left (x - r), up (y - r) and down (y + r), each with its validity (has_up /
+// has_down clear where that row is outside the image); up to the first half of pyr_unit_normal_from_tangents
+// (normal_direction), whose results are d and `some`.
+HWY_INLINE void normal_direction_of(VF cx, VF cy, VF cz, MI center, VF rx, VF ry, VF rz, MI has_right, VF lx, VF ly,
+                                    VF lz, MI has_left, VF ux, VF uy, VF uz, MI has_up, VF dx, VF dy, VF dz,
+                                    MI has_down, VI& direction_x, VI& direction_y, VI& direction_z, MI& some) {
     const DF df;
-    VF cx, cy, cz, rx, ry, rz, lx, ly, lz, ux, uy, uz, dx, dy, dz;  // NOLINT(readability-isolate-declaration)
-    load_points(df, row + x * pf, pf, cx, cy, cz);
-    load_points(df, row + (x + r) * pf, pf, rx, ry, rz);
-    load_points(df, row + (x - r) * pf, pf, lx, ly, lz);
-    load_points(df, up + x * pf, pf, ux, uy, uz);
-    load_points(df, down + x * pf, pf, dx, dy, dz);
-    const MI has_right = point_valid(rx, ry, rz);
-    const MI has_left = point_valid(lx, ly, lz);
-    const MI has_up = hn::And(has_up_row, point_valid(ux, uy, uz));
-    const MI has_down = hn::And(has_down_row, point_valid(dx, dy, dz));
-    const MI defined = hn::And(point_valid(cx, cy, cz), hn::And(hn::Or(has_right, has_left), hn::Or(has_down, has_up)));
+    const MI defined = hn::And(center, hn::And(hn::Or(has_right, has_left), hn::Or(has_down, has_up)));
     // u = P(xa) - P(xb), v = P(ya) - P(yb): the neighbour where it is valid, else the pixel itself.
     const auto right = hn::RebindMask(df, has_right);
     const auto left = hn::RebindMask(df, has_left);
@@ -274,7 +275,35 @@ HWY_INLINE void normal_q_vector(const float* row, const float* up, const float* 
     to_fixed(hn::Sub(hn::IfThenElse(below, dx, cx), hn::IfThenElse(above, ux, cx)),
              hn::Sub(hn::IfThenElse(below, dy, cy), hn::IfThenElse(above, uy, cy)),
              hn::Sub(hn::IfThenElse(below, dz, cz), hn::IfThenElse(above, uz, cz)), fvx, fvy, fvz);
-    unit_normal(fux, fuy, fuz, fvx, fvy, fvz, cx, cy, cz, defined, qx, qy, qz);
+    normal_direction(fux, fuy, fuz, fvx, fvy, fvz, defined, direction_x, direction_y, direction_z, some);
+}
+
+// pyr_normal_q for n pixels as normal_direction_of describes them.
+HWY_INLINE void normal_q_of(VF cx, VF cy, VF cz, MI center, VF rx, VF ry, VF rz, MI has_right, VF lx, VF ly, VF lz,
+                            MI has_left, VF ux, VF uy, VF uz, MI has_up, VF dx, VF dy, VF dz, MI has_down, VI& qx,
+                            VI& qy, VI& qz) {
+    VI ex, ey, ez;  // NOLINT(readability-isolate-declaration)
+    MI some;
+    normal_direction_of(cx, cy, cz, center, rx, ry, rz, has_right, lx, ly, lz, has_left, ux, uy, uz, has_up, dx, dy, dz,
+                        has_down, ex, ey, ez, some);
+    normal_from_direction(ex, ey, ez, some, cx, cy, cz, qx, qy, qz);
+}
+
+// pyr_normal_q for the pixels x .. x + n - 1 of row y, all with both horizontal neighbours inside the image, and
+// their points' z. up / down: the rows y - r / y + r, or row y itself where that row is outside the image (has_up /
+// has_down clear).
+HWY_INLINE void normal_q_vector(const float* row, const float* up, const float* down, std::size_t pf, std::size_t x,
+                                std::size_t r, MI has_up_row, MI has_down_row, VI& qx, VI& qy, VI& qz, VF& z) {
+    const DF df;
+    VF cx, cy, cz, rx, ry, rz, lx, ly, lz, ux, uy, uz, dx, dy, dz;  // NOLINT(readability-isolate-declaration)
+    load_points(df, row + x * pf, pf, cx, cy, cz);
+    load_points(df, row + (x + r) * pf, pf, rx, ry, rz);
+    load_points(df, row + (x - r) * pf, pf, lx, ly, lz);
+    load_points(df, up + x * pf, pf, ux, uy, uz);
+    load_points(df, down + x * pf, pf, dx, dy, dz);
+    normal_q_of(cx, cy, cz, point_valid(cx, cy, cz), rx, ry, rz, point_valid(rx, ry, rz), lx, ly, lz,
+                point_valid(lx, ly, lz), ux, uy, uz, hn::And(has_up_row, point_valid(ux, uy, uz)), dx, dy, dz,
+                hn::And(has_down_row, point_valid(dx, dy, dz)), qx, qy, qz);
     z = cz;
 }
 
@@ -349,6 +378,220 @@ void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::ui
     normals_to_row(c, w, h, y, r, out, nullptr);
 }
 
+// ---- The fused front end's rows (cpu_simd.hpp: PointRow, QuantRow)
+
+// f(x) for vectors of n pixels from x covering begin .. end - 1 (end - begin >= n): the first at begin, the next ones
+// at multiples of n (where the rows' arrays start on a cache line, loads at x then do not straddle two), the last
+// ending at end. They overlap: f must write the same wherever they do.
+template <class F>
+HWY_INLINE void for_vectors(std::size_t begin, std::size_t end, std::size_t n, const F& f) {
+    f(begin);
+    if (begin + n >= end) return;
+    for (std::size_t x = (begin / n + 1) * n; x < end; x += n) f(std::min(x, end - n));
+}
+
+// A ReadAhead's lines, spread over the vectors of for_vectors(begin, end, n): step() with each vector reads the next
+// few (for_vectors calls f at least (end - begin) / n times, rounded up).
+class ReadingAhead {
+public:
+    ReadingAhead(const ReadAhead& ahead, std::size_t begin, std::size_t end, std::size_t n)
+        : ahead_(ahead), lines_((ahead.bytes + kLine - 1) / kLine) {
+        const std::size_t vectors = (end - begin + n - 1) / n;
+        per_vector_ = (lines_ + vectors - 1) / vectors;
+    }
+
+    HWY_INLINE void step() {
+        const std::size_t end = std::min(lines_, next_ + per_vector_);
+        for (; next_ < end; ++next_) {
+            for (const void* at : ahead_.at) {
+                // Read, into the L2 cache (locality 2): the L1 cache is smaller than a row or two of points.
+                if (at != nullptr) __builtin_prefetch(static_cast<const char*>(at) + kLine * next_, 0, 2);
+            }
+        }
+    }
+
+private:
+    static constexpr std::size_t kLine = 64;
+    const ReadAhead& ahead_;
+    std::size_t lines_;
+    std::size_t per_vector_ = 0;
+    std::size_t next_ = 0;
+};
+
+// Points x .. x + n - 1 of a row of w points, `stride` floats apart: components 0, 1, 2. PCL's padded points
+// (stride 4) are deinterleaved too, except in the vector that holds the row's last point (whose padding float may
+// lie past the cloud's end); other layouts go through load_points.
+HWY_INLINE void load_row_points(DF df, const float* HWY_RESTRICT row, std::size_t stride, std::size_t x, std::size_t w,
+                                VF& px, VF& py, VF& pz) {
+    if (stride == 4 && x + hn::Lanes(df) < w) {
+        VF padding;
+        hn::LoadInterleaved4(df, row + 4 * x, px, py, pz, padding);
+        return;
+    }
+    load_points(df, row + x * stride, stride, px, py, pz);
+}
+
+void split_points_row(const float* points, std::size_t point_floats, std::uint32_t w, const PointRow& out) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    if (w < n) {
+        for (std::size_t x = 0; x < w; ++x) {
+            const float* p = points + x * point_floats;
+            out.x[x] = p[0];
+            out.y[x] = p[1];
+            out.z[x] = p[2];
+            out.valid[x] = kernels::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
+        }
+        return;
+    }
+    for (std::size_t x = 0;; x += n) {
+        x = std::min(x, std::size_t(w) - n);
+        VF px, py, pz;  // NOLINT(readability-isolate-declaration)
+        load_row_points(df, points, point_floats, x, w, px, py, pz);
+        hn::StoreU(px, df, out.x + x);
+        hn::StoreU(py, df, out.y + x);
+        hn::StoreU(pz, df, out.z + x);
+        hn::StoreU(hn::VecFromMask(di, point_valid(px, py, pz)), di, out.valid + x);
+        if (x + n >= w) break;
+    }
+}
+
+// Pixels x .. x + n - 1 of an unpacked row, from qn (0 where not valid), validity and z; and their validity bytes
+// unless `valid_bytes` is null.
+HWY_INLINE void store_quant_row(VI qx, VI qy, VI qz, MI valid, VF z, const QuantRow& out, std::size_t x,
+                                std::uint8_t* valid_bytes) {
+    const DF df;
+    const DI di;
+    const VI one = hn::IfThenElseZero(valid, hn::Set(di, 1));
+    hn::StoreU(qx, di, out.q[0] + x);
+    hn::StoreU(qy, di, out.q[1] + x);
+    hn::StoreU(qz, di, out.q[2] + x);
+    hn::StoreU(one, di, out.valid + x);
+    hn::StoreU(hn::IfThenElse(hn::RebindMask(df, valid), z, hn::Set(df, std::numeric_limits<float>::infinity())), df,
+               out.z + x);
+    if (valid_bytes != nullptr) {
+        const hn::Rebind<std::uint8_t, DI> d8;
+        hn::StoreU(hn::DemoteTo(d8, one), d8, valid_bytes + x);
+    }
+}
+
+// Pixel x of an unpacked row from the scalar code's quantized pixel of a point with depth z.
+void store_quant_pixel(const PyrQuant& q, float z, const QuantRow& out, std::size_t x) {
+    out.q[0][x] = q.qx;
+    out.q[1][x] = q.qy;
+    out.q[2][x] = q.qz;
+    out.valid[x] = q.valid != 0 ? 1 : 0;
+    out.z[x] = q.valid != 0 ? z : std::numeric_limits<float>::infinity();
+}
+
+// The sums of an unpacked row (QuantRow::sum) for pixels 1 .. w - 2 (the metric's vectors read them where the row is
+// at least a vector and two wide).
+void sum_quant_row(const QuantRow& r, std::uint32_t w) {
+    const DI di;
+    const std::size_t n = hn::Lanes(di);
+    const std::int32_t* const fields[4] = {r.q[0], r.q[1], r.q[2], r.valid};
+    std::int32_t* const sums[4] = {r.sum[0], r.sum[1], r.sum[2], r.sum[3]};
+    if (std::size_t(w) < n + 2) {
+        for (std::size_t x = 1; x + 1 < w; ++x) {
+            for (int f = 0; f < 4; ++f) sums[f][x] = fields[f][x - 1] + fields[f][x] + fields[f][x + 1];
+        }
+        return;
+    }
+    for_vectors(1, std::size_t(w) - 1, n, [&](std::size_t x) {
+        for (int f = 0; f < 4; ++f) {
+            const std::int32_t* v = fields[f];
+            hn::StoreU(hn::Add(hn::Add(hn::LoadU(di, v + x - 1), hn::LoadU(di, v + x)), hn::LoadU(di, v + x + 1)), di,
+                       sums[f] + x);
+        }
+    });
+}
+
+void normals_quant_row(const PassContext& c, const PointRow& up, const PointRow& row, const PointRow& down,
+                       std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* normals,
+                       std::uint32_t* quant, std::uint8_t* valid, const QuantRow& out, const ReadAhead& ahead) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    const auto scalar = [&](std::uint32_t x) {
+        const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, r);
+        float v[3];
+        store_normal(q, v);
+        if (normals != nullptr) std::copy_n(v, 3, normals + 3 * std::size_t(x));
+        const float* p = c.points + std::size_t(y) * c.row_floats + std::size_t(x) * c.point_floats;
+        const PyrQuant pq = kernels::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
+        if (quant != nullptr) store_quant(quant + kQuantWords * x, pq.qx, pq.qy, pq.qz, pq.valid, p[2]);
+        if (valid != nullptr) valid[x] = std::uint8_t(pq.valid);
+        store_quant_pixel(pq, p[2], out, x);
+    };
+    // Pixels r .. w - r - 1 have both horizontal neighbours; the others are the scalar code's.
+    if (std::size_t(w) < 2 * std::size_t(r) + n) {
+        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
+        sum_quant_row(out, w);
+        return;
+    }
+    const std::uint32_t x_end = w - r;
+    for (std::uint32_t x = 0; x < r; ++x) scalar(x);
+    for (std::uint32_t x = x_end; x < w; ++x) scalar(x);
+    const MI has_up_row = hn::Ne(hn::Set(di, y >= r ? 1 : 0), hn::Zero(di));
+    const MI has_down_row = hn::Ne(hn::Set(di, std::size_t(y) + r < h ? 1 : 0), hn::Zero(di));
+    const auto valid_at = [&](const PointRow& p, std::size_t x) { return hn::MaskFromVec(hn::LoadU(di, p.valid + x)); };
+    // Whole vectors (for_vectors), a block of them at a time in two loops: the first to the normals' directions
+    // (normal_direction_of), kept in `block`, the second from them to q and the stores. Each loop's chain of
+    // dependent operations is half the whole one, so the core overlaps more vectors (the whole chain, through a
+    // square root and a division, is longer than its out-of-order window holds). The rows' pointers are in locals,
+    // which the stores cannot change.
+    const PointRow u = up;
+    const PointRow m = row;
+    const PointRow d = down;
+    const QuantRow o = out;
+    constexpr std::size_t kBlock = 8;
+    HWY_ALIGN std::int32_t block[4][kBlock * kMaxLanes];  // dx, dy, dz, some (-1 or 0)
+    std::size_t at[kBlock];
+    std::size_t count = 0;
+    const auto run_block = [&] {
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t x = at[k];
+            const std::size_t xr = x + r;
+            const std::size_t xl = x - r;
+            VI dx, dy, dz;  // NOLINT(readability-isolate-declaration)
+            MI some;
+            normal_direction_of(hn::LoadU(df, m.x + x), hn::LoadU(df, m.y + x), hn::LoadU(df, m.z + x), valid_at(m, x),
+                                hn::LoadU(df, m.x + xr), hn::LoadU(df, m.y + xr), hn::LoadU(df, m.z + xr),
+                                valid_at(m, xr), hn::LoadU(df, m.x + xl), hn::LoadU(df, m.y + xl),
+                                hn::LoadU(df, m.z + xl), valid_at(m, xl), hn::LoadU(df, u.x + x),
+                                hn::LoadU(df, u.y + x), hn::LoadU(df, u.z + x), hn::And(has_up_row, valid_at(u, x)),
+                                hn::LoadU(df, d.x + x), hn::LoadU(df, d.y + x), hn::LoadU(df, d.z + x),
+                                hn::And(has_down_row, valid_at(d, x)), dx, dy, dz, some);
+            hn::Store(dx, di, block[0] + k * n);
+            hn::Store(dy, di, block[1] + k * n);
+            hn::Store(dz, di, block[2] + k * n);
+            hn::Store(hn::VecFromMask(di, some), di, block[3] + k * n);
+        }
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t x = at[k];
+            const VF cz = hn::LoadU(df, m.z + x);
+            VI qx, qy, qz;  // NOLINT(readability-isolate-declaration)
+            normal_from_direction(hn::Load(di, block[0] + k * n), hn::Load(di, block[1] + k * n),
+                                  hn::Load(di, block[2] + k * n), hn::MaskFromVec(hn::Load(di, block[3] + k * n)),
+                                  hn::LoadU(df, m.x + x), hn::LoadU(df, m.y + x), cz, qx, qy, qz);
+            if (normals != nullptr) store_normals(qx, qy, qz, normals + 3 * x);
+            if (quant != nullptr) store_quant_of_normal(qx, qy, qz, cz, quant + kQuantWords * x);
+            // Valid where q != 0 (store_quant_of_normal).
+            store_quant_row(qx, qy, qz, hn::Ne(hn::Or(hn::Or(qx, qy), qz), hn::Zero(di)), cz, o, x, valid);
+        }
+        count = 0;
+    };
+    ReadingAhead reading(ahead, r, x_end, n);
+    for_vectors(r, x_end, n, [&](std::size_t x) {
+        reading.step();
+        at[count++] = x;
+        if (count == kBlock) run_block();
+    });
+    run_block();
+    sum_quant_row(out, w);
+}
+
 // ---- Quantize (shaders/pyr_quantize.h)
 
 // pyr_quantize_component for finite n: clamp to [-1, 1] (Min/Max equal the scalar comparisons for finite n), the
@@ -393,6 +636,46 @@ void quantize_row(const float* points, std::size_t point_floats, const float* no
         hn::StoreInterleaved3(w0, w1, hn::BitCast(du, pz), du, out + kQuantWords * x);
         if (x + n >= w) break;
     }
+}
+
+void quantize_quant_row(const float* points, std::size_t point_floats, const float* normals, std::size_t normal_floats,
+                        std::uint32_t w, std::uint32_t* quant, std::uint8_t* valid, const QuantRow& out) {
+    const DF df;
+    const DI di;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    if (w < n) {
+        for (std::size_t x = 0; x < w; ++x) {
+            const float* p = points + x * point_floats;
+            const float* q = normals + x * normal_floats;
+            const PyrQuant v = kernels::pyr_quantize(p[0], p[1], p[2], q[0], q[1], q[2]);
+            if (quant != nullptr) store_quant(quant + kQuantWords * x, v.qx, v.qy, v.qz, v.valid, p[2]);
+            if (valid != nullptr) valid[x] = std::uint8_t(v.valid);
+            store_quant_pixel(v, p[2], out, x);
+        }
+        sum_quant_row(out, w);
+        return;
+    }
+    const VI low = hn::Set(di, 0xffff);
+    for (std::size_t x = 0;; x += n) {
+        x = std::min(x, std::size_t(w) - n);
+        VF px, py, pz, nx, ny, nz;  // NOLINT(readability-isolate-declaration)
+        load_row_points(df, points, point_floats, x, w, px, py, pz);
+        load_row_points(df, normals, normal_floats, x, w, nx, ny, nz);
+        // quantize_row's operations.
+        const MI is_valid = hn::And(point_valid(px, py, pz), normal_valid(nx, ny, nz));
+        const VI qx = hn::IfThenElseZero(is_valid, quantize_component(nx));
+        const VI qy = hn::IfThenElseZero(is_valid, quantize_component(ny));
+        const VI qz = hn::IfThenElseZero(is_valid, quantize_component(nz));
+        if (quant != nullptr) {
+            const VU w0 = hn::BitCast(du, hn::Or(hn::And(qx, low), hn::ShiftLeft<16>(qy)));
+            const VU w1 = hn::BitCast(du, hn::Or(hn::And(qz, low), hn::IfThenElseZero(is_valid, hn::Set(di, 1 << 16))));
+            hn::StoreInterleaved3(w0, w1, hn::BitCast(du, pz), du, quant + kQuantWords * x);
+        }
+        store_quant_row(qx, qy, qz, is_valid, pz, out, x, valid);
+        if (x + n >= w) break;
+    }
+    sum_quant_row(out, w);
 }
 
 // ---- The paper metric (shaders/pyr_metric.h)
@@ -534,6 +817,126 @@ void metric_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uin
             metric_vector(m, has_row, x - begin, tc, dt, out + x);
             if (x + n >= x1) break;
         }
+    }
+}
+
+// pyr_metric_fillable of pixel x from unpacked rows (rows[1] its own, rows[0] / rows[2] above / below or null): the
+// shared function on the image's part of the pixel's 3 x 3 box, packed into store_quant's words as an image of its
+// own, whose borders are the image's wherever the box meets them (so every neighbour test is the same).
+std::uint8_t metric_pixel(const QuantRow* const rows[3], std::uint32_t w, std::uint32_t x, std::int32_t tc, float dt) {
+    std::uint32_t words[9 * kQuantWords];
+    const std::uint32_t x0 = x > 0 ? x - 1 : 0;
+    const std::uint32_t x1 = std::min(w, x + 2);
+    const std::uint32_t box_w = x1 - x0;
+    std::uint32_t box_h = 0;
+    std::uint32_t box_y = 0;
+    for (int k = 0; k < 3; ++k) {
+        const QuantRow* row = rows[k];
+        if (row == nullptr) continue;
+        if (k == 1) box_y = box_h;
+        for (std::uint32_t i = x0; i < x1; ++i) {
+            store_quant(words + kQuantWords * (std::size_t(box_h) * box_w + (i - x0)), row->q[0][i], row->q[1][i],
+                        row->q[2][i], std::uint32_t(row->valid[i]), row->z[i]);
+        }
+        ++box_h;
+    }
+    PassContext c;
+    c.quant = words;
+    return std::uint8_t(kernels::pyr_metric_fillable(c, box_w, box_h, x - x0, box_y, tc, dt));
+}
+
+// pyr_metric_fillable for the pixels x .. x + n - 1 of a row, which have both horizontal neighbours, from the
+// unpacked rows (metric_vector's arithmetic): qn . (the 3 x 3 box of sums less the pixel's own qn), k from the
+// validity sums; each neighbour's |z - z_j| once. A neighbour that is not valid has z_j = +infinity: |z - z_j| is
+// +infinity where the pixel is valid (z finite), which leaves dmin as it is (Min with +infinity is exact on every
+// target, like Min of finite values), and dmax takes only the valid ones. In lanes whose pixel is not valid
+// (z = +infinity) the depths may be NaN; the result there is 0 whatever they are.
+template <bool kAbove, bool kBelow>
+HWY_INLINE void metric_quant_vector(const QuantRow& above, const QuantRow& row, const QuantRow& below, std::size_t x,
+                                    VI tc, VF dt, std::uint8_t* out) {
+    const DF df;
+    const DI di;
+    const hn::Rebind<std::uint8_t, DI> d8;
+    const auto box = [&](int f) {
+        VI s = hn::LoadU(di, row.sum[f] + x);
+        if constexpr (kAbove) s = hn::Add(s, hn::LoadU(di, above.sum[f] + x));
+        if constexpr (kBelow) s = hn::Add(s, hn::LoadU(di, below.sum[f] + x));
+        return s;
+    };
+    const VI qx = hn::LoadU(di, row.q[0] + x);
+    const VI qy = hn::LoadU(di, row.q[1] + x);
+    const VI qz = hn::LoadU(di, row.q[2] + x);
+    const VI s = hn::Add(hn::Add(hn::Mul(qx, hn::Sub(box(0), qx)), hn::Mul(qy, hn::Sub(box(1), qy))),
+                         hn::Mul(qz, hn::Sub(box(2), qz)));
+    const VI valid = hn::LoadU(di, row.valid + x);
+    const VI k = hn::Sub(box(3), valid);  // 0..8
+    const VF z = hn::LoadU(df, row.z + x);
+    const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+    VF dmin = inf;
+    VF dmax = hn::Zero(df);
+    const auto neighbour = [&](const float* at) {
+        const VF zj = hn::LoadU(df, at);
+        const VF dd = hn::Abs(hn::Sub(z, zj));
+        dmin = hn::Min(dmin, dd);
+        dmax = hn::IfThenElse(hn::Lt(zj, inf), hn::Max(dmax, dd), dmax);
+    };
+    if constexpr (kAbove) {
+        neighbour(above.z + x - 1);
+        neighbour(above.z + x);
+        neighbour(above.z + x + 1);
+    }
+    neighbour(row.z + x - 1);
+    neighbour(row.z + x + 1);
+    if constexpr (kBelow) {
+        neighbour(below.z + x - 1);
+        neighbour(below.z + x);
+        neighbour(below.z + x + 1);
+    }
+    // k * tc fits int32: k <= 8, tc in [-2^28, 2^26].
+    const MI curvature_ok = hn::Not(hn::Lt(s, hn::Mul(k, tc)));
+    const MI depth_ok = hn::RebindMask(di, hn::Le(hn::Sub(dmax, dmin), dt));
+    const MI fillable =
+        hn::And(hn::And(hn::Ne(valid, hn::Zero(di)), hn::Gt(k, hn::Zero(di))), hn::And(curvature_ok, depth_ok));
+    hn::StoreU(hn::DemoteTo(d8, hn::IfThenElseZero(fillable, hn::Set(di, 1))), d8, out + x);
+}
+
+template <bool kAbove, bool kBelow>
+void metric_quant_vectors(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
+                          std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    const VI tcv = hn::Set(di, tc);
+    const VF dtv = hn::Set(df, dt);
+    // The rows' pointers in locals, which the stores cannot change; a row outside the image is not read.
+    const QuantRow a = kAbove ? *above : row;
+    const QuantRow m = row;
+    const QuantRow b = kBelow ? *below : row;
+    ReadingAhead reading(ahead, 1, std::size_t(w) - 1, n);
+    for_vectors(1, std::size_t(w) - 1, n, [&](std::size_t x) {
+        reading.step();
+        metric_quant_vector<kAbove, kBelow>(a, m, b, x, tcv, dtv, out);
+    });
+}
+
+void metric_quant_row(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
+                      std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) {
+    const QuantRow* const rows[3] = {above, &row, below};
+    // Pixels 1 .. w - 2 by vectors where the rows have their sums (sum_quant_row), the others the scalar code's.
+    if (std::size_t(w) < hn::Lanes(DF()) + 2) {
+        for (std::uint32_t x = 0; x < w; ++x) out[x] = metric_pixel(rows, w, x, tc, dt);
+        return;
+    }
+    out[0] = metric_pixel(rows, w, 0, tc, dt);
+    out[w - 1] = metric_pixel(rows, w, w - 1, tc, dt);
+    if (above != nullptr && below != nullptr) {
+        metric_quant_vectors<true, true>(above, row, below, w, tc, dt, out, ahead);
+    } else if (above != nullptr) {
+        metric_quant_vectors<true, false>(above, row, below, w, tc, dt, out, ahead);
+    } else if (below != nullptr) {
+        metric_quant_vectors<false, true>(above, row, below, w, tc, dt, out, ahead);
+    } else {
+        metric_quant_vectors<false, false>(above, row, below, w, tc, dt, out, ahead);
     }
 }
 
@@ -915,9 +1318,10 @@ void compact_row(const std::uint32_t* raw, const std::uint32_t* lut, std::uint32
 }
 
 // This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
-constexpr RowKernels kKernels = {"",           HWY_TARGET,   &normals_row, &quantize_row,   &metric_row,
-                                 &mip_row,     &inherit_row, &edge_row,    &normals_to_row, &depth_row,
-                                 &column_step, &compact_row, &row_runs};
+constexpr RowKernels kKernels = {
+    "",           HWY_TARGET,        &normals_row,       &quantize_row,       &metric_row,      &mip_row,
+    &inherit_row, &edge_row,         &normals_to_row,    &depth_row,          &column_step,     &compact_row,
+    &row_runs,    &split_points_row, &normals_quant_row, &quantize_quant_row, &metric_quant_row};
 
 // Only returns the address of constant data; see available_targets.
 const RowKernels* get_kernels() {

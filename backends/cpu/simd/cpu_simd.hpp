@@ -26,6 +26,34 @@ struct PassContext;
 
 namespace pyrseg::cpu::simd {
 
+// The fused front end's rows (backends/cpu/points_to_mask.cpp), which only a thread's own window holds, as
+// structures of arrays of w elements each (vector loads at any offset, no deinterleaving).
+//
+// A row of points: the components and pyr_point_valid (-1 where valid, else 0).
+struct PointRow {
+    float* x = nullptr;
+    float* y = nullptr;
+    float* z = nullptr;
+    std::int32_t* valid = nullptr;
+};
+
+// A row of quantized pixels unpacked (the values of store_quant's words, as the paper metric reads them): qn (0
+// where not valid), validity (1 or 0), depth (z where valid, +infinity where not), and, for pixels 1 .. w - 2, the
+// sums of qx, qy, qz and validity over the pixel and its horizontal neighbours.
+struct QuantRow {
+    std::int32_t* q[3] = {nullptr, nullptr, nullptr};
+    std::int32_t* valid = nullptr;
+    float* z = nullptr;
+    std::int32_t* sum[4] = {nullptr, nullptr, nullptr, nullptr};
+};
+
+// Memory that the next row function will read and this one reads ahead into the L2 cache, a few lines with each of
+// its vectors (its arithmetic then hides the wait): the spans at[i] of `bytes` bytes each, null for none.
+struct ReadAhead {
+    const void* at[2] = {nullptr, nullptr};
+    std::size_t bytes = 0;
+};
+
 // The row functions of one Highway target. Rows are independent: the passes call these from many threads.
 struct RowKernels {
     const char* name = "";    // the PYRSEG_CPU_SIMD name
@@ -82,6 +110,27 @@ struct RowKernels {
     // (so labelled), else of the one right of it, and its marks are cleared; else it stays as it is. That is the
     // contract's sweep there and back along the row. Returns whether marks remain.
     bool (*row_runs)(const std::uint8_t* mask, std::uint32_t* row, std::uint64_t* marked, std::uint32_t w) = nullptr;
+
+    // The fused front end's row functions (PointRow, QuantRow above).
+    // One row of points (point_floats apart) split into `out`: w points.
+    void (*split_points_row)(const float* points, std::size_t point_floats, std::uint32_t w,
+                             const PointRow& out) = nullptr;
+    // Row y of the paper metric's normals with radius r and their quantized pixels (what normals_to_row writes),
+    // from the rows y - r (up), y (row) and y + r (down) split (`row` again for up / down outside the image; the
+    // image's columns x < r and x >= w - r read c's points). Into `out`, and into normals (3 floats a pixel),
+    // quant (kQuantWords words a pixel) and valid (a byte a pixel, 1 or 0) unless null.
+    void (*normals_quant_row)(const PassContext& c, const PointRow& up, const PointRow& row, const PointRow& down,
+                              std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* normals,
+                              std::uint32_t* quant, std::uint8_t* valid, const QuantRow& out,
+                              const ReadAhead& ahead) = nullptr;
+    // One row of quantize (what quantize_row writes) into `out`, and into quant and valid unless null.
+    void (*quantize_quant_row)(const float* points, std::size_t point_floats, const float* normals,
+                               std::size_t normal_floats, std::uint32_t w, std::uint32_t* quant, std::uint8_t* valid,
+                               const QuantRow& out) = nullptr;
+    // The paper metric of a row (what metric_row writes) from it, the row above and the row below (null outside the
+    // image).
+    void (*metric_quant_row)(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
+                             std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
