@@ -713,14 +713,32 @@ private:
         // from the last band up, each as far as it changes something. A row stepped again from a row that gained
         // labels meanwhile ends as one step from that row's final labels would leave it: labels only ever appear.
         // The edges the band pass left wait for the first part: after it only the rows the crossings reach change.
+        // Those edges read each row's candidates (edge_candidates), made once a row's labels are final for the pass
+        // and kept for the three rows around it, where one of them needs them.
+        if (edges && candidates_.size() < bands * 3 * w) candidates_.resize(bands * 3 * w);
+        const auto needs_candidates = [&](size_t y) {
+            return !settled(y) || (y > 0 && !settled(y - 1)) || (y + 1 < h && !settled(y + 1));
+        };
         pool_.parallel_for(bands, 1, [&](size_t b0, size_t b1) {
             for (size_t b = b0; b < b1; ++b) {
                 const size_t y0 = band_begin(b);
                 const size_t y1 = band_begin(b + 1);
                 std::uint8_t* scratch = valid_scratch_.empty() ? nullptr : valid_scratch_.data() + b * w;
+                uint32_t* ring = edges ? candidates_.data() + b * 3 * w : nullptr;
+                const auto candidates_of = [&](size_t y) { return ring + (y % 3) * w; };
+                const auto make_candidates = [&](size_t y) {
+                    if (edges && needs_candidates(y))
+                        simd_->edge_candidates(mask_of(y), row_of(y), uint32_t(w), candidates_of(y));
+                };
+                make_candidates(y1 - 1);
                 for (size_t y = y1 - 1; y-- > y0;) {
                     if (pending_[y] != 0) step(y, y + 1);
-                    if (edges && y + 2 < y1 && !settled(y + 1)) edge_row(c, lv, y + 1, scratch);
+                    make_candidates(y);
+                    if (edges && y + 2 < y1 && !settled(y + 1)) {
+                        simd_->edge_row_from_candidates(candidates_of(y), candidates_of(y + 1), candidates_of(y + 2),
+                                                        mask_of(y + 1), valid_row(c, y + 1, scratch), row_of(y + 1),
+                                                        uint32_t(w));
+                    }
                 }
             }
         });
@@ -773,6 +791,7 @@ private:
     // final_fill_rows, per row: kPending when marked pixels remain after the band pass, kLate when the upward
     // crossing changed it.
     std::vector<std::uint8_t> pending_;
+    std::vector<uint32_t> candidates_;  // final_fill_rows: three rows of edge candidates a band
     static constexpr std::uint8_t kPending = 1;
     static constexpr std::uint8_t kLate = 2;
     bool edges_fused_ = false;     // final_fill_rows labelled the edges too

@@ -1178,6 +1178,75 @@ void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const st
     for (; x < w; ++x) scalar(x);
 }
 
+// Step 6c's candidates of a row (cpu_simd.hpp): label - 1 where fillable (0 wraps to the largest value), the largest
+// value elsewhere, so that an edge pixel's label is one minimum of its neighbours' candidates.
+void edge_candidates(const std::uint8_t* mask, const std::uint32_t* labels, std::uint32_t w, std::uint32_t* out) {
+    std::size_t x = 0;
+#if HWY_TARGET != HWY_SCALAR
+    const DU du;
+    const hn::Rebind<std::uint8_t, DU> d8q;
+    const std::size_t n = hn::Lanes(du);
+    const VU one = hn::Set(du, 1u);
+    for (; x + n <= w; x += n) {
+        const VU not_fillable = hn::Sub(hn::And(hn::PromoteTo(du, hn::LoadU(d8q, mask + x)), one), one);
+        hn::StoreU(hn::Or(hn::Sub(hn::LoadU(du, labels + x), one), not_fillable), du, out + x);
+    }
+#endif
+    for (; x < w; ++x) out[x] = (mask[x] & PYR_MASK_FILLABLE) != 0 ? labels[x] - 1u : ~0u;
+}
+
+// edge_row from the rows' candidates (edge_candidates): the same labels with five loads and four minima a vector.
+void edge_row_from_candidates(const std::uint32_t* above, const std::uint32_t* row, const std::uint32_t* below,
+                              const std::uint8_t* mask, const std::uint8_t* valid, std::uint32_t* labels,
+                              std::uint32_t w) {
+    const auto scalar = [&](std::size_t x) {
+        if ((mask[x] & PYR_MASK_FILLABLE) != 0 || valid[x] == 0) return;
+        std::uint32_t best = labels[x] - 1u;
+        if (x > 0) best = std::min(best, row[x - 1]);
+        if (x + 1 < w) best = std::min(best, row[x + 1]);
+        if (above != nullptr) best = std::min(best, above[x]);
+        if (below != nullptr) best = std::min(best, below[x]);
+        labels[x] = best + 1u;
+    };
+    std::size_t x = 1;
+#if HWY_TARGET != HWY_SCALAR
+    const hn::ScalableTag<std::uint8_t> d8;
+    const DU du;
+    const std::size_t n8 = hn::Lanes(d8);
+    const std::size_t n = hn::Lanes(du);
+    const VU one = hn::Set(du, 1u);
+    const VU none = hn::Set(du, ~0u);
+    if (n8 % n == 0 && n8 <= 64) {
+        const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
+        const std::uint64_t part = n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+        for (; x + n8 + 1 <= w; x += n8) {
+            const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
+            const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
+            const auto edge = hn::AndNot(invalid, not_fillable);
+            if (hn::AllFalse(d8, edge)) continue;
+            std::uint8_t bytes[8] = {};
+            hn::StoreMaskBits(d8, edge, bytes);
+            std::uint64_t edges = 0;
+            std::memcpy(&edges, bytes, sizeof edges);
+            for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
+                const std::uint64_t bits = edges & part;
+                if (bits == 0) continue;
+                std::uint8_t lane_bytes[8] = {};
+                std::memcpy(lane_bytes, &bits, sizeof bits);
+                const VU own = hn::LoadU(du, labels + s);
+                const VU vertical = hn::Min(above != nullptr ? hn::LoadU(du, above + s) : none,
+                                            below != nullptr ? hn::LoadU(du, below + s) : none);
+                const VU best = hn::Min(hn::Min(hn::Sub(own, one), vertical),
+                                        hn::Min(hn::LoadU(du, row + s - 1), hn::LoadU(du, row + s + 1)));
+                hn::StoreU(hn::IfThenElse(hn::LoadMaskBits(du, lane_bytes), hn::Add(best, one), own), du, labels + s);
+            }
+        }
+    }
+#endif
+    if (w > 0) scalar(0);
+    for (; x < w; ++x) scalar(x);
+}
+
 // Step 6b's column step on one row's marked pixels (cpu_simd.hpp): a marked pixel takes the label of the pixel
 // next to it in the row the sweep comes from when that one is fillable and labelled (pyr_fill_step, once).
 bool column_step(const std::uint8_t* from_mask, const std::uint32_t* from, std::uint32_t* row, std::uint64_t* marked,
@@ -1233,18 +1302,28 @@ bool column_step(const std::uint8_t* from_mask, const std::uint32_t* from, std::
     return any;
 }
 
-// count copies of value from p on.
-HWY_INLINE void fill_run(std::uint32_t* p, std::size_t count, std::uint32_t value) {
-#if HWY_TARGET != HWY_SCALAR
-    const DU du;
-    const std::size_t n = hn::Lanes(du);
-    const VU v = hn::Set(du, value);
-    std::size_t k = 0;
-    for (; k + n <= count; k += n) hn::StoreU(v, du, p + k);
-    if (k < count) hn::BlendedStore(v, hn::FirstN(du, count - k), du, p + k);
+// Whether this target's BlendedStore writes only the lanes its mask selects. On NEON (and Highway's SSE4, SSSE3
+// and emulated targets) it loads the whole vector, blends and stores it back: lanes past a run would be written
+// again, past the row (another thread's row: its new labels lost) and past the buffer.
+#if HWY_TARGET == HWY_NEON || HWY_TARGET == HWY_SSE4 || HWY_TARGET == HWY_SSSE3 || HWY_TARGET == HWY_EMU128 || \
+    HWY_TARGET == HWY_SCALAR
+constexpr bool kMaskedStores = false;
 #else
-    std::fill_n(p, count, value);
+constexpr bool kMaskedStores = true;  // AVX2, AVX-512: masked moves; SVE: predicated stores
 #endif
+
+// count copies of value from p on, nothing past them.
+HWY_INLINE void fill_run(std::uint32_t* p, std::size_t count, std::uint32_t value) {
+    if constexpr (kMaskedStores) {
+        const DU du;
+        const std::size_t n = hn::Lanes(du);
+        const VU v = hn::Set(du, value);
+        std::size_t k = 0;
+        for (; k + n <= count; k += n) hn::StoreU(v, du, p + k);
+        if (k < count) hn::BlendedStore(v, hn::FirstN(du, count - k), du, p + k);
+    } else {
+        std::fill_n(p, count, value);
+    }
 }
 
 // Step 6a on one row (cpu_simd.hpp), run by run: on noisy masks a row has hundreds of runs, short ones, so nothing
@@ -1318,10 +1397,25 @@ void compact_row(const std::uint32_t* raw, const std::uint32_t* lut, std::uint32
 }
 
 // This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
-constexpr RowKernels kKernels = {
-    "",           HWY_TARGET,        &normals_row,       &quantize_row,       &metric_row,      &mip_row,
-    &inherit_row, &edge_row,         &normals_to_row,    &depth_row,          &column_step,     &compact_row,
-    &row_runs,    &split_points_row, &normals_quant_row, &quantize_quant_row, &metric_quant_row};
+constexpr RowKernels kKernels = {"",
+                                 HWY_TARGET,
+                                 &normals_row,
+                                 &quantize_row,
+                                 &metric_row,
+                                 &mip_row,
+                                 &inherit_row,
+                                 &edge_row,
+                                 &normals_to_row,
+                                 &depth_row,
+                                 &column_step,
+                                 &compact_row,
+                                 &row_runs,
+                                 &split_points_row,
+                                 &normals_quant_row,
+                                 &quantize_quant_row,
+                                 &metric_quant_row,
+                                 &edge_candidates,
+                                 &edge_row_from_candidates};
 
 // Only returns the address of constant data; see available_targets.
 const RowKernels* get_kernels() {

@@ -131,6 +131,15 @@ struct RowKernels {
     // image).
     void (*metric_quant_row)(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
                              std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) = nullptr;
+    // Step 6c's candidates of a row of the full level: out[x] = labels[x] - 1 (wrapping) where mask[x] is fillable,
+    // else the largest value; edge_row_from_candidates reads them in place of the labels and masks of the rows.
+    void (*edge_candidates)(const std::uint8_t* mask, const std::uint32_t* labels, std::uint32_t w,
+                            std::uint32_t* out) = nullptr;
+    // edge_row (the same labels) from the candidates of the rows above and below (null at the image's top and
+    // bottom) and of the row itself, with the row's mask, validity and labels.
+    void (*edge_row_from_candidates)(const std::uint32_t* above, const std::uint32_t* row, const std::uint32_t* below,
+                                     const std::uint8_t* mask, const std::uint8_t* valid, std::uint32_t* labels,
+                                     std::uint32_t w) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
