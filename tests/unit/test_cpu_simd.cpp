@@ -19,15 +19,13 @@
 #include <utility>
 #include <vector>
 
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include "backends/cpu/cpu_kernels.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "support/cpu_targets.hpp"
+#include "support/guarded_array.hpp"
 #include "support/oracle.hpp"
 
 namespace pyrseg::test {
@@ -326,34 +324,7 @@ TEST_P(CpuSimdRows, QuantizeMatchesTheSharedFunction) {
 
 // ---- The fused front end's rows (simd::PointRow, simd::QuantRow)
 
-// Floats at the very end of a readable mapping whose next page is not readable: a read past the last one faults.
-class GuardedFloats {
-public:
-    explicit GuardedFloats(const std::vector<float>& values) {
-        const auto page = std::size_t(sysconf(_SC_PAGESIZE));
-        const std::size_t bytes = values.size() * sizeof(float);
-        size_ = (bytes + page - 1) / page * page + page;
-        void* map = mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (map == MAP_FAILED) throw std::runtime_error("mmap failed");
-        base_ = static_cast<unsigned char*>(map);
-        unsigned char* guard = base_ + size_ - page;
-        if (mprotect(guard, page, PROT_NONE) != 0) throw std::runtime_error("mprotect failed");
-        data_ = reinterpret_cast<float*>(guard - bytes);
-        std::memcpy(data_, values.data(), bytes);
-    }
-    ~GuardedFloats() { munmap(base_, size_); }
-    GuardedFloats(const GuardedFloats&) = delete;
-    GuardedFloats& operator=(const GuardedFloats&) = delete;
-    GuardedFloats(GuardedFloats&&) = delete;
-    GuardedFloats& operator=(GuardedFloats&&) = delete;
-
-    [[nodiscard]] const float* data() const { return data_; }
-
-private:
-    unsigned char* base_ = nullptr;
-    std::size_t size_ = 0;
-    float* data_ = nullptr;
-};
+using GuardedFloats = GuardedArray<float>;
 
 // A layout's floats up to its last point's third, all a cloud must hold.
 std::vector<float> cloud_floats(const Layout& l, int w, int h) {

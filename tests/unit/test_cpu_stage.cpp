@@ -3,8 +3,6 @@
 // thin lines and single pixels, which make step 6's runs, blocks and band borders, at odd sizes) segmented on every
 // target against the scalar path, whose steps are the shared functions pixel by pixel.
 #include <gtest/gtest.h>
-#include <sys/mman.h>
-#include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -22,6 +20,7 @@
 #include "backends/cpu/union_find_fill.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "support/cpu_targets.hpp"
+#include "support/guarded_array.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -118,39 +117,6 @@ TEST_P(CpuStageRows, ColumnStepMatchesTheSharedFunction) {
     }
 }
 
-// Labels at the very end of a writable mapping whose next page is not accessible: a kernel that touches an element
-// past the last one (even to store back the value it read) faults.
-class GuardedLabels {
-public:
-    explicit GuardedLabels(const std::vector<std::uint32_t>& values) {
-        const auto page = std::size_t(sysconf(_SC_PAGESIZE));
-        const std::size_t bytes = values.size() * sizeof(std::uint32_t);
-        size_ = (bytes + page - 1) / page * page + page;
-        void* map = mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (map == MAP_FAILED) throw std::runtime_error("mmap failed");
-        base_ = static_cast<unsigned char*>(map);
-        unsigned char* guard = base_ + size_ - page;
-        if (mprotect(guard, page, PROT_NONE) != 0) throw std::runtime_error("mprotect failed");
-        data_ = reinterpret_cast<std::uint32_t*>(guard - bytes);
-        std::memcpy(data_, values.data(), bytes);
-        count_ = values.size();
-    }
-    ~GuardedLabels() { munmap(base_, size_); }
-    GuardedLabels(const GuardedLabels&) = delete;
-    GuardedLabels& operator=(const GuardedLabels&) = delete;
-    GuardedLabels(GuardedLabels&&) = delete;
-    GuardedLabels& operator=(GuardedLabels&&) = delete;
-
-    [[nodiscard]] std::uint32_t* data() { return data_; }
-    [[nodiscard]] std::vector<std::uint32_t> values() const { return {data_, data_ + count_}; }
-
-private:
-    unsigned char* base_ = nullptr;
-    std::size_t size_ = 0;
-    std::uint32_t* data_ = nullptr;
-    std::size_t count_ = 0;
-};
-
 // row_runs against the contract's step 6a written out (docs/algorithm.md section 5: left to right, then right to
 // left, an unlabelled fillable pixel takes the label of a fillable, labelled neighbour, visible to the next pixel),
 // on rows marked as inherit_row leaves them: runs of every length, across words, at the row's ends, whole rows.
@@ -197,7 +163,7 @@ TEST_P(CpuStageRows, RowRunsMatchTheContractsRowSweeps) {
             for (std::size_t i = 0; i + 1 < expected_marks.size(); ++i) expected_remain |= expected_marks[i] != 0;
             // The row ends where the mapping does (runs at its end must write nothing past it: on NEON a masked
             // store is a load and a store of the whole vector).
-            GuardedLabels guarded(row);
+            GuardedArray<std::uint32_t> guarded(row);
             const bool remain = k.row_runs(mask.data(), guarded.data(), marked.data(), w);
             row = guarded.values();
             ASSERT_EQ(row, expected) << "width " << w << " trial " << trial;

@@ -1109,6 +1109,42 @@ bool inherit_row(const std::uint8_t* mask, const std::uint32_t* parent, std::uin
     return any;
 }
 
+// Step 6c's vector loop over pixels 1 .. w - 2, shared by edge_row and edge_row_from_candidates: vectors of mask
+// bytes with no valid non-fillable pixel (most of a frame) are skipped, and so is each part of one, as wide as a
+// vector of labels, that has none (on fragmented masks most vectors of bytes have one, few parts do). Calls
+// part(s, is_edge) for the others (s: the part's first pixel; is_edge: a mask of its lanes) and returns the first
+// pixel it did not cover, from which the caller goes on one pixel at a time.
+template <class Part>
+HWY_INLINE std::size_t for_each_edge_part(const std::uint8_t* mask, const std::uint8_t* valid, std::uint32_t w,
+                                          const Part& part) {
+    const hn::ScalableTag<std::uint8_t> d8;
+    const DU du;
+    const std::size_t n8 = hn::Lanes(d8);
+    const std::size_t n = hn::Lanes(du);
+    std::size_t x = 1;
+    if (n8 % n != 0 || n8 > 64) return x;
+    const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
+    const std::uint64_t lanes = n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+    for (; x + n8 + 1 <= w; x += n8) {
+        const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
+        const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
+        const auto edge = hn::AndNot(invalid, not_fillable);
+        if (hn::AllFalse(d8, edge)) continue;
+        std::uint8_t bytes[8] = {};
+        hn::StoreMaskBits(d8, edge, bytes);
+        std::uint64_t edges = 0;
+        std::memcpy(&edges, bytes, sizeof edges);
+        for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
+            const std::uint64_t bits = edges & lanes;
+            if (bits == 0) continue;
+            std::uint8_t lane_bytes[8] = {};
+            std::memcpy(lane_bytes, &bits, sizeof bits);  // lanes are little-endian bits on every target
+            part(s, hn::LoadMaskBits(du, lane_bytes));
+        }
+    }
+    return x;
+}
+
 // The edge label of pixel x of the row (edge_row's rule), one pixel at a time: the image's borders and the tails.
 std::uint32_t edge_pixel(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
                          const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
@@ -1133,49 +1169,24 @@ void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const st
     const auto scalar = [&](std::size_t x) {
         labels[x] = edge_pixel(mask_above, mask, mask_below, above, labels, below, valid, w, std::uint32_t(x));
     };
-    const hn::ScalableTag<std::uint8_t> d8;
     const DU du;
     const hn::Rebind<std::uint8_t, DU> d8q;
-    const std::size_t n8 = hn::Lanes(d8);
-    const std::size_t n = hn::Lanes(du);
     const VU one = hn::Set(du, 1u);
     // Labels minus 1 of fillable neighbours, the largest value for the others (see edge_pixel).
     const auto candidate = [&](const std::uint32_t* l, const std::uint8_t* m) {
         const VU not_fillable = hn::Sub(hn::And(hn::PromoteTo(du, hn::LoadU(d8q, m)), one), one);
         return hn::Or(hn::Sub(hn::LoadU(du, l), one), not_fillable);
     };
-    std::size_t x = 1;
-    // Pixels 1 .. w - 2 by vectors of bytes; a vector with no valid non-fillable pixel (most of a frame) is skipped,
-    // and so is each part of one, as wide as a vector of labels, that has none (on fragmented masks most vectors of
-    // bytes have one, few parts do).
-    if (n8 % n == 0 && n8 <= 64) {
-        const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
-        const std::uint64_t part = n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
-        for (; x + n8 + 1 <= w; x += n8) {
-            const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
-            const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
-            const auto edge = hn::AndNot(invalid, not_fillable);
-            if (hn::AllFalse(d8, edge)) continue;
-            std::uint8_t bytes[8] = {};
-            hn::StoreMaskBits(d8, edge, bytes);
-            std::uint64_t edges = 0;
-            std::memcpy(&edges, bytes, sizeof edges);
-            for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
-                const std::uint64_t bits = edges & part;
-                if (bits == 0) continue;
-                std::uint8_t lane_bytes[8] = {};
-                std::memcpy(lane_bytes, &bits, sizeof bits);  // lanes are little-endian bits on every target
-                const VU own = hn::LoadU(du, labels + s);
-                VU best = hn::Min(hn::Sub(own, one), hn::Min(candidate(labels + s - 1, mask + s - 1),
-                                                             candidate(labels + s + 1, mask + s + 1)));
-                if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
-                if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
-                hn::StoreU(hn::IfThenElse(hn::LoadMaskBits(du, lane_bytes), hn::Add(best, one), own), du, labels + s);
-            }
-        }
-    }
+    const std::size_t x = for_each_edge_part(mask, valid, w, [&](std::size_t s, auto is_edge) {
+        const VU own = hn::LoadU(du, labels + s);
+        VU best = hn::Min(hn::Sub(own, one),
+                          hn::Min(candidate(labels + s - 1, mask + s - 1), candidate(labels + s + 1, mask + s + 1)));
+        if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
+        if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
+        hn::StoreU(hn::IfThenElse(is_edge, hn::Add(best, one), own), du, labels + s);
+    });
     if (w > 0) scalar(0);
-    for (; x < w; ++x) scalar(x);
+    for (std::size_t i = x; i < w; ++i) scalar(i);
 }
 
 // Step 6c's candidates of a row (cpu_simd.hpp): label - 1 where fillable (0 wraps to the largest value), the largest
@@ -1208,43 +1219,19 @@ void edge_row_from_candidates(const std::uint32_t* above, const std::uint32_t* r
         if (below != nullptr) best = std::min(best, below[x]);
         labels[x] = best + 1u;
     };
-    std::size_t x = 1;
-#if HWY_TARGET != HWY_SCALAR
-    const hn::ScalableTag<std::uint8_t> d8;
     const DU du;
-    const std::size_t n8 = hn::Lanes(d8);
-    const std::size_t n = hn::Lanes(du);
     const VU one = hn::Set(du, 1u);
     const VU none = hn::Set(du, ~0u);
-    if (n8 % n == 0 && n8 <= 64) {
-        const auto fillable_bit = hn::Set(d8, std::uint8_t{PYR_MASK_FILLABLE});
-        const std::uint64_t part = n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
-        for (; x + n8 + 1 <= w; x += n8) {
-            const auto not_fillable = hn::Eq(hn::And(hn::LoadU(d8, mask + x), fillable_bit), hn::Zero(d8));
-            const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
-            const auto edge = hn::AndNot(invalid, not_fillable);
-            if (hn::AllFalse(d8, edge)) continue;
-            std::uint8_t bytes[8] = {};
-            hn::StoreMaskBits(d8, edge, bytes);
-            std::uint64_t edges = 0;
-            std::memcpy(&edges, bytes, sizeof edges);
-            for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
-                const std::uint64_t bits = edges & part;
-                if (bits == 0) continue;
-                std::uint8_t lane_bytes[8] = {};
-                std::memcpy(lane_bytes, &bits, sizeof bits);
-                const VU own = hn::LoadU(du, labels + s);
-                const VU vertical = hn::Min(above != nullptr ? hn::LoadU(du, above + s) : none,
-                                            below != nullptr ? hn::LoadU(du, below + s) : none);
-                const VU best = hn::Min(hn::Min(hn::Sub(own, one), vertical),
-                                        hn::Min(hn::LoadU(du, row + s - 1), hn::LoadU(du, row + s + 1)));
-                hn::StoreU(hn::IfThenElse(hn::LoadMaskBits(du, lane_bytes), hn::Add(best, one), own), du, labels + s);
-            }
-        }
-    }
-#endif
+    const std::size_t x = for_each_edge_part(mask, valid, w, [&](std::size_t s, auto is_edge) {
+        const VU own = hn::LoadU(du, labels + s);
+        const VU vertical = hn::Min(above != nullptr ? hn::LoadU(du, above + s) : none,
+                                    below != nullptr ? hn::LoadU(du, below + s) : none);
+        const VU best = hn::Min(hn::Min(hn::Sub(own, one), vertical),
+                                hn::Min(hn::LoadU(du, row + s - 1), hn::LoadU(du, row + s + 1)));
+        hn::StoreU(hn::IfThenElse(is_edge, hn::Add(best, one), own), du, labels + s);
+    });
     if (w > 0) scalar(0);
-    for (; x < w; ++x) scalar(x);
+    for (std::size_t i = x; i < w; ++i) scalar(i);
 }
 
 // Step 6b's column step on one row's marked pixels (cpu_simd.hpp): a marked pixel takes the label of the pixel
