@@ -2,11 +2,14 @@
 // Shared helpers for the io tests: a scratch folder per test, raw file access, clouds to round-trip, and a PCD
 // builder that can produce what pyrseg's writer never does (F 8, I/U fields, padding, COUNT > 1).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -61,6 +64,35 @@ inline void write_bytes(const fs::path& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     ASSERT_TRUE(out.good()) << path;
+}
+
+// How `write` ends in a child process whose files may not grow past 64 KiB, as a full disk would stop it (the
+// limit is process-wide, hence the child): "no error", "io error naming <name>", or "other error".
+inline std::string outcome_of_write_past_size_limit(const std::function<void()>& write, const std::string& name) {
+    const pid_t child = ::fork();
+    if (child < 0) return "fork failed";
+    if (child == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);  // the write then fails with EFBIG instead of killing the process
+        const rlimit limit{rlim_t{64} * 1024, rlim_t{64} * 1024};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        try {
+            write();
+        } catch (const Error& e) {
+            const bool named = std::string(e.what()).find(name) != std::string::npos;
+            ::_exit(e.code() == ErrorCode::io && named ? 3 : 4);
+        }
+        ::_exit(0);
+    }
+    int status = 0;
+    if (::waitpid(child, &status, 0) != child || !WIFEXITED(status)) return "child did not exit";
+    switch (WEXITSTATUS(status)) {
+        case 0:
+            return "no error";
+        case 3:
+            return "io error naming " + name;
+        default:
+            return "other error";
+    }
 }
 
 // A small organized cloud: a tilted plane with a few NaN points (and NaN normals at the same pixels).
