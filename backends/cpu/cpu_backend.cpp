@@ -156,16 +156,38 @@ public:
         PassContext c = context();
         if (robust) {
             // Each pixel's tangents once, rather than once for every window that holds the pixel.
-            if (robust_texels_.empty()) robust_texels_.resize(plan_.pixel_count());  // once per Segmenter
-            rows(size_t(plan_.height), [&](size_t y) {
-                for (size_t x = 0; x < w; ++x) {
-                    robust_texels_[y * w + x] =
-                        kernels::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius, scale);
-                }
-            });
-            c.robust_texels = robust_texels_.data();
-            windows_.build(robust_texels_.data(), w, size_t(h), window,
+            c.robust_texels = robust_planes();
+            if (simd_ != nullptr) {
+                rows(size_t(h),
+                     [&](size_t y) { simd_->robust_texels_row(c, uint32_t(w), h, uint32_t(y), radius, scale); });
+            } else {
+                rows(size_t(h), [&](size_t y) {
+                    for (size_t x = 0; x < w; ++x) {
+                        c.robust_texels.store(y * w + x, kernels::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x),
+                                                                                   uint32_t(y), radius, scale));
+                    }
+                });
+            }
+            windows_.build(c.robust_texels, w, size_t(h), window, simd_,
                            [&](size_t n, const auto& body) { rows(n, body); });
+            if (simd_ != nullptr) {
+                // The vector rows take the windows inside the image's columns; the others are the scalar code's.
+                const size_t words = (w + 63) / 64;
+                if (robust_rest_.size() < size_t(h) * words) robust_rest_.resize(size_t(h) * words);  // once
+                rows(size_t(h), [&](size_t y) {
+                    std::uint64_t* rest = robust_rest_.data() + y * words;
+                    simd_->robust_normals_row(c, windows_.row(y), uint32_t(w), h, uint32_t(y), window,
+                                              normals_.data() + 3 * y * w, rest);
+                    for (size_t i = 0; i < words; ++i) {
+                        for (std::uint64_t bits = rest[i]; bits != 0; bits &= bits - 1) {
+                            const size_t x = i * 64 + size_t(std::countr_zero(bits));
+                            store_normal_q(robust_normal(c, x, y), normals_.data() + 3 * (y * w + x));
+                        }
+                    }
+                });
+                normals_estimated_ = true;
+                return;
+            }
         }
         if (!robust && simd_ != nullptr) {
             rows(size_t(plan_.height), [&](size_t y) {
@@ -178,10 +200,7 @@ public:
             for (size_t x = 0; x < w; ++x) {
                 const PyrIVec3 q = robust ? robust_normal(c, x, y)
                                           : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
-                float* n = normals_.data() + 3 * (y * w + x);
-                n[0] = float(q.x) * PYR_NORMAL_UNIT;
-                n[1] = float(q.y) * PYR_NORMAL_UNIT;
-                n[2] = float(q.z) * PYR_NORMAL_UNIT;
+                store_normal_q(q, normals_.data() + 3 * (y * w + x));
             }
         });
         normals_estimated_ = true;
@@ -213,10 +232,15 @@ public:
         const core::Thresholds t = plan_.thresholds;
         const bool robust = plan_.params.metric == Metric::robust;
         const auto stride = uint32_t(plan_.params.curvature_stride);
-        if (!robust && simd_ != nullptr) {
+        if (simd_ != nullptr) {
             rows(full.height, [&](size_t y) {
-                simd_->metric_row(c, full.width, full.height, uint32_t(y), t.curvature, t.depth,
-                                  mask_.data() + full.offset + y * full.width);
+                std::uint8_t* out = mask_.data() + full.offset + y * full.width;
+                if (robust) {
+                    simd_->metric_robust_row(c, full.width, full.height, uint32_t(y), stride, t.curvature_base,
+                                             t.curvature_growth, t.depth, t.depth_growth, out);
+                } else {
+                    simd_->metric_row(c, full.width, full.height, uint32_t(y), t.curvature, t.depth, out);
+                }
             });
             return;
         }
@@ -359,25 +383,76 @@ public:
             return;
         }
         // Several rounds: each one reads its neighbours' masks, which the round's own writes change, so it first
-        // computes every new label and then writes them (with the round in the mask).
+        // computes every new label and then writes them (with the round in the mask). A pixel can only take a label
+        // in a round after the first when a neighbour took one in the round before (only those became candidates),
+        // so a round skips the rows with no changed row next to them, and a round that labels nothing ends them.
+        const size_t h = full.height;
+        const size_t w = full.width;
         if (edge_next_.empty()) edge_next_.resize(plan_.pixel_count());  // once per Segmenter
+        if (edge_changed_.size() < 2 * h) edge_changed_.resize(2 * h);
+        std::uint8_t* changed = edge_changed_.data();  // this round's, per row
+        std::uint8_t* before = changed + h;            // the round before's
+        std::fill_n(changed, h, std::uint8_t{1});
+        const std::uint8_t* valid = validity_bytes(c);
         for (uint32_t round = 1; round <= rounds; ++round) {
-            rows(full.height, [&](size_t y) {
-                for (uint32_t x = 0; x < full.width; ++x) {
-                    edge_next_[y * full.width + x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
+            std::swap(changed, before);
+            const auto open = [&](size_t y) {
+                return round == 1 || before[y] != 0 || (y > 0 && before[y - 1] != 0) ||
+                       (y + 1 < h && before[y + 1] != 0);
+            };
+            rows(h, [&](size_t y) {
+                if (!open(y)) return;
+                uint32_t* next = edge_next_.data() + y * w;
+                if (simd_ != nullptr) {
+                    const size_t i = full.offset + y * w;
+                    const bool up = y > 0;
+                    const bool down = y + 1 < h;
+                    simd_->edge_round_row(up ? c.mask + i - w : nullptr, c.mask + i, down ? c.mask + i + w : nullptr,
+                                          up ? c.labels + i - w : nullptr, c.labels + i,
+                                          down ? c.labels + i + w : nullptr, valid + y * w, uint32_t(w), round, next);
+                } else {
+                    for (uint32_t x = 0; x < w; ++x) next[x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
                 }
             });
-            rows(full.height, [&](size_t y) {
-                for (uint32_t x = 0; x < full.width; ++x) {
-                    const uint32_t i = full.offset + uint32_t(y) * full.width + x;
-                    const uint32_t l = edge_next_[y * full.width + x];
-                    if (l == labels_[i]) continue;
-                    labels_[i] = l;
-                    if (round < rounds) mask_[i] = std::uint8_t(mask_[i] | (round << PYR_MASK_EDGE_SHIFT));
-                }
-                if (round == rounds) mark_row(y);
+            const auto round_bits = std::uint8_t(round < rounds ? round << PYR_MASK_EDGE_SHIFT : 0u);
+            rows(h, [&](size_t y) {
+                changed[y] = 0;
+                if (!open(y)) return;
+                changed[y] =
+                    std::uint8_t(apply_edge_round(edge_next_.data() + y * w, labels_.data() + full.offset + y * w,
+                                                  mask_.data() + full.offset + y * w, w, round_bits));
             });
+            if (std::find(changed, changed + h, std::uint8_t{1}) == changed + h) break;
         }
+        rows(h, [&](size_t y) { mark_row(y); });
+    }
+
+    // Writes a round's labels into a row, with round_bits in the masks of the pixels it changes; whether it changed
+    // one.
+    bool apply_edge_round(const uint32_t* next, uint32_t* labels, std::uint8_t* mask, size_t w,
+                          std::uint8_t round_bits) const {
+        if (simd_ != nullptr) return simd_->apply_edge_round(next, labels, mask, uint32_t(w), round_bits);
+        bool any = false;
+        for (size_t x = 0; x < w; ++x) {
+            if (next[x] == labels[x]) continue;
+            any = true;
+            labels[x] = next[x];
+            mask[x] = std::uint8_t(mask[x] | round_bits);
+        }
+        return any;
+    }
+
+    // Validity bytes of the full level: the caller's mask's or points_to_mask's, else made from the quantized
+    // pixels into mask_valid_ (unused in such a frame).
+    const std::uint8_t* validity_bytes(const PassContext& c) {
+        if (c.mask_valid != nullptr) return c.mask_valid;
+        const size_t w = plan_.width;
+        rows(size_t(plan_.height), [&](size_t y) {
+            std::uint8_t* out = mask_valid_.data() + y * w;
+            const uint32_t* q = c.quant + kQuantWords * y * w;
+            for (size_t x = 0; x < w; ++x) out[x] = std::uint8_t(q[kQuantWords * x + 1] >> 16);
+        });
+        return mask_valid_.data();
     }
 
     void compact(bool apply, bool after_edges) override {
@@ -461,6 +536,27 @@ public:
     }
 
 private:
+    static void store_normal_q(const PyrIVec3& q, float* n) {
+        n[0] = float(q.x) * PYR_NORMAL_UNIT;
+        n[1] = float(q.y) * PYR_NORMAL_UNIT;
+        n[2] = float(q.z) * PYR_NORMAL_UNIT;
+    }
+
+    // The robust texels' planes (RobustTexelPlanes) in robust_texels_, sized on first use.
+    RobustTexelPlanes robust_planes() {
+        const size_t pixels = plan_.pixel_count();
+        if (robust_texels_.empty()) robust_texels_.resize(8 * pixels);  // once per Segmenter
+        std::int32_t* p = robust_texels_.data();
+        RobustTexelPlanes planes;
+        planes.gz = p;
+        planes.tangents = reinterpret_cast<std::uint32_t*>(p + pixels);
+        for (size_t k = 0; k < 3; ++k) {
+            planes.th[k] = p + (2 + k) * pixels;
+            planes.tv[k] = p + (5 + k) * pixels;
+        }
+        return planes;
+    }
+
     // Section 8b's normal of pixel (x, y): from the box sums when its whole window is members, else the window
     // pixel by pixel (the shared function); the same words either way (backends/cpu/robust_windows.hpp).
     PyrIVec3 robust_normal(const PassContext& c, size_t x, size_t y) const {
@@ -771,11 +867,13 @@ private:
     ThreadPool pool_;
     CloudView cloud_{};
     core::CloudLayout layout_{};
-    std::vector<float> normals_;                 // estimated, packed
-    std::vector<PyrRobustTexel> robust_texels_;  // the robust normals' texels (metric robust only)
-    RobustWindows windows_;                      // their box sums and window depth ranges
-    std::vector<std::uint32_t> edge_next_;       // a round's new edge labels (edge_rounds > 1 only)
-    DepthView depth_{};                          // a depth frame, as the caller has it
+    std::vector<float> normals_;               // estimated, packed
+    std::vector<std::int32_t> robust_texels_;  // the robust normals' texels as 8 planes (metric robust only)
+    std::vector<std::uint64_t> robust_rest_;   // the pixels the robust normals' vector rows leave, a bit each
+    RobustWindows windows_;                    // their box sums and window depth ranges
+    std::vector<std::uint32_t> edge_next_;     // a round's new edge labels (edge_rounds > 1 only)
+    std::vector<std::uint8_t> edge_changed_;   // per row, whether a round changed it (edge_rounds > 1 only)
+    DepthView depth_{};                        // a depth frame, as the caller has it
     const core::DepthTables* depth_tables_ = nullptr;
     std::vector<float> depth_points_;       // its back-projection (depth frames only)
     std::vector<uint32_t> quant_;           // kQuantWords per pixel
@@ -817,14 +915,14 @@ size_t physical_memory_bytes() {
 // Bytes a CpuExecutor allocates (estimated normals counted: they are allocated on the first frame without normals).
 size_t memory_needed(const core::Plan& plan) {
     const size_t pixels = plan.pixel_count();
-    return pixels * (kQuantWords * sizeof(uint32_t) + 1 + 3 * sizeof(float)) +             // quant, validity, normals
-           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +         // masks, labels
-           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                               // compaction table
-           fill_scratch_size(plan) * sizeof(uint32_t) +                                    // union-find
-           plan.stats_words() * sizeof(uint32_t) +                                         // statistics
-           (plan.params.metric == Metric::robust ? pixels * sizeof(PyrRobustTexel) : 0) +  // robust normals' texels
-           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0) +            // edge rounds' labels
-           PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,              // its rows, per thread
+    return pixels * (kQuantWords * sizeof(uint32_t) + 1 + 3 * sizeof(float)) +      // quant, validity, normals
+           size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
+           (size_t(plan.max_label) + 1) * sizeof(uint32_t) +                        // compaction table
+           fill_scratch_size(plan) * sizeof(uint32_t) +                             // union-find
+           plan.stats_words() * sizeof(uint32_t) +                                  // statistics
+           (plan.params.metric == Metric::robust ? pixels * (sizeof(PyrRobustTexel) + 1) : 0) +  // texels, rest bits
+           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0) +                  // edge rounds' labels
+           PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,                    // its rows, per thread
                                        ThreadPool::default_size());
 }
 

@@ -29,6 +29,35 @@ inline std::int32_t quant_component(const std::uint32_t* quant, std::size_t i, i
     return static_cast<std::int16_t>((c & 1) != 0 ? word >> 16 : word & 0xffffu);
 }
 
+// The robust normals' texels (pyr_robust_texel) of a frame as planes of W x H elements, so that rows of them load as
+// vectors: G(z) (-1 where the point is not point-valid), the tangent bits, and t_h, t_v per component (0 where
+// missing).
+struct RobustTexelPlanes {
+    std::int32_t* gz = nullptr;
+    std::uint32_t* tangents = nullptr;
+    std::int32_t* th[3] = {nullptr, nullptr, nullptr};
+    std::int32_t* tv[3] = {nullptr, nullptr, nullptr};
+
+    void store(std::size_t i, const PyrRobustTexel& t) const {
+        gz[i] = t.gz;
+        tangents[i] = t.tangents;
+        th[0][i] = t.th.x;
+        th[1][i] = t.th.y;
+        th[2][i] = t.th.z;
+        tv[0][i] = t.tv.x;
+        tv[1][i] = t.tv.y;
+        tv[2][i] = t.tv.z;
+    }
+    [[nodiscard]] PyrRobustTexel load(std::size_t i) const {
+        PyrRobustTexel t{};
+        t.gz = gz[i];
+        t.tangents = tangents[i];
+        t.th = PyrIVec3{th[0][i], th[1][i], th[2][i]};
+        t.tv = PyrIVec3{tv[0][i], tv[1][i], tv[2][i]};
+        return t;
+    }
+};
+
 struct PassContext {
     const float* points = nullptr;             // the caller's cloud, strided
     std::size_t row_floats = 0;                // from one row to the next
@@ -38,8 +67,8 @@ struct PassContext {
     std::uint8_t* mask = nullptr;              // all levels
     std::uint32_t* labels = nullptr;           // all levels
     const std::uint32_t* lut = nullptr;
-    std::uint32_t* stats = nullptr;                 // the statistics words, PYR_STATS_WORDS per slot
-    const PyrRobustTexel* robust_texels = nullptr;  // the robust normals' texels of the frame, W*H
+    std::uint32_t* stats = nullptr;   // the statistics words, PYR_STATS_WORDS per slot
+    RobustTexelPlanes robust_texels;  // the robust normals' texels of the frame
 };
 
 inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
@@ -60,7 +89,7 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_QZ(i) std::bit_cast<float>(ctx.quant[::pyrseg::cpu::kQuantWords * static_cast<std::size_t>(i) + 2])
 // The robust normals read the texels estimate_normals computed once per frame (w: the image width, named by the
 // function it expands in).
-#define PYR_ROBUST_TEXEL(jx, jy) (ctx.robust_texels[static_cast<std::size_t>(jy) * (w) + (jx)])
+#define PYR_ROBUST_TEXEL(jx, jy) (ctx.robust_texels.load(static_cast<std::size_t>(jy) * (w) + (jx)))
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))

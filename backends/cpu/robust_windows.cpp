@@ -3,65 +3,55 @@
 #include <algorithm>
 
 namespace pyrseg::cpu {
-namespace {
-
-constexpr std::size_t kComponents = 6;
-
-void add_texel(std::uint32_t* dst, const PyrRobustTexel& t) {
-    // Missing tangents are zeros in a texel (pyr_robust_texel), so they add nothing.
-    dst[0] += std::uint32_t(t.th.x);
-    dst[1] += std::uint32_t(t.th.y);
-    dst[2] += std::uint32_t(t.th.z);
-    dst[3] += std::uint32_t(t.tv.x);
-    dst[4] += std::uint32_t(t.tv.y);
-    dst[5] += std::uint32_t(t.tv.z);
-}
-
-}  // namespace
 
 void RobustWindows::size(std::size_t width, std::size_t height, std::uint32_t window) {
     width_ = width;
     height_ = height;
     window_ = window;
-    const std::size_t stride = (width + 1) * kComponents;
-    table_.resize(stride * (height + 1));
+    table_.resize(kComponents * (width + 1) * (height + 1));
     row_min_.resize(width * height);
     row_max_.resize(width * height);
     min_.resize(width * height);
     max_.resize(width * height);
-    std::fill_n(table_.begin(), stride, 0u);
-}
-
-void RobustWindows::prefix_row(const PyrRobustTexel* texels, std::size_t y) {
-    const std::size_t stride = (width_ + 1) * kComponents;
-    std::uint32_t* row = table_.data() + (y + 1) * stride;
-    std::fill_n(row, kComponents, 0u);
-    for (std::size_t x = 0; x < width_; ++x) {
-        std::copy_n(row + x * kComponents, kComponents, row + (x + 1) * kComponents);
-        add_texel(row + (x + 1) * kComponents, texels[y * width_ + x]);
+    for (std::size_t k = 0; k < kComponents; ++k) {
+        std::fill_n(table_.begin() + std::ptrdiff_t(k * (height + 1) * (width + 1)), width + 1, 0u);
     }
 }
 
-void RobustWindows::accumulate_columns() {
-    const std::size_t stride = (width_ + 1) * kComponents;
+void RobustWindows::prefix_row(const RobustTexelPlanes& texels, std::size_t y) {
+    // Missing tangents are zeros in a texel (pyr_robust_texel), so they add nothing.
+    const std::int32_t* const components[kComponents] = {texels.th[0], texels.th[1], texels.th[2],
+                                                         texels.tv[0], texels.tv[1], texels.tv[2]};
+    for (std::size_t k = 0; k < kComponents; ++k) {
+        const std::int32_t* in = components[k] + y * width_;
+        std::uint32_t* row = table_.data() + (k * (height_ + 1) + y + 1) * (width_ + 1);
+        std::uint32_t sum = 0;
+        row[0] = 0;
+        for (std::size_t x = 0; x < width_; ++x) row[x + 1] = sum += std::uint32_t(in[x]);
+    }
+}
+
+void RobustWindows::accumulate_columns(std::size_t k) {
+    const std::size_t stride = width_ + 1;
+    std::uint32_t* plane = table_.data() + k * (height_ + 1) * stride;
     for (std::size_t y = 1; y <= height_; ++y) {
-        std::uint32_t* row = table_.data() + y * stride;
+        std::uint32_t* row = plane + y * stride;
         const std::uint32_t* above = row - stride;
-        for (std::size_t k = 0; k < stride; ++k) row[k] += above[k];
+        for (std::size_t x = 0; x < stride; ++x) row[x] += above[x];
     }
 }
 
-void RobustWindows::row_range(const PyrRobustTexel* texels, std::size_t y) {
+void RobustWindows::row_range(const RobustTexelPlanes& texels, std::size_t y) {
     const auto r = std::size_t(window_);
-    const PyrRobustTexel* in = texels + y * width_;
+    const std::int32_t* in = texels.gz + y * width_;
     for (std::size_t x = 0; x < width_; ++x) {
         const std::size_t x0 = x >= r ? x - r : 0;
         const std::size_t x1 = std::min(x + r, width_ - 1);
-        std::int32_t lo = in[x0].gz;
-        std::int32_t hi = in[x0].gz;
+        std::int32_t lo = in[x0];
+        std::int32_t hi = in[x0];
         for (std::size_t j = x0 + 1; j <= x1; ++j) {
-            lo = std::min(lo, in[j].gz);
-            hi = std::max(hi, in[j].gz);
+            lo = std::min(lo, in[j]);
+            hi = std::max(hi, in[j]);
         }
         row_min_[y * width_ + x] = lo;
         row_max_[y * width_ + x] = hi;
@@ -93,19 +83,28 @@ void RobustWindows::sums(std::size_t x, std::size_t y, PyrIVec3& u, PyrIVec3& v)
     const std::size_t x1 = std::min(x + r, width_ - 1) + 1;
     const std::size_t y0 = y >= r ? y - r : 0;
     const std::size_t y1 = std::min(y + r, height_ - 1) + 1;
-    const std::size_t stride = (width_ + 1) * kComponents;
-    const std::uint32_t* a = table_.data() + y1 * stride + x1 * kComponents;
-    const std::uint32_t* b = table_.data() + y0 * stride + x1 * kComponents;
-    const std::uint32_t* c = table_.data() + y1 * stride + x0 * kComponents;
-    const std::uint32_t* d = table_.data() + y0 * stride + x0 * kComponents;
     std::int32_t s[kComponents];
-    for (std::size_t k = 0; k < kComponents; ++k) s[k] = std::int32_t(a[k] - b[k] - c[k] + d[k]);
-    u.x = s[0];
-    u.y = s[1];
-    u.z = s[2];
-    v.x = s[3];
-    v.y = s[4];
-    v.z = s[5];
+    for (std::size_t k = 0; k < kComponents; ++k) {
+        const std::uint32_t* top = table_row(k, y0);
+        const std::uint32_t* bottom = table_row(k, y1);
+        s[k] = std::int32_t(bottom[x1] - top[x1] - bottom[x0] + top[x0]);
+    }
+    u = PyrIVec3{s[0], s[1], s[2]};
+    v = PyrIVec3{s[3], s[4], s[5]};
+}
+
+simd::RobustWindowRow RobustWindows::row(std::size_t y) const {
+    const auto r = std::size_t(window_);
+    const std::size_t y0 = y >= r ? y - r : 0;
+    const std::size_t y1 = std::min(y + r, height_ - 1) + 1;
+    simd::RobustWindowRow out;
+    for (std::size_t k = 0; k < kComponents; ++k) {
+        out.top[k] = table_row(k, y0);
+        out.bottom[k] = table_row(k, y1);
+    }
+    out.min = min_.data() + y * width_;
+    out.max = max_.data() + y * width_;
+    return out;
 }
 
 }  // namespace pyrseg::cpu

@@ -275,6 +275,57 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
     }
 }
 
+// Rounds 1 .. 12 of step 6c with several rounds: masks with earlier rounds in their upper bits (and rounds from later
+// ones, which must not count), labels on fillable pixels and on pixels labelled in a round; every pixel's label as
+// pyr_edge_label gives it, the row itself unchanged, nothing written past the row.
+TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
+    const simd::RowKernels& k = kernels_named(GetParam());
+    std::mt19937 rng(13);
+    std::size_t taken = 0;
+    for (const std::uint32_t w : kWidths) {
+        for (std::uint32_t h = 1; h <= 3; ++h) {
+            for (std::uint32_t round = 1; round <= 12; round += (w > 100 ? 5 : 1)) {
+                const std::size_t n = std::size_t(w) * h;
+                std::vector<std::uint8_t> mask(n);
+                std::vector<std::uint8_t> valid(n);
+                std::vector<std::uint32_t> labels(n);
+                for (std::size_t i = 0; i < n; ++i) {
+                    const bool fillable = rng() % 3 == 0;
+                    const std::uint32_t labelled_round = rng() % 2 == 0 ? 0u : std::uint32_t(rng() % 14 + 1);
+                    mask[i] = std::uint8_t((fillable ? PYR_MASK_FILLABLE : 0u) | (rng() % 2 != 0 ? 2u : 0u) |
+                                           (labelled_round << PYR_MASK_EDGE_SHIFT));
+                    valid[i] = std::uint8_t(rng() % 5 == 0 ? 0 : rng() % 255 + 1);
+                    const bool labelled = fillable ? rng() % 4 != 0 : labelled_round != 0;
+                    labels[i] = labelled ? std::uint32_t(rng() % (round % 2 == 0 ? 5 : 1000000) + 1) : 0u;
+                }
+                PassContext c;
+                c.mask = mask.data();
+                c.labels = labels.data();
+                c.mask_valid = valid.data();
+                const PyrLevel level{w, h, 0};
+                for (std::uint32_t y = 0; y < h; ++y) {
+                    const std::size_t i = std::size_t(y) * w;
+                    const bool up = y > 0;
+                    const bool down = y + 1 < h;
+                    GuardedArray<std::uint32_t> out(
+                        std::vector<std::uint32_t>(w, 0x5a5a5a5au));  // ends at a guard page
+                    k.edge_round_row(up ? mask.data() + i - w : nullptr, mask.data() + i,
+                                     down ? mask.data() + i + w : nullptr, up ? labels.data() + i - w : nullptr,
+                                     labels.data() + i, down ? labels.data() + i + w : nullptr, valid.data() + i, w,
+                                     round, out.data());
+                    for (std::uint32_t x = 0; x < w; ++x) {
+                        const std::uint32_t expected = kernels::pyr_edge_label(c, level, x, y, round);
+                        ASSERT_EQ(out.data()[x], expected)
+                            << w << "x" << h << " round " << round << " pixel " << x << "," << y;
+                        taken += expected != labels[i + x] ? 1 : 0;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(taken, 1000u) << "too few pixels labelled in a round to test much";
+}
+
 INSTANTIATE_TEST_SUITE_P(Targets, CpuStageRows, ::testing::ValuesIn(target_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 

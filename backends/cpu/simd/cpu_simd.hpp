@@ -54,6 +54,17 @@ struct ReadAhead {
     std::size_t bytes = 0;
 };
 
+// What the robust normals' vector rows read of the windows of one row y (backends/cpu/robust_windows.hpp): per
+// tangent component k (t_h x y z, t_v x y z) the rows y0 (top) and y1 + 1 (bottom) of its summed-area table (W + 1
+// entries each), y0 .. y1 being the window's rows clipped to the image; and the range of G(z) over each pixel's
+// window (W entries each).
+struct RobustWindowRow {
+    const std::uint32_t* top[6] = {};
+    const std::uint32_t* bottom[6] = {};
+    const std::int32_t* min = nullptr;
+    const std::int32_t* max = nullptr;
+};
+
 // The row functions of one Highway target. Rows are independent: the passes call these from many threads.
 struct RowKernels {
     const char* name = "";    // the PYRSEG_CPU_SIMD name
@@ -131,6 +142,37 @@ struct RowKernels {
     // image).
     void (*metric_quant_row)(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
                              std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) = nullptr;
+    // Round `round` >= 1 of step 6c with several rounds (pyr_edge_label) on one row of the full level: out[x] is the
+    // label pixel x gets in that round (its own where it takes none), for x < w; the masks hold the rounds before
+    // (bits PYR_MASK_EDGE_SHIFT and up), the rows above and below are null at the image's top and bottom.
+    void (*edge_round_row)(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+                           const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
+                           const std::uint8_t* valid, std::uint32_t w, std::uint32_t round,
+                           std::uint32_t* out) = nullptr;
+    // A round's labels (edge_round_row's `out`) into the row: labels[x] = next[x], and round_bits ORed into mask[x]
+    // where that changed the label, for x < w. Returns whether a label changed.
+    bool (*apply_edge_round)(const std::uint32_t* next, std::uint32_t* labels, std::uint8_t* mask, std::uint32_t w,
+                             std::uint8_t round_bits) = nullptr;
+    // The robust metric's rows (docs/algorithm.md sections 2b and 8b).
+    // Row y of the robust normals' texels with radius r (pyr_robust_texel): into c.robust_texels.
+    void (*robust_texels_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
+                              float scale) = nullptr;
+    // The smallest (lo) and largest (hi) of in[x - r .. x + r], clipped to 0 .. w - 1, for x < w: the robust windows'
+    // depth range along a row.
+    void (*robust_range_row)(const std::int32_t* in, std::uint32_t w, std::uint32_t r, std::int32_t* lo,
+                             std::int32_t* hi) = nullptr;
+    // Row y of the robust normals (pyr_robust_normal_q) with windows of radius `window`, as normals_row writes them,
+    // for each pixel whose window's columns lie inside the image: from the box sums (`sums`: RobustWindowRow) where
+    // the window's pixels are all members, else from the members pixel by pixel. The other pixels (the first and
+    // last `window` columns, or all of a row too narrow for a vector) are left to the caller, marked in `rest`
+    // ((w + 63) / 64 words, bit x % 64 of word x / 64; bits past w clear).
+    void (*robust_normals_row)(const PassContext& c, const RobustWindowRow& sums, std::uint32_t w, std::uint32_t h,
+                               std::uint32_t y, std::uint32_t window, float* out, std::uint64_t* rest) = nullptr;
+    // Row y of the robust metric (pyr_metric_robust_fillable) over c.quant with curvature stride `stride` and the
+    // thresholds' constants: w mask bytes, 1 where fillable.
+    void (*metric_robust_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y,
+                              std::uint32_t stride, float curvature_base, float curvature_growth, float dt,
+                              float depth_growth, std::uint8_t* out) = nullptr;
     // Step 6c's candidates of a row of the full level: out[x] = labels[x] - 1 (wrapping) where mask[x] is fillable,
     // else the largest value; edge_row_from_candidates reads them in place of the labels and masks of the rows.
     void (*edge_candidates)(const std::uint8_t* mask, const std::uint32_t* labels, std::uint32_t w,
