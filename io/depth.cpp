@@ -1,6 +1,7 @@
 // Depth images in (16-bit PNG through the PNG reader, TIFF through libtiff) and their back-projection.
 #include <tiffio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -37,8 +38,60 @@ struct TiffCloser {
     void operator()(TIFF* t) const { TIFFClose(t); }
 };
 
+// The most pixels a depth image may have: 2^28 (16384 x 16384, 1 GiB of float depth), far beyond any depth camera.
+// A compressed strip may expand beyond its size in the file, so the file's size alone does not bound the image.
+constexpr std::uint64_t kMaxDepthPixels = std::uint64_t{1} << 28;
+
+// How many bytes one byte of a strip can decode to, for the codecs whose bound is known; 0 for the others.
+std::uint64_t max_expansion(std::uint16_t compression) {
+    switch (compression) {
+        case COMPRESSION_NONE:
+            return 1;
+        case COMPRESSION_PACKBITS:
+            return 64;  // a 2-byte run of 128 bytes
+        case COMPRESSION_LZW:
+            return 4096;  // a 9- to 12-bit code stands for at most 4096 bytes
+        case COMPRESSION_ADOBE_DEFLATE:
+        case COMPRESSION_DEFLATE:
+            return 1032;  // deflate's limit
+        default:
+            return 0;
+    }
+}
+
+// The strips must lie inside the file and, where the codec's expansion is bounded, be able to hold the image;
+// checked before anything the size of the image is allocated.
+void check_strips(TIFF* tiff, const std::filesystem::path& path, std::uint64_t file_size, std::uint64_t image_bytes) {
+    const std::uint32_t strips = TIFFNumberOfStrips(tiff);
+    if (strips == 0) fail(ErrorCode::format, path, "TIFF without strips");
+    std::uint64_t stored = 0;
+    for (std::uint32_t s = 0; s < strips; ++s) {
+        int error = 0;
+        const std::uint64_t offset = TIFFGetStrileOffsetWithErr(tiff, s, &error);
+        const std::uint64_t bytes = error == 0 ? TIFFGetStrileByteCountWithErr(tiff, s, &error) : 0;
+        if (error != 0 || bytes == 0 || offset > file_size || bytes > file_size - offset) {
+            fail(ErrorCode::format, path,
+                 "TIFF strip " + std::to_string(s) + " of " + std::to_string(strips) + " (" + std::to_string(bytes) +
+                     " bytes at offset " + std::to_string(offset) + ") is not inside the file of " +
+                     std::to_string(file_size) + " bytes (truncated file?)");
+        }
+        stored += bytes;  // at most 65536 strips (one per row) of at most file_size bytes: no overflow
+    }
+    std::uint16_t compression = COMPRESSION_NONE;
+    TIFFGetFieldDefaulted(tiff, TIFFTAG_COMPRESSION, &compression);
+    const std::uint64_t ratio = max_expansion(compression);
+    if (ratio > 0 && stored < (image_bytes + ratio - 1) / ratio) {
+        fail(ErrorCode::format, path,
+             "the TIFF's strips hold " + std::to_string(stored) + " bytes" +
+                 (compression == COMPRESSION_NONE ? std::string()
+                                                  : " (expanding at most " + std::to_string(ratio) + "-fold)") +
+                 ", too few for the " + std::to_string(image_bytes) + " bytes of its image (truncated file?)");
+    }
+}
+
 DepthImage from_tiff(const std::filesystem::path& path) {
-    (void)detail::read_file(path);  // a clear io error for a missing file, a directory or a FIFO
+    // A clear io error for a missing file, a directory or a FIFO, and the size the strips are checked against.
+    const std::uint64_t file_size = detail::InputFile(path).size();
     TIFFSetErrorHandler(nullptr);
     TIFFSetWarningHandler(nullptr);
     const std::unique_ptr<TIFF, TiffCloser> tiff(TIFFOpen(path.c_str(), "r"));
@@ -67,19 +120,27 @@ DepthImage from_tiff(const std::filesystem::path& path) {
                                                 : "unsigned") +
                  " samples");
     }
-    if (width == 0 || height == 0 || width > 1u << 16 || height > 1u << 16) {
+    if (width == 0 || height == 0 || width > 1u << 16 || height > 1u << 16 ||
+        std::uint64_t{width} * height > kMaxDepthPixels) {
         fail(ErrorCode::format, path,
-             "TIFF size " + std::to_string(width) + " x " + std::to_string(height) + " is not a depth image size");
+             "TIFF size " + std::to_string(width) + " x " + std::to_string(height) +
+                 " is not a depth image size (at most 65536 on a side and " + std::to_string(kMaxDepthPixels) +
+                 " pixels)");
     }
+    if (TIFFIsTiled(tiff.get())) fail(ErrorCode::format, path, "unsupported TIFF layout (tiled)");
     const tmsize_t line = TIFFScanlineSize(tiff.get());
     if (line != tmsize_t(width) * (bits / 8)) fail(ErrorCode::format, path, "unsupported TIFF layout (tiled?)");
+    check_strips(tiff.get(), path, file_size, std::uint64_t(line) * height);
     DepthImage out{int(width), int(height), {}, is_float};
-    out.depth.resize(std::size_t(width) * height);
+    // Grown row by row as rows decode: an image whose codec's expansion is unbounded costs memory only for data
+    // that is really there.
+    out.depth.reserve(std::min<std::size_t>(std::size_t(width) * height, std::size_t{1} << 22));
     std::vector<unsigned char> row(static_cast<std::size_t>(line));
     for (std::uint32_t y = 0; y < height; ++y) {
         if (TIFFReadScanline(tiff.get(), row.data(), y, 0) != 1) {
             fail(ErrorCode::format, path, "TIFF data ends early (row " + std::to_string(y) + " unreadable)");
         }
+        out.depth.resize(out.depth.size() + width);
         float* dst = out.depth.data() + std::size_t(y) * width;
         for (std::uint32_t x = 0; x < width; ++x) {
             if (is_float) {
@@ -99,8 +160,8 @@ DepthImage from_tiff(const std::filesystem::path& path) {
 DepthImage read_depth_image(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".png") return from_png(path);
-    if (ext == ".tif" || ext == ".tiff") return from_tiff(path);
+    if (ext == ".png") return detail::guard_reader(path, [&] { return from_png(path); });
+    if (ext == ".tif" || ext == ".tiff") return detail::guard_reader(path, [&] { return from_tiff(path); });
     fail(ErrorCode::format, path, "unsupported depth image format '" + ext + "' (16-bit .png, or .tif/.tiff)");
 }
 

@@ -1,12 +1,15 @@
 #include "file_util.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -30,7 +33,7 @@ void fail(ErrorCode code, const std::filesystem::path& path, std::string_view wh
     throw Error(code, path.string() + ": " + std::string(what));
 }
 
-std::vector<unsigned char> read_file(const std::filesystem::path& path) {
+InputFile::InputFile(const std::filesystem::path& path) : path_(path) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
     if (ec || !std::filesystem::exists(status)) {
@@ -38,23 +41,107 @@ std::vector<unsigned char> read_file(const std::filesystem::path& path) {
     }
     if (std::filesystem::is_directory(status)) fail(ErrorCode::io, path, "cannot read: is a directory");
     if (!std::filesystem::is_regular_file(status)) fail(ErrorCode::io, path, "cannot read: not a regular file");
-
     errno = 0;
-    File file(std::fopen(path.c_str(), "rb"));
-    if (!file) fail(ErrorCode::io, path, "cannot open: " + errno_text(errno));
-
-    std::vector<unsigned char> bytes;
-    // The size is only a hint: the file may change under us, so read to the end rather than trusting it.
-    const auto hint = std::filesystem::file_size(path, ec);
-    if (!ec && hint < (std::size_t{1} << 40)) bytes.reserve(static_cast<std::size_t>(hint));
-    unsigned char chunk[1 << 16];
-    for (;;) {
-        const std::size_t n = std::fread(chunk, 1, sizeof chunk, file.get());
-        bytes.insert(bytes.end(), chunk, chunk + n);
-        if (n < sizeof chunk) break;
+    file_.reset(std::fopen(path.c_str(), "rb"));
+    if (!file_) fail(ErrorCode::io, path, "cannot open: " + errno_text(errno));
+    // The size of what was opened, not of what the name points to by now.
+    struct stat st {};
+    if (::fstat(::fileno(file_.get()), &st) != 0 || st.st_size < 0) {
+        fail(ErrorCode::io, path, "cannot read its size: " + errno_text(errno));
     }
-    if (std::ferror(file.get())) fail(ErrorCode::io, path, "read error: " + errno_text(errno));
-    return bytes;
+    size_ = static_cast<std::uint64_t>(st.st_size);
+}
+
+std::size_t InputFile::read_some_nothrow(void* out, std::size_t n) noexcept {
+    std::size_t done = 0;
+    while (done < n) {
+        const std::size_t got = std::fread(static_cast<unsigned char*>(out) + done, 1, n - done, file_.get());
+        if (got == 0) break;
+        done += got;
+    }
+    return done;
+}
+
+std::size_t InputFile::read_some(void* out, std::size_t n) {
+    const std::size_t got = read_some_nothrow(out, n);
+    if (got < n && std::ferror(file_.get())) fail(ErrorCode::io, path_, "read error: " + errno_text(errno));
+    return got;
+}
+
+void InputFile::read_exact(void* out, std::size_t n, std::string_view what) {
+    if (read_some(out, n) != n) {
+        fail(ErrorCode::format, path_, "the file ends before " + std::string(what) + " (truncated file?)");
+    }
+}
+
+void InputFile::seek(std::uint64_t offset) {
+    if (offset > static_cast<std::uint64_t>(std::numeric_limits<off_t>::max()) ||
+        ::fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0) {
+        fail(ErrorCode::io, path_, "cannot seek to byte " + std::to_string(offset));
+    }
+}
+
+namespace {
+constexpr std::size_t kLineBlock = std::size_t{1} << 20;
+}  // namespace
+
+LineReader::LineReader(InputFile& file, std::uint64_t start, std::size_t max_line)
+    : file_(file), max_line_(max_line), buffer_(kLineBlock) {
+    file_.seek(start);
+}
+
+bool LineReader::next(std::string_view& line) {
+    for (;;) {
+        const char* begin = buffer_.data() + begin_;
+        if (const void* nl = std::memchr(begin, '\n', end_ - begin_)) {
+            line = std::string_view(begin, static_cast<std::size_t>(static_cast<const char*>(nl) - begin));
+            begin_ += line.size() + 1;
+            return true;
+        }
+        if (eof_) {
+            if (begin_ == end_ || too_long_) return false;
+            line = std::string_view(begin, end_ - begin_);
+            begin_ = end_;
+            return true;
+        }
+        refill();
+    }
+}
+
+void LineReader::refill() {
+    if (end_ - begin_ > max_line_) {
+        too_long_ = true;
+        eof_ = true;
+        return;
+    }
+    std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
+    end_ -= begin_;
+    begin_ = 0;
+    if (buffer_.size() - end_ < kLineBlock) buffer_.resize(end_ + kLineBlock);
+    const std::size_t got = file_.read_some(buffer_.data() + end_, buffer_.size() - end_);
+    end_ += got;
+    if (got == 0) eof_ = true;
+}
+
+std::vector<unsigned char> read_head(InputFile& file, std::size_t max_bytes) {
+    std::vector<unsigned char> head(static_cast<std::size_t>(std::min<std::uint64_t>(max_bytes, file.size())));
+    head.resize(file.read_some(head.data(), head.size()));
+    return head;
+}
+
+std::vector<unsigned char> read_file(const std::filesystem::path& path, std::uint64_t max_bytes) {
+    return guard_reader(path, [&] {
+        InputFile file(path);
+        if (file.size() > max_bytes) {
+            fail(ErrorCode::format, path,
+                 "the file has " + std::to_string(file.size()) + " bytes, more than the " + std::to_string(max_bytes) +
+                     " this reader accepts");
+        }
+        // The size at opening bounds the read: a file that grows meanwhile cannot make it grow without end.
+        std::vector<unsigned char> bytes(static_cast<std::size_t>(file.size()));
+        bytes.resize(file.read_some(bytes.data(), bytes.size()));
+        return bytes;
+    });
 }
 
 void write_atomically(const std::filesystem::path& path,

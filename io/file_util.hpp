@@ -1,8 +1,14 @@
 #pragma once
-// Whole-file reads and writes with pyrseg::Error messages that name the file, shared by the format readers.
+// File reads and writes with pyrseg::Error messages that name the file, shared by the format readers.
 #include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <functional>
+#include <memory>
+#include <new>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,8 +21,87 @@ namespace pyrseg::io::detail {
 // "<path>: <what>", the shape every io message takes.
 [[noreturn]] void fail(ErrorCode code, const std::filesystem::path& path, std::string_view what);
 
-// The whole content of a regular file (directories, FIFOs and devices are refused: they would fail or never end).
-std::vector<unsigned char> read_file(const std::filesystem::path& path);
+// read_file's default limit: what is read whole (a calibration file) is small; the readers of large formats (PCD,
+// PLY, PNG, TIFF, .npy) read from an InputFile instead, bounded by what the header claims and the file holds.
+inline constexpr std::uint64_t kMaxWholeFile = std::uint64_t{1} << 30;
+
+// A regular file open for reading (directories, FIFOs and devices are refused: they would fail or never end), and
+// its size at opening. Readers check a format's magic and header from its first bytes before reading more, and
+// bound every read by what the file holds, so that a lying header or a huge sparse file costs an error, not memory.
+class InputFile {
+public:
+    explicit InputFile(const std::filesystem::path& path);
+
+    [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+    [[nodiscard]] std::uint64_t size() const { return size_; }
+    [[nodiscard]] std::FILE* get() const { return file_.get(); }
+
+    // Up to `n` bytes from the current position; fewer only at the end of the file. Throws ErrorCode::io on a read
+    // error; read_some_nothrow returns fewer bytes then (ferror(get()) tells), for callbacks of C libraries that must
+    // not be left by an exception.
+    std::size_t read_some(void* out, std::size_t n);
+    std::size_t read_some_nothrow(void* out, std::size_t n) noexcept;
+    // Exactly `n` bytes, or ErrorCode::format: "the file ends before <what> (truncated file?)".
+    void read_exact(void* out, std::size_t n, std::string_view what);
+    void seek(std::uint64_t offset);
+
+private:
+    struct Closer {
+        void operator()(std::FILE* f) const noexcept { std::fclose(f); }
+    };
+    std::filesystem::path path_;
+    std::unique_ptr<std::FILE, Closer> file_;
+    std::uint64_t size_ = 0;
+};
+
+// The lines of a file from byte `start` on, read a block at a time: a line longer than `max_line` bytes ends the
+// reading (too_long() tells) rather than being buffered whole (a sparse file of zeros is one line of gigabytes).
+class LineReader {
+public:
+    LineReader(InputFile& file, std::uint64_t start, std::size_t max_line);
+
+    // The next line without its '\n' (valid until the next call); false at the end of the file or of a too long line.
+    bool next(std::string_view& line);
+    [[nodiscard]] bool too_long() const { return too_long_; }
+
+private:
+    void refill();
+
+    InputFile& file_;
+    std::size_t max_line_;
+    std::vector<char> buffer_;
+    std::size_t begin_ = 0, end_ = 0;
+    bool eof_ = false, too_long_ = false;
+};
+
+// The first `max_bytes` bytes of the file (all of it when shorter).
+std::vector<unsigned char> read_head(InputFile& file, std::size_t max_bytes);
+
+// The whole content of a regular file of at most `max_bytes` bytes (ErrorCode::format naming the file otherwise).
+std::vector<unsigned char> read_file(const std::filesystem::path& path, std::uint64_t max_bytes = kMaxWholeFile);
+
+// Runs a reader's body so that nothing but a pyrseg::Error naming the file leaves it: std::bad_alloc becomes
+// ErrorCode::out_of_memory, any other exception (from a library the reader calls) ErrorCode::format.
+template <typename Body>
+auto guard_reader(const std::filesystem::path& path, Body&& body) -> decltype(body()) {
+    try {
+        return body();
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        fail(ErrorCode::out_of_memory, path, "out of memory reading the file");
+    } catch (const std::length_error&) {
+        fail(ErrorCode::out_of_memory, path, "the file asks for more memory than can be addressed");
+    } catch (const std::exception& e) {
+        fail(ErrorCode::format, path, std::string("cannot read: ") + e.what());
+    } catch (...) {
+        fail(ErrorCode::format, path, "cannot read: unknown error");
+    }
+}
+
+// read_npy, calling `check` with the array's header (dtype and shape; no bytes yet) before its data is read, so
+// that a caller's limits on the shape apply before the data costs memory.
+NpyArray read_npy(const std::filesystem::path& path, const std::function<void(const NpyArray& header)>& check);
 
 // Writes into a temporary file beside `path` and renames it over `path` once complete, so that a failure (a full
 // disk, an exception, a crash) leaves either the old file or none, never a partial one.

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <charconv>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -23,6 +24,7 @@ static_assert(std::endian::native == std::endian::little, "npy '<' dtypes are wr
 constexpr char kMagic[] = "\x93NUMPY";
 constexpr std::size_t kMagicLen = 6;
 constexpr std::size_t kAlign = 64;
+constexpr std::uint64_t kMaxHeader = std::uint64_t{1} << 20;
 
 std::string shape_repr(const std::vector<std::size_t>& shape) {
     std::string s = "(";
@@ -191,52 +193,74 @@ void write_npy(const std::filesystem::path& path, const float* data, int height,
 }
 
 NpyArray read_npy(const std::filesystem::path& path) {
-    const std::vector<unsigned char> bytes = detail::read_file(path);
-    if (bytes.size() < kMagicLen + 4 || std::memcmp(bytes.data(), kMagic, kMagicLen) != 0) {
-        fail(ErrorCode::format, path, "not a .npy file (no \\x93NUMPY magic)");
-    }
-    const unsigned major = bytes[6], minor = bytes[7];
-    if ((major != 1 && major != 2 && major != 3) || minor != 0) {
-        fail(ErrorCode::format, path,
-             "npy format version " + std::to_string(major) + "." + std::to_string(minor) + " is not supported");
-    }
-    std::size_t prefix = 10;
-    std::uint64_t header_len = static_cast<std::uint64_t>(bytes[8]) | static_cast<std::uint64_t>(bytes[9]) << 8;
-    if (major >= 2) {
-        if (bytes.size() < 12) fail(ErrorCode::format, path, "truncated npy header");
-        header_len |= static_cast<std::uint64_t>(bytes[10]) << 16 | static_cast<std::uint64_t>(bytes[11]) << 24;
-        prefix = 12;
-    }
-    if (header_len > bytes.size() - prefix) {
-        fail(ErrorCode::format, path,
-             "header length " + std::to_string(header_len) + " exceeds the " + std::to_string(bytes.size() - prefix) +
-                 " bytes left in the file (truncated file?)");
-    }
-    const std::string_view header(reinterpret_cast<const char*>(bytes.data()) + prefix,
-                                  static_cast<std::size_t>(header_len));
-    NpyArray a = HeaderParser(header, path).parse();
-
-    const std::size_t item = item_size(a.dtype);
-    if (item == 0) {
-        fail(ErrorCode::format, path,
-             "dtype '" + a.dtype + "' is not supported (little-endian bool, int, uint, float or complex only)");
-    }
-    std::uint64_t total = item;
-    for (const std::size_t d : a.shape) {
-        if (d != 0 && total > std::numeric_limits<std::uint64_t>::max() / d) {
-            fail(ErrorCode::format, path, "shape " + shape_repr(a.shape) + " overflows");
-        }
-        total *= d;
-    }
-    const std::uint64_t left = bytes.size() - prefix - header_len;
-    if (total != left) {
-        fail(ErrorCode::format, path,
-             "shape " + shape_repr(a.shape) + " of '" + a.dtype + "' needs " + std::to_string(total) +
-                 " bytes of data, the file has " + std::to_string(left) + (total > left ? " (truncated file?)" : ""));
-    }
-    const auto begin = bytes.begin() + static_cast<std::ptrdiff_t>(prefix + header_len);
-    a.bytes.assign(begin, bytes.end());
-    return a;
+    return detail::read_npy(path, [](const NpyArray&) {});
 }
+
+namespace detail {
+
+NpyArray read_npy(const std::filesystem::path& path, const std::function<void(const NpyArray& header)>& check) {
+    return guard_reader(path, [&] {
+        InputFile file(path);
+        // The magic, version and header length first: a file that is not .npy costs 12 bytes of reading.
+        const std::vector<unsigned char> start = read_head(file, 12);
+        if (start.size() < kMagicLen + 4 || std::memcmp(start.data(), kMagic, kMagicLen) != 0) {
+            fail(ErrorCode::format, path, "not a .npy file (no \\x93NUMPY magic)");
+        }
+        const unsigned major = start[6], minor = start[7];
+        if ((major != 1 && major != 2 && major != 3) || minor != 0) {
+            fail(ErrorCode::format, path,
+                 "npy format version " + std::to_string(major) + "." + std::to_string(minor) + " is not supported");
+        }
+        std::size_t prefix = 10;
+        std::uint64_t header_len = static_cast<std::uint64_t>(start[8]) | static_cast<std::uint64_t>(start[9]) << 8;
+        if (major >= 2) {
+            if (start.size() < 12) fail(ErrorCode::format, path, "truncated npy header");
+            header_len |= static_cast<std::uint64_t>(start[10]) << 16 | static_cast<std::uint64_t>(start[11]) << 24;
+            prefix = 12;
+        }
+        if (header_len > file.size() - prefix) {
+            fail(ErrorCode::format, path,
+                 "header length " + std::to_string(header_len) + " exceeds the " +
+                     std::to_string(file.size() - prefix) + " bytes left in the file (truncated file?)");
+        }
+        // numpy itself refuses headers over 10000 bytes unless told otherwise; a dict of a dtype and a shape
+        // never needs more.
+        if (header_len > kMaxHeader) {
+            fail(ErrorCode::format, path,
+                 "header length " + std::to_string(header_len) + " is more than the " + std::to_string(kMaxHeader) +
+                     " bytes a .npy header may have here");
+        }
+        std::string header(static_cast<std::size_t>(header_len), '\0');
+        file.seek(prefix);
+        file.read_exact(header.data(), header.size(), "the end of the header");
+        NpyArray a = HeaderParser(header, path).parse();
+
+        const std::size_t item = item_size(a.dtype);
+        if (item == 0) {
+            fail(ErrorCode::format, path,
+                 "dtype '" + a.dtype + "' is not supported (little-endian bool, int, uint, float or complex only)");
+        }
+        std::uint64_t total = item;
+        for (const std::size_t d : a.shape) {
+            if (d != 0 && total > std::numeric_limits<std::uint64_t>::max() / d) {
+                fail(ErrorCode::format, path, "shape " + shape_repr(a.shape) + " overflows");
+            }
+            total *= d;
+        }
+        const std::uint64_t left = file.size() - prefix - header_len;
+        if (total != left) {
+            fail(ErrorCode::format, path,
+                 "shape " + shape_repr(a.shape) + " of '" + a.dtype + "' needs " + std::to_string(total) +
+                     " bytes of data, the file has " + std::to_string(left) +
+                     (total > left ? " (truncated file?)" : ""));
+        }
+        check(a);
+        a.bytes.resize(static_cast<std::size_t>(total));
+        file.read_exact(a.bytes.data(), a.bytes.size(), "the end of the array data");
+        return a;
+    });
+}
+
+}  // namespace detail
 
 }  // namespace pyrseg::io

@@ -2,6 +2,7 @@
 // it claims are checked against the bytes actually in the file, so a lying header costs an error, not memory.
 #include <lzf.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -29,6 +30,10 @@ static_assert(std::endian::native == std::endian::little, "PCD binary reading as
 
 // LZF copies at most 264 bytes per 3-byte back reference, so no valid block expands more than 88 times.
 constexpr std::uint64_t kMaxLzfRatio = 88;
+// A PCD header is a dozen short lines; one of more than this is not a PCD's.
+constexpr std::size_t kMaxHeaderBytes = std::size_t{1} << 20;
+// Binary data is read in blocks of this size.
+constexpr std::size_t kStreamBytes = std::size_t{1} << 20;
 
 float load_float(const unsigned char* p, int size) {
     if (size == 8) {
@@ -56,49 +61,71 @@ void allocate(const PcdHeader& h, io::PointCloud& cloud) {
     if (h.normal[0] >= 0) cloud.normals.resize(3 * h.points);
 }
 
-// binary is array-of-structures; binary_compressed (soa) stores each field's values for all points together.
-void gather_all(const PcdHeader& h, const unsigned char* data, bool soa, io::PointCloud& cloud) {
-    auto field_base = [&](const PcdField& f) { return data + (soa ? f.offset * h.points : f.offset); };
-    auto stride = [&](const PcdField& f) { return soa ? f.bytes() : h.point_size; };
+// Points first .. first + n of DATA binary (array-of-structures), at `data`.
+void gather_points(const PcdHeader& h, const unsigned char* data, std::uint64_t first, std::uint64_t n,
+                   io::PointCloud& cloud) {
     for (int c = 0; c < 3; ++c) {
         const PcdField& f = h.fields[static_cast<std::size_t>(h.xyz[c])];
-        gather(field_base(f), stride(f), f.size, h.points, cloud.points.data(), c);
+        gather(data + f.offset, h.point_size, f.size, n, cloud.points.data() + 3 * first, c);
     }
     if (h.normal[0] < 0) return;
     for (int c = 0; c < 3; ++c) {
         const PcdField& f = h.fields[static_cast<std::size_t>(h.normal[c])];
-        gather(field_base(f), stride(f), f.size, h.points, cloud.normals.data(), c);
+        gather(data + f.offset, h.point_size, f.size, n, cloud.normals.data() + 3 * first, c);
     }
 }
 
-void read_binary(const PcdHeader& h, const std::vector<unsigned char>& bytes, const std::filesystem::path& path,
-                 io::PointCloud& cloud) {
-    const std::uint64_t left = bytes.size() - h.data_offset;
+// binary_compressed stores each field's values for all points together.
+void gather_soa(const PcdHeader& h, const unsigned char* data, io::PointCloud& cloud) {
+    for (int c = 0; c < 3; ++c) {
+        const PcdField& f = h.fields[static_cast<std::size_t>(h.xyz[c])];
+        gather(data + f.offset * h.points, f.bytes(), f.size, h.points, cloud.points.data(), c);
+    }
+    if (h.normal[0] < 0) return;
+    for (int c = 0; c < 3; ++c) {
+        const PcdField& f = h.fields[static_cast<std::size_t>(h.normal[c])];
+        gather(data + f.offset * h.points, f.bytes(), f.size, h.points, cloud.normals.data(), c);
+    }
+}
+
+void read_binary(const PcdHeader& h, detail::InputFile& file, io::PointCloud& cloud) {
+    const std::uint64_t left = file.size() - h.data_offset;
     const std::uint64_t needed = h.points * h.point_size;  // < 2^31 * 2^32: no overflow
     if (needed > left) {
-        fail(ErrorCode::format, path,
+        fail(ErrorCode::format, file.path(),
              "DATA binary: " + std::to_string(h.points) + " points of " + std::to_string(h.point_size) +
                  " bytes need " + std::to_string(needed) + " bytes, but only " + std::to_string(left) +
                  " follow the header (truncated file, or wrong WIDTH/HEIGHT/POINTS/SIZE?)");
     }
-    // Bytes beyond the data are allowed: PCL's writers padded files to a page boundary.
+    // Bytes beyond the data are allowed (PCL's writers padded files to a page boundary) and never read.
     allocate(h, cloud);
-    gather_all(h, bytes.data() + h.data_offset, false, cloud);
+    // Streamed a block of points at a time: the data is never held whole beside the cloud.
+    const std::uint64_t block = std::max<std::uint64_t>(1, kStreamBytes / h.point_size);
+    std::vector<unsigned char> buffer(static_cast<std::size_t>(std::min(block, h.points) * h.point_size));
+    file.seek(h.data_offset);
+    for (std::uint64_t first = 0; first < h.points; first += block) {
+        const std::uint64_t n = std::min(block, h.points - first);
+        file.read_exact(buffer.data(), static_cast<std::size_t>(n * h.point_size),
+                        "point " + std::to_string(first + n) + " of DATA binary");
+        gather_points(h, buffer.data(), first, n, cloud);
+    }
 }
 
-void read_compressed(const PcdHeader& h, const std::vector<unsigned char>& bytes, const std::filesystem::path& path,
-                     io::PointCloud& cloud) {
+void read_compressed(const PcdHeader& h, detail::InputFile& file, io::PointCloud& cloud) {
+    const std::filesystem::path& path = file.path();
     const std::string what = "DATA binary_compressed: ";
-    const std::uint64_t left = bytes.size() - h.data_offset;
+    const std::uint64_t left = file.size() - h.data_offset;
     if (left < 8) {
         fail(ErrorCode::format, path,
              what + "the file ends " + std::to_string(left) +
                  " bytes after the header, before the two block sizes (truncated file?)");
     }
-    const unsigned char* p = bytes.data() + h.data_offset;
+    unsigned char sizes[8];
+    file.seek(h.data_offset);
+    file.read_exact(sizes, sizeof sizes, "the two block sizes of DATA binary_compressed");
     std::uint32_t compressed = 0, uncompressed = 0;
-    std::memcpy(&compressed, p, 4);
-    std::memcpy(&uncompressed, p + 4, 4);
+    std::memcpy(&compressed, sizes, 4);
+    std::memcpy(&uncompressed, sizes + 4, 4);
     const std::uint64_t needed = h.points * h.point_size;
     if (uncompressed != needed) {
         fail(ErrorCode::format, path,
@@ -116,9 +143,12 @@ void read_compressed(const PcdHeader& h, const std::vector<unsigned char>& bytes
              what + "compressed size " + std::to_string(compressed) + " is too small to hold " +
                  std::to_string(uncompressed) + " bytes of LZF data");
     }
+    // Both sizes are now bounded by the file's: the block is in the file, and LZF expands it at most 88-fold.
+    std::vector<unsigned char> block(compressed);
+    file.read_exact(block.data(), block.size(), "the end of the compressed block");
     std::vector<unsigned char> raw(uncompressed);
     errno = 0;
-    const unsigned got = lzf_decompress(p + 8, compressed, raw.data(), uncompressed);
+    const unsigned got = lzf_decompress(block.data(), compressed, raw.data(), uncompressed);
     if (got == 0) {
         fail(ErrorCode::format, path,
              what + (errno == E2BIG ? "LZF data expands past the uncompressed size " + std::to_string(uncompressed)
@@ -129,8 +159,9 @@ void read_compressed(const PcdHeader& h, const std::vector<unsigned char>& bytes
              what + "LZF data expands to " + std::to_string(got) + " bytes, not the " + std::to_string(uncompressed) +
                  " the header promises");
     }
+    block = {};
     allocate(h, cloud);
-    gather_all(h, raw.data(), true, cloud);
+    gather_soa(h, raw.data(), cloud);
 }
 
 // from_chars accepts nan and inf in any case but no leading '+', which some writers emit.
@@ -143,10 +174,11 @@ bool parse_number(std::string_view token, T& value) {
 
 class AsciiReader {
 public:
-    AsciiReader(const PcdHeader& h, const std::vector<unsigned char>& bytes, const std::filesystem::path& path)
+    AsciiReader(const PcdHeader& h, detail::InputFile& file)
         : h_(h),
-          text_(reinterpret_cast<const char*>(bytes.data()) + h.data_offset, bytes.size() - h.data_offset),
-          path_(path) {
+          data_bytes_(file.size() - h.data_offset),
+          path_(file.path()),
+          lines_(file, h.data_offset, max_line(h)) {
         check_size();  // first: it also bounds values_per_point, and so targets_, by the file's size
         // Which output float, if any, each value of a line feeds: -1 skip, 0..2 point xyz, 3..5 normal xyz.
         for (std::size_t i = 0; i < h.fields.size(); ++i) {
@@ -184,24 +216,32 @@ private:
     void check_size() const {
         const std::uint64_t per_point = 2 * h_.values_per_point;  // values_per_point <= 2^32
         if (h_.points > (std::numeric_limits<std::uint64_t>::max() - 1) / per_point ||
-            h_.points * per_point - 1 > text_.size()) {
+            h_.points * per_point - 1 > data_bytes_) {
             fail(std::to_string(h_.points) + " points of " + std::to_string(h_.values_per_point) +
-                 " values cannot fit in the " + std::to_string(text_.size()) +
+                 " values cannot fit in the " + std::to_string(data_bytes_) +
                  " bytes after the header (truncated file, or wrong WIDTH/HEIGHT/POINTS?)");
         }
     }
 
+    // The longest data line accepted: 64 characters per value (a double takes at most 24) and some slack for
+    // spaces; longer lines are not a point's.
+    static std::size_t max_line(const PcdHeader& h) {
+        return static_cast<std::size_t>(
+            std::min<std::uint64_t>(64 * h.values_per_point + 4096, std::uint64_t{1} << 40));
+    }
+
     // The next non-blank line, or a null view at the end of the data.
     std::string_view next_line() {
-        while (pos_ < text_.size()) {
-            std::size_t end = text_.find('\n', pos_);
-            if (end == std::string_view::npos) end = text_.size();
-            const std::string_view line = text_.substr(pos_, end - pos_);
-            pos_ = end + 1;
+        std::string_view line;
+        while (lines_.next(line)) {
             ++line_number_;
             for (const char c : line) {
                 if (!is_space(c)) return line;
             }
+        }
+        if (lines_.too_long()) {
+            fail("data line " + std::to_string(line_number_ + 1) + " is longer than " + std::to_string(max_line(h_)) +
+                 " bytes, too long for a point of " + std::to_string(h_.values_per_point) + " values");
         }
         return {};
     }
@@ -259,32 +299,39 @@ private:
     }
 
     const PcdHeader& h_;
-    std::string_view text_;
+    std::uint64_t data_bytes_;
     const std::filesystem::path& path_;
+    detail::LineReader lines_;
     std::vector<Target> targets_;
-    std::size_t pos_ = 0;
     std::uint64_t line_number_ = 0;  // counted from the first line after DATA
 };
 
 }  // namespace
 
 PointCloud read_pcd(const std::filesystem::path& path) {
-    const std::vector<unsigned char> bytes = detail::read_file(path);
-    const PcdHeader h = detail::parse_pcd_header(bytes, path);
-
-    PointCloud cloud;
-    switch (h.data) {
-        case PcdData::binary:
-            read_binary(h, bytes, path, cloud);
-            break;
-        case PcdData::binary_compressed:
-            read_compressed(h, bytes, path, cloud);
-            break;
-        case PcdData::ascii:
-            AsciiReader(h, bytes, path).read(cloud);
-            break;
-    }
-    return cloud;
+    return detail::guard_reader(path, [&] {
+        detail::InputFile file(path);
+        // The header from the file's first bytes: a file that is not a PCD is refused without reading it whole.
+        const std::vector<unsigned char> head = detail::read_head(file, kMaxHeaderBytes);
+        const PcdHeader h = detail::parse_pcd_header(head, path);
+        if (head.size() < file.size() && h.data_offset == head.size() && head.back() != '\n') {
+            fail(ErrorCode::format, path,
+                 "the header is longer than " + std::to_string(kMaxHeaderBytes) + " bytes (not a PCD file?)");
+        }
+        PointCloud cloud;
+        switch (h.data) {
+            case PcdData::binary:
+                read_binary(h, file, cloud);
+                break;
+            case PcdData::binary_compressed:
+                read_compressed(h, file, cloud);
+                break;
+            case PcdData::ascii:
+                AsciiReader(h, file).read(cloud);
+                break;
+        }
+        return cloud;
+    });
 }
 
 }  // namespace pyrseg::io

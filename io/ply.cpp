@@ -1,6 +1,6 @@
 // PLY clouds through PCL's PLY reader and writer (pcl::PLYReader, pcl::PLYWriter in pcl_io): pyrseg decodes no PLY
-// data itself. It does read the header first, because PCL 1.13's reader (Debian builds it with assertions on) does
-// not fail cleanly on every header; found by feeding it crafted files:
+// data itself. It does check the file first, because PCL 1.13's reader (Debian builds it with assertions on) does
+// not fail cleanly on every file; found by feeding it crafted files:
 //   - obj_info num_cols x num_rows smaller than the vertex count: an assertion fails (vertexScalarPropertyCallback),
 //     the process aborts; larger than the vertex count: cells that are never written read as zeros;
 //   - an obj_info line that starts with whitespace: an assertion fails (objInfoCallback), the process aborts;
@@ -8,10 +8,15 @@
 //   - an element with instances but no properties: a loop over every instance that reads nothing (a hang);
 //   - uchar colours other than red green blue [alpha] in that order, or list properties in element vertex: values
 //     stored at the wrong offsets, or assertions;
-//   - a file shorter than its magic: a read of uninitialized memory.
+//   - a file shorter than its magic: a read of uninitialized memory;
+//   - a range_grid vertex index past the vertices: a SIGSEGV (the index wraps PCL's 32-bit bounds check), or a cell
+//     read as zeros (an index equal to the vertex count);
+//   - an obj_info grid of many cells over a wide vertex: PCL allocates the vertex's size for every cell, twice.
 // So the header is parsed here, strictly, to the PLY 1.0 grammar; the bytes the declared elements need at the least
 // are checked against the file's size (so PCL's allocations stay within a small multiple of the file's size); the
-// organized grid is checked against the vertex count; and only then does PCL read the file.
+// organized grid is checked against the vertex count and the file's size; the data is walked as PCL will parse it,
+// checking every list against the file and every range_grid index against the vertices; and only then does PCL
+// read the file.
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -56,6 +61,10 @@ constexpr std::size_t kMaxHeaderBytes = std::size_t{1} << 20;
 // Element counts beyond this are refused before any arithmetic on them (2^48 instances: far beyond any file).
 constexpr std::uint64_t kMaxCount = std::uint64_t{1} << 48;
 constexpr std::uint8_t kLabelZeroGray = 128;
+// What PCL may allocate for an organized grid per byte of PLY data, beyond a fixed slack: 64 bytes a byte covers a
+// grid of 12-byte points even when every cell is empty (one byte in a binary file, two in an ascii one).
+constexpr std::uint64_t kGridBytesPerFileByte = 64;
+constexpr std::uint64_t kGridBytesSlack = std::uint64_t{16} << 20;
 
 enum class PlyFormat { ascii, binary_little_endian, binary_big_endian };
 
@@ -82,6 +91,7 @@ struct PlyElement {
 struct PlyHeader {
     PlyFormat format = PlyFormat::ascii;
     std::vector<PlyElement> elements;
+    std::uint64_t data_offset = 0;         // the first byte after end_header
     std::uint64_t data_bytes = 0;          // the file's bytes after end_header
     int grid_cols = 0, grid_rows = 0;      // obj_info num_cols / num_rows (PCL, Stanford range scans)
     int vendor_cols = 0, vendor_rows = 0;  // "Width = W; Height = H" in an obj_info or comment line (Photoneo)
@@ -240,6 +250,7 @@ public:
         if ((h_.grid_cols > 0) != (h_.grid_rows > 0)) {
             fail(ErrorCode::format, path_, "obj_info gives only one of num_cols and num_rows");
         }
+        h_.data_offset = pos_;
         h_.data_bytes = file_size > pos_ ? file_size - pos_ : 0;
         return h_;
     }
@@ -454,6 +465,222 @@ void check_header(const PlyHeader& h, const fs::path& path) {
     if (vertex->count > std::uint64_t(INT_MAX)) fail(ErrorCode::format, path, "too many vertices");
 }
 
+// PCL copies range_grid cells from vertex index * point_step and checks that against its data in 32-bit unsigned
+// arithmetic, so an index past the vertices either wraps to a crash (-1, or 1431655765 with 12-byte points) or
+// reads a cell it zero-filled (an index equal to the vertex count). Every index is therefore checked here, in the
+// data, before PCL reads the file: the data is walked as PCL's parser walks it (elements in header order; binary:
+// each property's bytes, each list's count then its items; ascii: one line per instance), which also checks that
+// every list fits in the file. Reading PLY without PCL would avoid the walk, but PCL also decodes colours, normals,
+// cameras and every PLY dialect pyrseg accepts; the walk costs a seek per element without lists or a grid, and a
+// pass over the grid (a few bytes per cell) otherwise.
+class DataWalker {
+public:
+    DataWalker(const PlyHeader& h, const fs::path& path) : h_(h), file_(path) {
+        const PlyElement* vertex = h.find("vertex");
+        vertices_ = vertex != nullptr ? vertex->count : 0;
+    }
+
+    void walk() {
+        for (const PlyElement& e : h_.elements) {
+            for (const PlyProperty& p : e.properties) {
+                // PCL converts float indices to int: NaN or 1e30 would be undefined behaviour.
+                if (is_grid_index(e, p) && is_floating(p.type)) {
+                    fail(ErrorCode::format, file_.path(),
+                         "element range_grid: list '" + p.name + "' holds " + p.type + ", not integer vertex indices");
+                }
+            }
+        }
+        if (h_.format == PlyFormat::ascii) {
+            walk_ascii();
+        } else {
+            walk_binary();
+        }
+    }
+
+private:
+    [[noreturn]] void error(const PlyElement& e, std::uint64_t instance, const std::string& what) const {
+        fail(ErrorCode::format, file_.path(),
+             "PLY data: element '" + e.name + "' instance " + std::to_string(instance) + ": " + what);
+    }
+
+    static bool is_grid_index(const PlyElement& e, const PlyProperty& p) {
+        return e.name == "range_grid" && p.count_size > 0 && (p.name == "vertex_indices" || p.name == "vertex_index");
+    }
+
+    void check_index(const PlyElement& e, std::uint64_t instance, long long index) const {
+        if (index < 0 || static_cast<std::uint64_t>(index) >= vertices_) {
+            error(e, instance,
+                  "range_grid vertex index " + std::to_string(index) + " is not one of the " +
+                      std::to_string(vertices_) + " vertices");
+        }
+    }
+
+    // ---- binary
+
+    // `n` bytes at the current position (a view into the buffer, valid until the next call).
+    const unsigned char* take(std::size_t n, const PlyElement& e, std::uint64_t instance) {
+        if (n > end_ - begin_) {
+            std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
+            end_ -= begin_;
+            begin_ = 0;
+            if (buffer_.size() < n) buffer_.resize(n);
+            end_ += file_.read_some(buffer_.data() + end_, buffer_.size() - end_);
+            if (n > end_) error(e, instance, "the file ends inside it (truncated file?)");
+        }
+        const unsigned char* p = buffer_.data() + begin_;
+        begin_ += n;
+        offset_ += n;
+        return p;
+    }
+
+    std::uint64_t unsigned_value(const unsigned char* p, int size) const {
+        std::uint64_t v = 0;
+        for (int i = 0; i < size; ++i) {
+            const int byte = h_.format == PlyFormat::binary_big_endian ? i : size - 1 - i;
+            v = v << 8 | p[byte];
+        }
+        return v;
+    }
+
+    long long integer_value(const unsigned char* p, const PlyProperty& prop) const {
+        const std::uint64_t v = unsigned_value(p, prop.size);
+        const bool is_signed = prop.type == "char" || prop.type == "int8" || prop.type == "short" ||
+                               prop.type == "int16" || prop.type == "int" || prop.type == "int32";
+        if (!is_signed) return static_cast<long long>(v);
+        const int bits = 8 * prop.size;
+        const std::uint64_t sign = std::uint64_t{1} << (bits - 1);
+        return static_cast<long long>(v ^ sign) - static_cast<long long>(sign);
+    }
+
+    void walk_binary() {
+        const std::uint64_t end = h_.data_offset + h_.data_bytes;
+        offset_ = h_.data_offset;
+        file_.seek(offset_);
+        for (const PlyElement& e : h_.elements) {
+            bool lists = false;
+            std::uint64_t per = 0;
+            for (const PlyProperty& p : e.properties) {
+                lists = lists || p.count_size > 0;
+                per += static_cast<std::uint64_t>(p.size);
+            }
+            if (!lists) {
+                // check_data_size has bounded count * per by the file's size.
+                offset_ += e.count * per;
+                if (offset_ > end) error(e, 0, "the file ends inside this element (truncated file?)");
+                file_.seek(offset_);
+                begin_ = end_ = 0;
+                continue;
+            }
+            for (std::uint64_t i = 0; i < e.count; ++i) {
+                for (const PlyProperty& p : e.properties) {
+                    if (p.count_size == 0) {
+                        (void)take(static_cast<std::size_t>(p.size), e, i);
+                        continue;
+                    }
+                    const std::uint64_t items =
+                        unsigned_value(take(static_cast<std::size_t>(p.count_size), e, i), p.count_size);
+                    const std::uint64_t left = end > offset_ ? end - offset_ : 0;
+                    if (items > left / static_cast<std::uint64_t>(p.size)) {
+                        error(e, i,
+                              "list '" + p.name + "' of " + std::to_string(items) + " items runs past the end of " +
+                                  "the file (truncated file?)");
+                    }
+                    for (std::uint64_t k = 0; k < items; ++k) {
+                        const unsigned char* item = take(static_cast<std::size_t>(p.size), e, i);
+                        if (is_grid_index(e, p)) check_index(e, i, integer_value(item, p));
+                    }
+                }
+            }
+        }
+    }
+
+    // ---- ascii
+
+    void walk_ascii() {
+        detail::LineReader lines(file_, h_.data_offset, kMaxAsciiLine);
+        std::string_view line;
+        for (const PlyElement& e : h_.elements) {
+            bool grid = false;
+            for (const PlyProperty& p : e.properties) grid = grid || is_grid_index(e, p);
+            for (std::uint64_t i = 0; i < e.count; ++i) {
+                if (!lines.next(line)) {
+                    error(e, i,
+                          lines.too_long() ? "a line longer than " + std::to_string(kMaxAsciiLine) + " bytes"
+                                           : std::string("the file ends before it (truncated file?)"));
+                }
+                if (grid) check_ascii_grid_line(e, i, line);
+            }
+        }
+    }
+
+    void check_ascii_grid_line(const PlyElement& e, std::uint64_t instance, std::string_view line) const {
+        std::vector<std::string_view> tokens = split(line);
+        for (std::string_view& t : tokens) {
+            while (!t.empty() && (t.back() == '\r' || t.front() == '\r')) {
+                t = t.back() == '\r' ? t.substr(0, t.size() - 1) : t.substr(1);
+            }
+        }
+        std::erase_if(tokens, [](std::string_view t) { return t.empty(); });
+        std::size_t at = 0;
+        auto integer = [&](const std::string& what) {
+            if (at >= tokens.size()) error(e, instance, "the line ends before " + what);
+            const std::string_view t = tokens[at++];
+            long long v = 0;
+            const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+            if (ec != std::errc() || end != t.data() + t.size()) {
+                error(e, instance, what + " '" + std::string(t.substr(0, 32)) + "' is not an integer");
+            }
+            return v;
+        };
+        for (const PlyProperty& p : e.properties) {
+            if (p.count_size == 0) {
+                ++at;
+                continue;
+            }
+            const long long items = integer("the item count of list '" + p.name + "'");
+            if (items < 0 || static_cast<std::uint64_t>(items) > tokens.size() - std::min(at, tokens.size())) {
+                error(e, instance,
+                      "list '" + p.name + "' claims " + std::to_string(items) + " items, the line has fewer");
+            }
+            for (long long k = 0; k < items; ++k) {
+                if (is_grid_index(e, p)) {
+                    check_index(e, instance, integer("a range_grid vertex index"));
+                } else {
+                    ++at;
+                }
+            }
+        }
+    }
+
+    // PLY ascii lines are a few dozen numbers; this only stops a line of gigabytes from being buffered.
+    static constexpr std::size_t kMaxAsciiLine = std::size_t{16} << 20;
+
+    const PlyHeader& h_;
+    detail::InputFile file_;
+    std::uint64_t vertices_ = 0;
+    std::vector<unsigned char> buffer_ = std::vector<unsigned char>(std::size_t{1} << 16);
+    std::size_t begin_ = 0, end_ = 0;
+    std::uint64_t offset_ = 0;
+};
+
+// PCL allocates its point size (point_step) for every cell of an obj_info grid, twice (while reading, then for the
+// range_grid copy); a cell of a range_grid takes as little as one byte of the file. Bounded here by the file's size.
+void check_grid_memory(const PlyHeader& h, const fs::path& path) {
+    const PlyElement* vertex = h.find("vertex");
+    if (h.grid_cols == 0 || vertex == nullptr) return;
+    std::uint64_t point_step = 0;  // at least PCL's: uchar colours and intensity become 4-byte floats
+    for (const PlyProperty& p : vertex->properties) point_step += std::max(p.size, 4);
+    const std::uint64_t cells = std::uint64_t(h.grid_cols) * std::uint64_t(h.grid_rows);  // <= INT_MAX
+    const std::uint64_t needed = 2 * cells * point_step;  // point_step <= 8 * (1 MiB header): no overflow
+    const std::uint64_t allowed = kGridBytesPerFileByte * h.data_bytes + kGridBytesSlack;
+    if (needed > allowed) {
+        fail(ErrorCode::format, path,
+             "an obj_info grid of " + grid_text(h.grid_cols, h.grid_rows) + " cells of " + std::to_string(point_step) +
+                 "-byte points takes " + std::to_string(needed) + " bytes to read, more than the " +
+                 std::to_string(h.data_bytes) + " bytes of data in the file can describe");
+    }
+}
+
 // PCL prints its errors and warnings on the console: quiet while pyrseg calls it, so only pyrseg's exception speaks.
 class QuietPcl {
 public:
@@ -544,13 +771,13 @@ void add_field(pcl::PCLPointCloud2& blob, const char* name) {
     blob.point_step += 4;
 }
 
-}  // namespace
-
-PointCloud read_ply(const std::filesystem::path& path) {
+PointCloud read_ply_file(const std::filesystem::path& path) {
     std::uint64_t file_size = 0;
     const std::string head = read_head(path, file_size);
     const PlyHeader header = HeaderParser(path, head).parse(file_size);
     check_header(header, path);
+    check_grid_memory(header, path);
+    DataWalker(header, path).walk();
 
     pcl::PCLPointCloud2 blob;
     int status = -1;
@@ -575,6 +802,12 @@ PointCloud read_ply(const std::filesystem::path& path) {
                  " data after the header (truncated or corrupt file?)");
     }
     return to_cloud(blob, header, path);
+}
+
+}  // namespace
+
+PointCloud read_ply(const std::filesystem::path& path) {
+    return detail::guard_reader(path, [&] { return read_ply_file(path); });
 }
 
 void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels, bool binary) {

@@ -97,16 +97,32 @@ void write_png(const std::filesystem::path& path, const void* pixels, int width,
 
 // ---- reading
 
-struct MemoryReader {
-    const unsigned char* data;
-    std::size_t size, pos;
-};
+// libpng reads the file as it decodes (never more than a chunk header or a zlib buffer at a time), so the file is
+// not read whole first.
+void read_from_file(png_structp png, png_bytep out, std::size_t size) {
+    auto* file = static_cast<detail::InputFile*>(png_get_io_ptr(png));
+    if (file->read_some_nothrow(out, size) != size) {
+        png_error(png,
+                  std::ferror(file->get()) ? "read error" : "file ends in the middle of a chunk (truncated file?)");
+    }
+}
 
-void read_from_memory(png_structp png, png_bytep out, std::size_t size) {
-    auto* r = static_cast<MemoryReader*>(png_get_io_ptr(png));
-    if (size > r->size - r->pos) png_error(png, "file ends in the middle of a chunk (truncated file?)");
-    std::memcpy(out, r->data + r->pos, size);
-    r->pos += size;
+// What libpng may allocate for one chunk (text, ICC profile, unknown chunk; also their decompressed size). libpng
+// allocates a chunk's claimed length before reading it, so without a limit a 52-byte file can ask for 2 GiB. Image
+// data (IDAT) is streamed through a fixed buffer and is not bound by it.
+constexpr png_alloc_size_t kMaxChunkBytes = png_alloc_size_t{8} << 20;
+// Ancillary chunks (tEXt, sPLT, unknown) libpng keeps: each costs memory and a file can hold millions.
+constexpr png_uint_32 kMaxCachedChunks = 256;
+
+void limit_chunks(png_structp png) {
+    // Width and height keep libpng's limits (png_set_user_limits, 1000000 each): the pixel data is bounded more
+    // tightly by the file's size in read_png_file, with a message that says so.
+    png_set_chunk_malloc_max(png, kMaxChunkBytes);
+    png_set_chunk_cache_max(png, kMaxCachedChunks);
+    // Metadata pyrseg never uses is skipped unread (libpng then neither allocates it nor inflates it).
+    static constexpr png_byte kIgnored[] = "tEXt\0zTXt\0iTXt\0iCCP\0sPLT\0eXIf\0";
+    png_set_keep_unknown_chunks(png, PNG_HANDLE_CHUNK_NEVER, kIgnored, static_cast<int>(sizeof kIgnored / 5));
+    png_set_keep_unknown_chunks(png, PNG_HANDLE_CHUNK_NEVER, nullptr, 0);
 }
 
 struct Layout {
@@ -153,6 +169,48 @@ struct ReadGuard {
     ~ReadGuard() { png_destroy_read_struct(&png, &info, nullptr); }
 };
 
+Image read_png_file(const std::filesystem::path& path) {
+    detail::InputFile file(path);
+    png_byte signature[8] = {};
+    if (file.read_some(signature, sizeof signature) != sizeof signature || png_sig_cmp(signature, 0, 8) != 0) {
+        fail(ErrorCode::format, path, "not a PNG file (no PNG signature)");
+    }
+    ErrorSlot slot;
+    ReadGuard g;
+    g.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &slot, on_error, on_warning);
+    if (g.png != nullptr) g.info = png_create_info_struct(g.png);
+    if (g.info == nullptr) fail(ErrorCode::internal, path, "cannot create a libpng reader");
+    limit_chunks(g.png);
+    png_set_read_fn(g.png, &file, read_from_file);
+    png_set_sig_bytes(g.png, 8);
+
+    Layout layout;
+    if (!read_header(g.png, g.info, &layout)) {
+        fail(ErrorCode::format, path, std::string("corrupt PNG: ") + slot.message);
+    }
+    // Deflate expands at most 1032-fold, so an image claiming more pixel data than that is lying: refuse it before
+    // allocating rather than let a tiny file request gigabytes.
+    const std::uint64_t stored = (layout.width * layout.stored_bits + 7) / 8 * layout.height;
+    const std::uint64_t limit = 1040 * static_cast<std::uint64_t>(file.size()) + 4096;
+    if (stored > limit || static_cast<std::uint64_t>(layout.row_bytes) * layout.height > (std::uint64_t{1} << 34)) {
+        fail(ErrorCode::format, path,
+             "a " + std::to_string(layout.width) + " x " + std::to_string(layout.height) +
+                 " image cannot be stored in a file of " + std::to_string(file.size()) + " bytes");
+    }
+    Image image;
+    image.width = static_cast<int>(layout.width);
+    image.height = static_cast<int>(layout.height);
+    image.channels = layout.channels;
+    image.bit_depth = layout.bit_depth;
+    image.data.resize(layout.row_bytes * layout.height);
+    std::vector<png_bytep> rows(layout.height);
+    for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = image.data.data() + y * layout.row_bytes;
+    if (!read_rows(g.png, g.info, rows.data())) {
+        fail(ErrorCode::format, path, std::string("corrupt PNG: ") + slot.message);
+    }
+    return image;
+}
+
 }  // namespace
 
 void write_png_rgb(const std::filesystem::path& path, const std::uint8_t* rgb, int width, int height) {
@@ -168,43 +226,7 @@ void write_png_gray8(const std::filesystem::path& path, const std::uint8_t* gray
 }
 
 Image read_png(const std::filesystem::path& path) {
-    const std::vector<unsigned char> bytes = detail::read_file(path);
-    if (bytes.size() < 8 || png_sig_cmp(bytes.data(), 0, 8) != 0) {
-        fail(ErrorCode::format, path, "not a PNG file (no PNG signature)");
-    }
-    ErrorSlot slot;
-    ReadGuard g;
-    g.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &slot, on_error, on_warning);
-    if (g.png != nullptr) g.info = png_create_info_struct(g.png);
-    if (g.info == nullptr) fail(ErrorCode::internal, path, "cannot create a libpng reader");
-    MemoryReader reader{bytes.data(), bytes.size(), 0};
-    png_set_read_fn(g.png, &reader, read_from_memory);
-
-    Layout layout;
-    if (!read_header(g.png, g.info, &layout)) {
-        fail(ErrorCode::format, path, std::string("corrupt PNG: ") + slot.message);
-    }
-    // Deflate expands at most 1032-fold, so an image claiming more pixel data than that is lying: refuse it before
-    // allocating rather than let a tiny file request gigabytes.
-    const std::uint64_t stored = (layout.width * layout.stored_bits + 7) / 8 * layout.height;
-    const std::uint64_t limit = 1040 * static_cast<std::uint64_t>(bytes.size()) + 4096;
-    if (stored > limit || static_cast<std::uint64_t>(layout.row_bytes) * layout.height > (std::uint64_t{1} << 34)) {
-        fail(ErrorCode::format, path,
-             "a " + std::to_string(layout.width) + " x " + std::to_string(layout.height) +
-                 " image cannot be stored in a file of " + std::to_string(bytes.size()) + " bytes");
-    }
-    Image image;
-    image.width = static_cast<int>(layout.width);
-    image.height = static_cast<int>(layout.height);
-    image.channels = layout.channels;
-    image.bit_depth = layout.bit_depth;
-    image.data.resize(layout.row_bytes * layout.height);
-    std::vector<png_bytep> rows(layout.height);
-    for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = image.data.data() + y * layout.row_bytes;
-    if (!read_rows(g.png, g.info, rows.data())) {
-        fail(ErrorCode::format, path, std::string("corrupt PNG: ") + slot.message);
-    }
-    return image;
+    return detail::guard_reader(path, [&] { return read_png_file(path); });
 }
 
 }  // namespace pyrseg::io
