@@ -1,8 +1,10 @@
 #pragma once
 // pyrseg::io: the file formats the CLI and the tests need: PCD and PLY in; .npy, PNG and PLY out (and back in).
 // Every failure is a pyrseg::Error whose message names the file: ErrorCode::io when the file cannot be opened,
-// read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::invalid_argument
-// for bad arguments to a writer. The writers of .npy, PNG, PCD, PLY and statistics replace their file only once it
+// read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::out_of_memory when a
+// well-formed file needs more memory than there is, ErrorCode::invalid_argument for bad arguments to a writer. No
+// other exception leaves a reader, and a reader allocates only what the file can hold (a header that claims more
+// than the file's bytes is a format error, found before the memory is taken). The writers of .npy, PNG, PCD, PLY and statistics replace their file only once it
 // is complete (a temporary file beside it, renamed): a failure leaves the old file or none, never a partial one.
 #include <array>
 #include <cstddef>
@@ -97,7 +99,8 @@ struct DepthImage {
     bool floating = false;  // float samples (usually metres) rather than integers (usually millimetres)
 };
 // A 16-bit grayscale PNG (as depth cameras and TUM/CAPE datasets store millimetres or 1/5000 m), or a
-// single-channel TIFF of 16-bit unsigned or 32-bit float samples (libtiff).
+// single-channel, stripped TIFF of 16-bit unsigned or 32-bit float samples (libtiff), at most 65536 pixels on a side
+// and 2^28 pixels in all.
 PYRSEG_IO_EXPORT DepthImage read_depth_image(const std::filesystem::path& path);
 PYRSEG_IO_EXPORT void write_tiff_float(const std::filesystem::path& path, const float* depth, int width, int height);
 
