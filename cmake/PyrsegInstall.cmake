@@ -8,10 +8,10 @@ set_target_properties(pyrseg PROPERTIES EXPORT_NAME pyrseg)
 set_target_properties(pyrseg_io PROPERTIES EXPORT_NAME io)
 set_target_properties(pyrseg_synthetic PROPERTIES EXPORT_NAME synthetic)
 # Static libraries carry their private link dependencies, so the interface targets they link go into the export set
-# too: the flags target only adds link options (sanitizers); OpenCV core and PCL io are found without a CMake package
+# too: the flags target only adds link options (sanitizers); PCL io is found without a CMake package
 # (io/CMakeLists.txt) and exported as the paths found here.
 set(_pyrseg_exported pyrseg pyrseg_io pyrseg_synthetic pyrseg_build_flags)
-foreach(_t pyrseg_opencv_core pyrseg_pcl_io)
+foreach(_t pyrseg_pcl_io)
   if(TARGET ${_t})
     list(APPEND _pyrseg_exported ${_t})
   endif()
@@ -50,10 +50,7 @@ install(FILES LICENSE CHANGELOG.md README.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
 set(PYRSEG_STATIC_DEPENDENCIES "")
 if(NOT BUILD_SHARED_LIBS)
   set(PYRSEG_STATIC_DEPENDENCIES "find_dependency(hwy)\nfind_dependency(nlohmann_json)\nfind_dependency(PNG)\n")
-  string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(TIFF)\n")
-  if(OpenCV_FOUND)
-    string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(OpenCV COMPONENTS core)\n")
-  endif()
+  string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(TIFF)\nfind_dependency(tinyxml2)\n")
   if(PYRSEG_BUILD_opencl)
     string(APPEND PYRSEG_STATIC_DEPENDENCIES "find_dependency(OpenCL)\n")
   endif()
@@ -120,17 +117,12 @@ if(PYRSEG_BUILD_cuda)
   string(APPEND _core_libs " -L${CUDAToolkit_LIBRARY_DIR} -lcudart_static -ldl -lrt")
 endif()
 _pyrseg_pc(pyrseg "${PROJECT_DESCRIPTION}" pyrseg "" "${_core_requires}" "${_core_libs}")
-set(_io_libs "${LZF_LIBRARY}")
-if(OpenCV_FOUND)
-  string(APPEND _io_libs " -lopencv_core")
-else()
-  string(APPEND _io_libs " ${PYRSEG_OPENCV_CORE_LIBRARY}")
-endif()
+set(_io_libs "${LZF_LIBRARY}")  # libyaml comes through Requires.private (yaml-0.1)
 if(TARGET pyrseg_pcl_io)
   string(APPEND _io_libs " ${PYRSEG_PCL_IO_LIBRARY} ${PYRSEG_PCL_COMMON_LIBRARY}")
 endif()
-_pyrseg_pc(pyrseg-io "pyrseg's file formats: PCD, PLY, NumPy, PNG and TIFF depth images" pyrseg_io pyrseg
-           "libpng libtiff-4" "${_io_libs}")
+_pyrseg_pc(pyrseg-io "pyrseg's file formats: PCD, PLY, NumPy, PNG and TIFF depth images, calibration files"
+           pyrseg_io pyrseg "libpng libtiff-4 tinyxml2 yaml-0.1" "${_io_libs}")
 _pyrseg_pc(pyrseg-synthetic "Seeded synthetic bin-picking scenes with ground truth, for tests and demos"
            pyrseg_synthetic "" "" "")
 

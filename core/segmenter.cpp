@@ -1,6 +1,8 @@
 #include "pyrseg/segmenter.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -40,9 +42,68 @@ void check_layout(const char* what, std::size_t row_stride, int point_stride, in
     }
 }
 
+// Given normals are expected unit length (docs/algorithm.md section 1). The contract defines the labels of any
+// normal (quantization clamps), so one off unit length only affects its own pixel; but a frame whose normals are all
+// off, scaled (s < 1 makes every pixel an edge: the frame comes back silently unlabelled), is a caller's mistake and
+// refused. 1% either way passes what real tools write; (0, 0, 0) and non-finite components mean "no normal".
+constexpr float kMinNormalLength2 = 0.99f * 0.99f;
+constexpr float kMaxNormalLength2 = 1.01f * 1.01f;
+
+enum class NormalKind { none, unit, off_unit };
+
+// The 1-norm s bounds the length (s / sqrt(3) <= |n| <= s), so outside [0.99, 1.75] it decides alone and inside it
+// the squared length can neither overflow nor underflow; a NaN component makes s NaN, an infinite one s infinite.
+NormalKind classify(const float* n) {
+    const float x = std::abs(n[0]);
+    const float y = std::abs(n[1]);
+    const float z = std::abs(n[2]);
+    const float s = x + y + z;
+    if (!(s > 0.0f && s <= std::numeric_limits<float>::max())) return NormalKind::none;
+    const float length2 = x * x + y * y + z * z;
+    const bool unit = s >= 0.99f && s <= 1.75f && length2 >= kMinNormalLength2 && length2 <= kMaxNormalLength2;
+    return unit ? NormalKind::unit : NormalKind::off_unit;
+}
+
+// Stops at the first unit normal, which for a frame of real normals is its first valid pixel: the check costs
+// nothing per frame but on the frames it refuses (or that have hardly any normal).
+void check_normals(const CloudView& cloud, const core::CloudLayout& layout) {
+    std::size_t off = 0;
+    std::size_t first_x = 0;
+    std::size_t first_y = 0;
+    for (std::size_t y = 0; y < std::size_t(cloud.height); ++y) {
+        for (std::size_t x = 0; x < std::size_t(cloud.width); ++x) {
+            const NormalKind kind = classify(cloud.normals + layout.at(x, y));
+            if (kind == NormalKind::unit) return;
+            if (kind == NormalKind::off_unit && off++ == 0) {
+                first_x = x;
+                first_y = y;
+            }
+        }
+    }
+    // A handful of normals says too little about how they were made (and a frame that small has hardly any labels).
+    constexpr std::size_t kFewNormals = 16;
+    if (off < kFewNormals) return;
+    const float* n = cloud.normals + layout.at(first_x, first_y);
+    const double length = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+    throw Error(ErrorCode::invalid_argument, "cloud.normals: none of the frame's " + std::to_string(off) +
+                                                 " normals is unit length (within 1%); the first, at pixel (" +
+                                                 std::to_string(first_x) + ", " + std::to_string(first_y) +
+                                                 "), has length " + std::to_string(length) +
+                                                 ": normalise them, or give (0, 0, 0) or NaN for no normal");
+}
+
 }  // namespace
 
 namespace {
+
+// Every member goes through here: a moved-from Segmenter has no Impl, and a clear error beats a null dereference.
+Segmenter::Impl& live(const std::unique_ptr<Segmenter::Impl>& impl) {
+    if (!impl) {
+        throw Error(ErrorCode::invalid_argument,
+                    "the Segmenter was moved from: it holds no backend; use the one it was moved to");
+    }
+    return *impl;
+}
 
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -81,20 +142,23 @@ Segmenter::Segmenter(Segmenter&&) noexcept = default;
 Segmenter& Segmenter::operator=(Segmenter&&) noexcept = default;
 
 void Segmenter::segment(const CloudView& cloud, Result& out) {
+    Impl& impl = live(impl_);
     if (cloud.points == nullptr) throw Error(ErrorCode::invalid_argument, "cloud.points is null");
-    check_frame_size("the cloud", cloud.width, cloud.height, impl_->plan);
-    (void)core::cloud_layout(cloud);  // throws when the steps do not fit
+    check_frame_size("the cloud", cloud.width, cloud.height, impl.plan);
+    const core::CloudLayout layout = core::cloud_layout(cloud);  // throws when the steps do not fit
+    if (cloud.normals != nullptr) check_normals(cloud, layout);
     const auto input =
         cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
     run_frame(
-        *impl_, input, [&] { impl_->executor->bind_cloud(cloud); }, out);
+        impl, input, [&] { impl.executor->bind_cloud(cloud); }, out);
 }
 
 void Segmenter::segment(const DepthView& depth, Result& out) {
-    check_frame_size("the depth image", depth.width, depth.height, impl_->plan);
-    core::make_depth_tables(depth, impl_->plan.params.unit_mm, impl_->depth_tables);
+    Impl& impl = live(impl_);
+    check_frame_size("the depth image", depth.width, depth.height, impl.plan);
+    core::make_depth_tables(depth, impl.plan.params.unit_mm, impl.depth_tables);
     run_frame(
-        *impl_, core::InputKind::depth, [&] { impl_->executor->bind_depth(depth, impl_->depth_tables); }, out);
+        impl, core::InputKind::depth, [&] { impl.executor->bind_depth(depth, impl.depth_tables); }, out);
 }
 
 Result Segmenter::segment(const DepthView& depth) {
@@ -110,36 +174,37 @@ Result Segmenter::segment(const CloudView& cloud) {
 }
 
 void Segmenter::segment_mask(const MaskView& mask, Result& out) {
+    Impl& impl = live(impl_);
     if (mask.fillable == nullptr) throw Error(ErrorCode::invalid_argument, "mask.fillable is null");
-    check_frame_size("the mask", mask.width, mask.height, impl_->plan);
+    check_frame_size("the mask", mask.width, mask.height, impl.plan);
     check_layout("the mask's", mask.row_stride, 1, mask.width, mask.height);
     run_frame(
-        *impl_, core::InputKind::mask, [&] { impl_->executor->bind_mask(mask); }, out);
+        impl, core::InputKind::mask, [&] { impl.executor->bind_mask(mask); }, out);
 }
 
-int Segmenter::width() const noexcept {
-    return impl_->plan.width;
+int Segmenter::width() const {
+    return live(impl_).plan.width;
 }
-int Segmenter::height() const noexcept {
-    return impl_->plan.height;
+int Segmenter::height() const {
+    return live(impl_).plan.height;
 }
-const Params& Segmenter::params() const noexcept {
-    return impl_->plan.params;
+const Params& Segmenter::params() const {
+    return live(impl_).plan.params;
 }
-const std::string& Segmenter::backend_name() const noexcept {
-    return impl_->backend;
+const std::string& Segmenter::backend_name() const {
+    return live(impl_).backend;
 }
-const std::vector<PassTiming>& Segmenter::last_timings() const noexcept {
-    return impl_->timings;
+const std::vector<PassTiming>& Segmenter::last_timings() const {
+    return live(impl_).timings;
 }
 std::uint32_t Segmenter::last_fill_rounds() const {
-    return impl_->executor->fill_rounds();
+    return live(impl_).executor->fill_rounds();
 }
 std::uint32_t Segmenter::last_dispatches() const {
-    return impl_->executor->dispatches();
+    return live(impl_).executor->dispatches();
 }
 std::uint32_t Segmenter::last_host_syncs() const {
-    return impl_->executor->host_syncs();
+    return live(impl_).executor->host_syncs();
 }
 
 }  // namespace pyrseg

@@ -1,11 +1,14 @@
-// Pinhole intrinsics: from "fx,fy,cx,cy", or from an OpenCV FileStorage calibration file read by OpenCV itself.
-#include <opencv2/core.hpp>
-
+// Pinhole intrinsics: from "fx,fy,cx,cy", or from a calibration file in OpenCV's FileStorage layout
+// (calibration_file.cpp reads it, without OpenCV).
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "calibration_file.hpp"
 #include "file_util.hpp"
 #include "pyrseg/io.hpp"
 
@@ -17,24 +20,6 @@ using detail::fail;
 bool plausible(const Intrinsics& k) {
     return k.fx > 0 && k.fy > 0 && std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) &&
            std::isfinite(k.cy);
-}
-
-// A 3x3 camera matrix node, or a map with fx fy cx cy; false when the node is neither.
-bool from_node(const cv::FileNode& node, Intrinsics& k) {
-    if (node.isMap() && !node["fx"].empty() && !node["fy"].empty() && !node["cx"].empty() && !node["cy"].empty()) {
-        k = {double(node["fx"]), double(node["fy"]), double(node["cx"]), double(node["cy"])};
-        return true;
-    }
-    cv::Mat m;
-    try {
-        node >> m;
-    } catch (const cv::Exception&) {
-        return false;
-    }
-    if (m.rows != 3 || m.cols != 3 || m.channels() != 1) return false;
-    m.convertTo(m, CV_64F);
-    k = {m.at<double>(0, 0), m.at<double>(1, 1), m.at<double>(0, 2), m.at<double>(1, 2)};
-    return true;
 }
 
 }  // namespace
@@ -70,29 +55,34 @@ Intrinsics parse_intrinsics(const std::string& text) {
 }
 
 Intrinsics read_intrinsics(const std::filesystem::path& path, const std::string& node_name) {
-    (void)detail::read_file(path);  // a clear io error for a missing file, a directory or a FIFO
-    cv::FileStorage fs;
-    try {
-        if (!fs.open(path.string(), cv::FileStorage::READ))
-            fail(ErrorCode::format, path, "not an OpenCV FileStorage file");
-    } catch (const cv::Exception& e) {
-        fail(ErrorCode::format, path, std::string("not an OpenCV FileStorage file (") + e.err + ")");
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    // Refused before reading: a multi-gigabyte "calibration" would otherwise be read whole first.
+    if (!ec && size > detail::kMaxCalibrationBytes) {
+        fail(ErrorCode::format, path,
+             "is " + std::to_string(size) + " bytes; a calibration file is at most " +
+                 std::to_string(detail::kMaxCalibrationBytes));
     }
+    const std::vector<unsigned char> bytes = detail::read_file(path);  // io errors: missing, directory, FIFO
+    const detail::CalibrationFile file =
+        detail::parse_calibration(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
     Intrinsics k;
-    const cv::FileNode root = fs.root();
     if (!node_name.empty()) {
-        const cv::FileNode node = fs[node_name];
-        if (node.empty()) fail(ErrorCode::format, path, "has no node '" + node_name + "'");
-        if (!from_node(node, k)) {
+        const auto node = std::find_if(file.nodes.begin(), file.nodes.end(),
+                                       [&](const detail::CalibrationNode& n) { return n.name == node_name; });
+        if (node == file.nodes.end()) fail(ErrorCode::format, path, "has no node '" + node_name + "'");
+        if (!node->intrinsics) {
             fail(ErrorCode::format, path, "node '" + node_name + "' is neither a 3x3 camera matrix nor fx fy cx cy");
         }
-    } else if (!from_node(root, k)) {
+        k = *node->intrinsics;
+    } else if (file.top_level) {
+        k = *file.top_level;
+    } else {
         std::vector<std::string> matrices;
-        for (const cv::FileNode& child : root) {
-            Intrinsics candidate;
-            if (from_node(child, candidate)) {
-                matrices.push_back(child.name());
-                k = candidate;
+        for (const detail::CalibrationNode& n : file.nodes) {
+            if (n.intrinsics) {
+                matrices.push_back(n.name);
+                k = *n.intrinsics;
             }
         }
         if (matrices.size() != 1) {

@@ -6,7 +6,8 @@ packages=(
   build-essential cmake ninja-build pkg-config  # toolchain
   libgtest-dev libbenchmark-dev                 # tests, benchmarks
   liblzf-dev libpng-dev                         # PCD binary_compressed, PNG pictures and depth images
-  libtiff-dev libopencv-core-dev                # float TIFF depth images; OpenCV FileStorage calibration files
+  libtiff-dev                                   # float TIFF depth images
+  libtinyxml2-dev libyaml-dev                   # calibration files (OpenCV's FileStorage layout; JSON: nlohmann)
   libpcl-dev                                    # PLY clouds via PCL's io (the peer benchmarks use PCL too)
   libopencv-dev nlohmann-json3-dev              # peer benchmarks (connectedComponents); statistics as JSON
   libhwy-dev                                    # Google Highway: the CPU backend's vector passes

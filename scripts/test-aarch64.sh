@@ -45,7 +45,7 @@ packages=(
   g++-aarch64-linux-gnu libc6-dev-arm64-cross            # the cross compiler and its C library
   libgtest-dev:arm64 libhwy-dev:arm64                    # GoogleTest; Google Highway (the CPU backend's vectors)
   liblzf-dev:arm64 libpng-dev:arm64 libtiff-dev:arm64    # pyrseg_io, which the conformance suite reads scans with
-  libopencv-core-dev:arm64                               # pyrseg_io's calibration files (OpenCV FileStorage)
+  libtinyxml2-dev:arm64 libyaml-dev:arm64                # pyrseg_io's calibration files (XML, YAML)
 )
 if ! command -v qemu-aarch64 >/dev/null && ! command -v qemu-aarch64-static >/dev/null; then
   packages+=(qemu-user)

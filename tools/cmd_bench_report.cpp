@@ -15,6 +15,7 @@
 
 #include "pyrseg/error.hpp"
 #include "tools/commands.hpp"
+#include "tools/output_files.hpp"
 #include "tools/plot.hpp"
 
 namespace pyrseg::cli {
@@ -509,9 +510,7 @@ int cmd_bench_report(const std::vector<std::string>& argv) {
     std::error_code ec;
     fs::create_directories(out_dir, ec);
     const fs::path md = out_dir / "performance.md";
-    std::ofstream out(md);
-    out << report.markdown;
-    if (!out) throw Error(ErrorCode::io, md.string() + ": cannot write");
+    write_text_file(md, report.markdown);
     write_png((out_dir / "bench_vs_pcl.png").string(), render_line_chart(report.vs_pcl));
     write_png((out_dir / "bench_vs_opencv.png").string(), render_line_chart(report.vs_opencv));
     std::printf("wrote %s, bench_vs_pcl.png, bench_vs_opencv.png\n", md.string().c_str());

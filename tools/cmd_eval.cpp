@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <optional>
 #include <set>
@@ -25,6 +24,7 @@
 #include "tools/eval/metrics.hpp"
 #include "tools/eval/summary.hpp"
 #include "tools/figures.hpp"
+#include "tools/output_files.hpp"
 #include "tools/plot.hpp"
 #ifdef PYRSEG_HAVE_PCL_PEER
 #include "peers/pcl_segmentation.hpp"
@@ -950,10 +950,7 @@ int cmd_eval(const std::vector<std::string>& argv) {
     const double total = seconds_since(start);
     md << "\nRun time: " << format("%.1f", total) << " s.\n";
     const fs::path report = out_dir / "quality.md";
-    std::ofstream file(report);
-    file << md.str();
-    file.close();
-    if (!file) throw Error(ErrorCode::io, report.string() + ": cannot write");
+    write_text_file(report, md.str());
     std::printf("done in %.1f s; wrote %s and the plots\n", total, report.string().c_str());
     return 0;
 }

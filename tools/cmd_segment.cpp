@@ -21,6 +21,7 @@
 #include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
+#include "tools/output_files.hpp"
 #include "tools/pcl_peer.hpp"
 #include "tools/progress.hpp"
 
@@ -36,7 +37,8 @@ constexpr const char* kSegmentUsage =
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
     "and the time. With no output option it writes nothing and also prints the segment sizes. Outputs (each name\n"
-    "must end in the extension shown, else nothing is done; a file is written whole or not at all):\n"
+    "must end in the extension shown, else nothing is done; a frame's files are written all or none: when one\n"
+    "cannot be written whole (a full disk), none of them is left and the exit status is 1):\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments);\n"
     "  --labels OUT.png      or as a 16-bit grayscale PNG, when every label fits in 16 bits\n"
     "  --png OUT.png         the segments in colour\n"
@@ -61,7 +63,8 @@ constexpr const char* kSegmentUsage =
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
     "NAME.ply, NAME.labels.pcd, NAME.stats.json as --write asks (default labels,png). A frame that fails is reported\n"
-    "and skipped; the exit status is 1 if any failed. No output may overwrite its input.\n"
+    "and skipped (none of its outputs is left); the exit status is 1 if any failed. No output may overwrite its\n"
+    "input.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
     "\n";
 
@@ -277,22 +280,48 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         loaded.depth ? segmenter->segment(loaded.depth->view(cloud.width, cloud.height)) : segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
 
-    if (out.labels) write_labels(*out.labels, result);
-    if (out.png) write_png(*out.png, colorize(result.labels, result.width, result.height));
-    if (out.mask) write_png(*out.mask, mask_picture(result.fillable_mask, result.width, result.height));
-    if (out.figure) write_png(*out.figure, comparison_figure(result));
-    if (out.ply) io::write_ply(*out.ply, cloud, result.labels.data(), true);
-    if (out.pcd) io::write_pcd(*out.pcd, cloud, result.labels.data(), io::PcdEncoding::binary);
+    // All of the frame's outputs or none (tools/output_files.hpp).
+    OutputFiles files;
+    if (out.labels) files.stage(*out.labels, [&](const fs::path& to) { write_labels(to, result); });
+    if (out.png) {
+        files.stage(*out.png, [&](const fs::path& to) {
+            write_png(to.string(), colorize(result.labels, result.width, result.height));
+        });
+    }
+    if (out.mask) {
+        files.stage(*out.mask, [&](const fs::path& to) {
+            write_png(to.string(), mask_picture(result.fillable_mask, result.width, result.height));
+        });
+    }
+    if (out.figure) {
+        files.stage(*out.figure, [&](const fs::path& to) { write_png(to.string(), comparison_figure(result)); });
+    }
+    if (out.ply) {
+        files.stage(*out.ply, [&](const fs::path& to) {
+            io::write_ply(to, cloud, result.labels.data(), true);
+            check_ply_complete(to, *out.ply);
+        });
+    }
+    if (out.pcd) {
+        files.stage(*out.pcd, [&](const fs::path& to) {
+            io::write_pcd(to, cloud, result.labels.data(), io::PcdEncoding::binary);
+        });
+    }
     std::string pcl_note;
     if (out.pcl_png) {
         const PclRun pcl = pcl_segment(cloud, params.unit_mm, kind);
-        write_png(*out.pcl_png, colorize(pcl.labels, cloud.width, cloud.height));
+        files.stage(*out.pcl_png, [&](const fs::path& to) {
+            write_png(to.string(), colorize(pcl.labels, cloud.width, cloud.height));
+        });
         pcl_note = "; " + std::to_string(pcl.regions) + " PCL regions (" + pcl.settings + ")";
     }
     if (out.stats) {
-        io::write_segment_stats(*out.stats, result.segments,
-                                io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+        files.stage(*out.stats, [&](const fs::path& to) {
+            io::write_segment_stats(to, result.segments,
+                                    io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+        });
     }
+    files.commit();
     const std::string unit_note =
         !loaded.millimetres && !args.value("unit-mm") && params.unit_mm == 1000.0 ? " in metres" : "";
     char line[512];
@@ -386,7 +415,7 @@ int run_batch(const Args& args, const Params& params) {
             total_ms += r.milliseconds;
             total_segments += r.segments;
             progress.frame_done(r.line, false);
-        } catch (const Error& e) {
+        } catch (const std::exception& e) {  // pyrseg::Error, or what a library still throws: the batch goes on
             failures.push_back(e.what());
             progress.frame_done(std::string("failed: ") + e.what(), true);
         }

@@ -51,12 +51,14 @@ public:
     // Labels a caller-made fillable mask (the pyramid without the normals and metric passes).
     void segment_mask(const MaskView& mask, Result& out);
 
-    [[nodiscard]] int width() const noexcept;
-    [[nodiscard]] int height() const noexcept;
-    [[nodiscard]] const Params& params() const noexcept;
-    [[nodiscard]] const std::string& backend_name() const noexcept;
+    // Every member of a moved-from Segmenter throws pyrseg::Error (ErrorCode::invalid_argument); only destroying it
+    // or assigning another to it are allowed.
+    [[nodiscard]] int width() const;
+    [[nodiscard]] int height() const;
+    [[nodiscard]] const Params& params() const;
+    [[nodiscard]] const std::string& backend_name() const;
     // Host wall time of each pass of the last frame, in pass order (accumulated per pass name).
-    [[nodiscard]] const std::vector<PassTiming>& last_timings() const noexcept;
+    [[nodiscard]] const std::vector<PassTiming>& last_timings() const;
     // Rounds of row and column sweeps the fixed-point fills of the last frame took; 0 for the union-find fills every
     // backend uses (only the CPU's PYRSEG_CPU_FILL=sweeps, kept as a cross-check, sweeps).
     [[nodiscard]] std::uint32_t last_fill_rounds() const;
