@@ -394,52 +394,56 @@ public:
         std::uint8_t* before = changed + h;            // the round before's
         std::fill_n(changed, h, std::uint8_t{1});
         const std::uint8_t* valid = validity_bytes(c);
+        const size_t words = (w + 63) / 64;
+        if (edge_bits_.size() < h * words) edge_bits_.resize(h * words);  // once per Segmenter
         for (uint32_t round = 1; round <= rounds; ++round) {
             std::swap(changed, before);
             const auto open = [&](size_t y) {
                 return round == 1 || before[y] != 0 || (y > 0 && before[y - 1] != 0) ||
                        (y + 1 < h && before[y + 1] != 0);
             };
+            // Each open row's new labels (edge_next_) and the pixels that take one (edge_bits_), then written.
             rows(h, [&](size_t y) {
+                changed[y] = 0;
                 if (!open(y)) return;
                 uint32_t* next = edge_next_.data() + y * w;
+                std::uint64_t* bits = edge_bits_.data() + y * words;
                 if (simd_ != nullptr) {
                     const size_t i = full.offset + y * w;
                     const bool up = y > 0;
                     const bool down = y + 1 < h;
-                    simd_->edge_round_row(up ? c.mask + i - w : nullptr, c.mask + i, down ? c.mask + i + w : nullptr,
-                                          up ? c.labels + i - w : nullptr, c.labels + i,
-                                          down ? c.labels + i + w : nullptr, valid + y * w, uint32_t(w), round, next);
-                } else {
-                    for (uint32_t x = 0; x < w; ++x) next[x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
+                    changed[y] = std::uint8_t(simd_->edge_round_row(
+                        up ? c.mask + i - w : nullptr, c.mask + i, down ? c.mask + i + w : nullptr,
+                        up ? c.labels + i - w : nullptr, c.labels + i, down ? c.labels + i + w : nullptr, valid + y * w,
+                        uint32_t(w), round, next, bits));
+                    return;
+                }
+                std::fill_n(bits, words, std::uint64_t{0});
+                for (uint32_t x = 0; x < w; ++x) {
+                    next[x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
+                    if (next[x] == labels_[full.offset + y * w + x]) continue;
+                    bits[x / 64] |= std::uint64_t{1} << (x % 64);
+                    changed[y] = 1;
                 }
             });
             const auto round_bits = std::uint8_t(round < rounds ? round << PYR_MASK_EDGE_SHIFT : 0u);
             rows(h, [&](size_t y) {
-                changed[y] = 0;
-                if (!open(y)) return;
-                changed[y] =
-                    std::uint8_t(apply_edge_round(edge_next_.data() + y * w, labels_.data() + full.offset + y * w,
-                                                  mask_.data() + full.offset + y * w, w, round_bits));
+                if (changed[y] == 0) return;
+                uint32_t* l = labels_.data() + full.offset + y * w;
+                std::uint8_t* m = mask_.data() + full.offset + y * w;
+                const uint32_t* next = edge_next_.data() + y * w;
+                const std::uint64_t* bits = edge_bits_.data() + y * words;
+                for (size_t i = 0; i < words; ++i) {
+                    for (std::uint64_t b = bits[i]; b != 0; b &= b - 1) {
+                        const size_t x = i * 64 + size_t(std::countr_zero(b));
+                        l[x] = next[x];
+                        m[x] = std::uint8_t(m[x] | round_bits);
+                    }
+                }
             });
             if (std::find(changed, changed + h, std::uint8_t{1}) == changed + h) break;
         }
         rows(h, [&](size_t y) { mark_row(y); });
-    }
-
-    // Writes a round's labels into a row, with round_bits in the masks of the pixels it changes; whether it changed
-    // one.
-    bool apply_edge_round(const uint32_t* next, uint32_t* labels, std::uint8_t* mask, size_t w,
-                          std::uint8_t round_bits) const {
-        if (simd_ != nullptr) return simd_->apply_edge_round(next, labels, mask, uint32_t(w), round_bits);
-        bool any = false;
-        for (size_t x = 0; x < w; ++x) {
-            if (next[x] == labels[x]) continue;
-            any = true;
-            labels[x] = next[x];
-            mask[x] = std::uint8_t(mask[x] | round_bits);
-        }
-        return any;
     }
 
     // Validity bytes of the full level: the caller's mask's or points_to_mask's, else made from the quantized
@@ -873,6 +877,7 @@ private:
     RobustWindows windows_;                    // their box sums and window depth ranges
     std::vector<std::uint32_t> edge_next_;     // a round's new edge labels (edge_rounds > 1 only)
     std::vector<std::uint8_t> edge_changed_;   // per row, whether a round changed it (edge_rounds > 1 only)
+    std::vector<std::uint64_t> edge_bits_;     // per row, the pixels a round labels, a bit each (edge_rounds > 1)
     DepthView depth_{};                        // a depth frame, as the caller has it
     const core::DepthTables* depth_tables_ = nullptr;
     std::vector<float> depth_points_;       // its back-projection (depth frames only)
@@ -921,8 +926,9 @@ size_t memory_needed(const core::Plan& plan) {
            fill_scratch_size(plan) * sizeof(uint32_t) +                             // union-find
            plan.stats_words() * sizeof(uint32_t) +                                  // statistics
            (plan.params.metric == Metric::robust ? pixels * (sizeof(PyrRobustTexel) + 1) : 0) +  // texels, rest bits
-           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) : 0) +                  // edge rounds' labels
-           PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,                    // its rows, per thread
+           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) + pixels / 8 + 8 * plan.height
+                                        : 0) +                                 // labels, bits
+           PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,  // its rows, per thread
                                        ThreadPool::default_size());
 }
 

@@ -276,8 +276,8 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
 }
 
 // Rounds 1 .. 12 of step 6c with several rounds: masks with earlier rounds in their upper bits (and rounds from later
-// ones, which must not count), labels on fillable pixels and on pixels labelled in a round; every pixel's label as
-// pyr_edge_label gives it, the row itself unchanged, nothing written past the row.
+// ones, which must not count), labels on fillable pixels and on pixels labelled in a round; exactly the pixels whose
+// label pyr_edge_label changes are marked, with that label, and nothing is written past the row.
 TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
     const simd::RowKernels& k = kernels_named(GetParam());
     std::mt19937 rng(13);
@@ -307,17 +307,30 @@ TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
                     const std::size_t i = std::size_t(y) * w;
                     const bool up = y > 0;
                     const bool down = y + 1 < h;
-                    GuardedArray<std::uint32_t> out(
-                        std::vector<std::uint32_t>(w, 0x5a5a5a5au));  // ends at a guard page
-                    k.edge_round_row(up ? mask.data() + i - w : nullptr, mask.data() + i,
-                                     down ? mask.data() + i + w : nullptr, up ? labels.data() + i - w : nullptr,
-                                     labels.data() + i, down ? labels.data() + i + w : nullptr, valid.data() + i, w,
-                                     round, out.data());
+                    // Both end at a guard page.
+                    GuardedArray<std::uint32_t> out(std::vector<std::uint32_t>(w, 0x5a5a5a5au));
+                    const std::size_t words = (std::size_t(w) + 63) / 64;
+                    GuardedArray<std::uint64_t> changed(std::vector<std::uint64_t>(words, ~std::uint64_t{0}));
+                    const bool any = k.edge_round_row(
+                        up ? mask.data() + i - w : nullptr, mask.data() + i, down ? mask.data() + i + w : nullptr,
+                        up ? labels.data() + i - w : nullptr, labels.data() + i, down ? labels.data() + i + w : nullptr,
+                        valid.data() + i, w, round, out.data(), changed.data());
+                    bool expected_any = false;
                     for (std::uint32_t x = 0; x < w; ++x) {
                         const std::uint32_t expected = kernels::pyr_edge_label(c, level, x, y, round);
-                        ASSERT_EQ(out.data()[x], expected)
-                            << w << "x" << h << " round " << round << " pixel " << x << "," << y;
-                        taken += expected != labels[i + x] ? 1 : 0;
+                        const bool takes = expected != labels[i + x];
+                        const bool marked = ((changed.data()[x / 64] >> (x % 64)) & 1u) != 0;
+                        ASSERT_EQ(marked, takes) << w << "x" << h << " round " << round << " pixel " << x << "," << y;
+                        if (takes) {
+                            ASSERT_EQ(out.data()[x], expected)
+                                << w << "x" << h << " round " << round << " pixel " << x << "," << y;
+                        }
+                        expected_any |= takes;
+                        taken += takes ? 1 : 0;
+                    }
+                    EXPECT_EQ(any, expected_any);
+                    for (std::size_t b = w; b < 64 * words; ++b) {
+                        ASSERT_EQ((changed.data()[b / 64] >> (b % 64)) & 1u, 0u) << "a bit past the row";
                     }
                 }
             }

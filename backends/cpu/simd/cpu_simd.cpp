@@ -1189,10 +1189,13 @@ void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const st
 
 // Round `round` of step 6c with several rounds (pyr_edge_label) on one row (cpu_simd.hpp): the same minimum over
 // candidates as edge_row, where a neighbour is a candidate when it is fillable or its mask holds an earlier round.
-void edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+// Only the pixels that take a label are written (few: a round labels the edge pixels next to the last one's).
+bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
                     const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
-                    const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, std::uint32_t* out) {
-    std::memcpy(out, labels, std::size_t(w) * sizeof(std::uint32_t));
+                    const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, std::uint32_t* out,
+                    std::uint64_t* changed) {
+    std::memset(changed, 0, (std::size_t(w) + 63) / 64 * sizeof(std::uint64_t));
+    bool any = false;
     const auto usable = [&](std::uint8_t m) {
         const std::uint32_t labelled_round = std::uint32_t(m) >> PYR_MASK_EDGE_SHIFT;
         return (m & PYR_MASK_FILLABLE) != 0 || (labelled_round != 0 && labelled_round < round);
@@ -1208,11 +1211,16 @@ void edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
         if (x + 1 < w) take(mask[x + 1], labels[x + 1]);
         if (above != nullptr) take(mask_above[x], above[x]);
         if (below != nullptr) take(mask_below[x], below[x]);
+        if (best == ~0u) return;
         out[x] = best + 1u;
+        changed[x / 64] |= std::uint64_t{1} << (x % 64);
+        any = true;
     };
     const DU du;
     const hn::Rebind<std::uint8_t, DU> d8q;
+    const std::size_t n = hn::Lanes(du);
     const VU one = hn::Set(du, 1u);
+    const VU none = hn::Set(du, ~0u);
     const VU fillable_bit = hn::Set(du, PYR_MASK_FILLABLE);
     const VU this_round = hn::Set(du, round);
     // Labels minus 1 of usable neighbours, the largest value for the others.
@@ -1221,49 +1229,26 @@ void edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
         const VU labelled_round = hn::ShiftRight<PYR_MASK_EDGE_SHIFT>(bits);
         const auto use = hn::Or(hn::Ne(hn::And(bits, fillable_bit), hn::Zero(du)),
                                 hn::And(hn::Ne(labelled_round, hn::Zero(du)), hn::Lt(labelled_round, this_round)));
-        return hn::IfThenElse(use, hn::Sub(hn::LoadU(du, l), one), hn::Set(du, ~0u));
+        return hn::IfThenElse(use, hn::Sub(hn::LoadU(du, l), one), none);
     };
     const std::size_t x = for_each_edge_part(mask, valid, w, [&](std::size_t s, auto is_edge) {
-        const VU own = hn::LoadU(du, labels + s);
+        const auto open = hn::And(is_edge, hn::Eq(hn::LoadU(du, labels + s), hn::Zero(du)));
+        if (hn::AllFalse(du, open)) return;
         VU best = hn::Min(candidate(labels + s - 1, mask + s - 1), candidate(labels + s + 1, mask + s + 1));
         if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
         if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
-        const auto open = hn::And(is_edge, hn::Eq(own, hn::Zero(du)));
-        hn::StoreU(hn::IfThenElse(open, hn::Add(best, one), own), du, out + s);
+        const auto takes = hn::And(open, hn::Ne(best, none));
+        if (hn::AllFalse(du, takes)) return;
+        hn::StoreU(hn::Add(best, one), du, out + s);
+        std::uint8_t bytes[8] = {};
+        hn::StoreMaskBits(du, takes, bytes);
+        std::uint64_t bits = 0;
+        std::memcpy(&bits, bytes, sizeof bits);
+        or_bits(changed, s, bits, n);
+        any = true;
     });
     if (w > 0) scalar(0);
     for (std::size_t i = x; i < w; ++i) scalar(i);
-}
-
-// A round's labels into a row (cpu_simd.hpp): labels = next, round_bits into the masks of the pixels it changes.
-bool apply_edge_round(const std::uint32_t* next, std::uint32_t* labels, std::uint8_t* mask, std::uint32_t w,
-                      std::uint8_t round_bits) {
-    std::size_t x = 0;
-    bool any = false;
-#if HWY_TARGET != HWY_SCALAR
-    const DU du;
-    const hn::Rebind<std::uint8_t, DU> d8q;
-    const std::size_t n = hn::Lanes(du);
-    const VU bits = hn::Set(du, round_bits);
-    for (; x + n <= w; x += n) {
-        const VU v = hn::LoadU(du, next + x);
-        const auto differs = hn::Ne(v, hn::LoadU(du, labels + x));
-        if (hn::AllFalse(du, differs)) continue;
-        any = true;
-        hn::StoreU(v, du, labels + x);
-        const VU m = hn::PromoteTo(du, hn::LoadU(d8q, mask + x));
-        // Demoted from signed lanes (values below 256: nothing saturates), the conversion every target has.
-        const DI di;
-        const hn::Rebind<std::uint8_t, DI> d8i;
-        hn::StoreU(hn::DemoteTo(d8i, hn::BitCast(di, hn::Or(m, hn::IfThenElseZero(differs, bits)))), d8i, mask + x);
-    }
-#endif
-    for (; x < w; ++x) {
-        if (next[x] == labels[x]) continue;
-        any = true;
-        labels[x] = next[x];
-        mask[x] = std::uint8_t(mask[x] | round_bits);
-    }
     return any;
 }
 
@@ -1482,7 +1467,6 @@ constexpr RowKernels kKernels = {"",
                                  &quantize_quant_row,
                                  &metric_quant_row,
                                  &edge_round_row,
-                                 &apply_edge_round,
                                  &robust_texels_row,
                                  &robust_range_row,
                                  &robust_normals_row,

@@ -142,17 +142,15 @@ struct RowKernels {
     // image).
     void (*metric_quant_row)(const QuantRow* above, const QuantRow& row, const QuantRow* below, std::uint32_t w,
                              std::int32_t tc, float dt, std::uint8_t* out, const ReadAhead& ahead) = nullptr;
-    // Round `round` >= 1 of step 6c with several rounds (pyr_edge_label) on one row of the full level: out[x] is the
-    // label pixel x gets in that round (its own where it takes none), for x < w; the masks hold the rounds before
-    // (bits PYR_MASK_EDGE_SHIFT and up), the rows above and below are null at the image's top and bottom.
-    void (*edge_round_row)(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
+    // Round `round` >= 1 of step 6c with several rounds (pyr_edge_label) on one row of the full level: marks in
+    // `changed` ((w + 63) / 64 words, bit x % 64 of word x / 64; bits past w clear) the pixels that take a label in
+    // that round, with the label in out[x] (out is not written elsewhere); returns whether one does. The masks hold
+    // the rounds before (bits PYR_MASK_EDGE_SHIFT and up); the rows above and below are null at the image's top and
+    // bottom.
+    bool (*edge_round_row)(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
                            const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
-                           const std::uint8_t* valid, std::uint32_t w, std::uint32_t round,
-                           std::uint32_t* out) = nullptr;
-    // A round's labels (edge_round_row's `out`) into the row: labels[x] = next[x], and round_bits ORed into mask[x]
-    // where that changed the label, for x < w. Returns whether a label changed.
-    bool (*apply_edge_round)(const std::uint32_t* next, std::uint32_t* labels, std::uint8_t* mask, std::uint32_t w,
-                             std::uint8_t round_bits) = nullptr;
+                           const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, std::uint32_t* out,
+                           std::uint64_t* changed) = nullptr;
     // The robust metric's rows (docs/algorithm.md sections 2b and 8b).
     // Row y of the robust normals' texels with radius r (pyr_robust_texel): into c.robust_texels.
     void (*robust_texels_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
