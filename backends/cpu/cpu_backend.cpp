@@ -926,7 +926,7 @@ size_t memory_needed(const core::Plan& plan) {
            fill_scratch_size(plan) * sizeof(uint32_t) +                             // union-find
            plan.stats_words() * sizeof(uint32_t) +                                  // statistics
            (plan.params.metric == Metric::robust ? pixels * (sizeof(PyrRobustTexel) + 1) : 0) +  // texels, rest bits
-           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) + pixels / 8 + 8 * plan.height
+           (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) + pixels / 8 + 8 * size_t(plan.height)
                                         : 0) +                                 // labels, bits
            PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,  // its rows, per thread
                                        ThreadPool::default_size());
