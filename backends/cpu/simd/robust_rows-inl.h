@@ -54,16 +54,16 @@ void robust_texels_row(const PassContext& c, std::uint32_t w, std::uint32_t h, s
         hn::StoreU(hn::IfThenElse(valid, robust_fixed(cz, s), hn::Set(di, -1)), di, t.gz + i);
         hn::StoreU(hn::Or(hn::IfThenElseZero(horizontal, hn::Set(di, 1)), hn::IfThenElseZero(across, hn::Set(di, 2))),
                    di, reinterpret_cast<std::int32_t*>(t.tangents + i));
-        const VF right[3] = {rx, ry, rz};
-        const VF left[3] = {lx, ly, lz};
-        const VF below[3] = {dx, dy, dz};
-        const VF above[3] = {ux, uy, uz};
-        for (int k = 0; k < 3; ++k) {
-            hn::StoreU(hn::IfThenElseZero(horizontal, hn::Sub(robust_fixed(right[k], s), robust_fixed(left[k], s))), di,
-                       t.th[k] + i);
-            hn::StoreU(hn::IfThenElseZero(across, hn::Sub(robust_fixed(below[k], s), robust_fixed(above[k], s))), di,
-                       t.tv[k] + i);
-        }
+        // (No arrays of vectors: SVE's are sizeless.)
+        const auto tangents = [&](VF a, VF b, MI exists, std::int32_t* out) {
+            hn::StoreU(hn::IfThenElseZero(exists, hn::Sub(robust_fixed(a, s), robust_fixed(b, s))), di, out + i);
+        };
+        tangents(rx, lx, horizontal, t.th[0]);
+        tangents(ry, ly, horizontal, t.th[1]);
+        tangents(rz, lz, horizontal, t.th[2]);
+        tangents(dx, ux, across, t.tv[0]);
+        tangents(dy, uy, across, t.tv[1]);
+        tangents(dz, uz, across, t.tv[2]);
         if (x + n >= x_end) break;
     }
 }
@@ -121,18 +121,27 @@ HWY_INLINE void robust_to_15_bits(VI& x, VI& y, VI& z) {
 // adds (the tables' sums wrap like it; missing tangents are zeros in the texels). Most windows that hold one
 // non-member hold few, so only their columns' loads and subtractions are done.
 HWY_INLINE void subtract_non_members(const RobustTexelPlanes& t, std::size_t w, std::size_t x, std::size_t y0,
-                                     std::size_t y1, std::size_t r, VI zi, VI jump, VI s[6]) {
+                                     std::size_t y1, std::size_t r, VI zi, VI jump, VI& ux, VI& uy, VI& uz, VI& vx,
+                                     VI& vy, VI& vz) {
     const DI di;
+    const std::int32_t* const th0 = t.th[0];
+    const std::int32_t* const th1 = t.th[1];
+    const std::int32_t* const th2 = t.th[2];
+    const std::int32_t* const tv0 = t.tv[0];
+    const std::int32_t* const tv1 = t.tv[1];
+    const std::int32_t* const tv2 = t.tv[2];
     for (std::size_t jy = y0; jy <= y1; ++jy) {
         for (std::size_t jx = x - r; jx <= x + r; ++jx) {
             const std::size_t j = jy * w + jx;
             const VI gz = hn::LoadU(di, t.gz + j);
             const MI outside = hn::Or(hn::Lt(gz, hn::Zero(di)), hn::Gt(hn::Abs(hn::Sub(gz, zi)), jump));
             if (hn::AllFalse(di, outside)) continue;
-            for (std::size_t k = 0; k < 3; ++k) {
-                s[k] = hn::Sub(s[k], hn::IfThenElseZero(outside, hn::LoadU(di, t.th[k] + j)));
-                s[3 + k] = hn::Sub(s[3 + k], hn::IfThenElseZero(outside, hn::LoadU(di, t.tv[k] + j)));
-            }
+            ux = hn::Sub(ux, hn::IfThenElseZero(outside, hn::LoadU(di, th0 + j)));
+            uy = hn::Sub(uy, hn::IfThenElseZero(outside, hn::LoadU(di, th1 + j)));
+            uz = hn::Sub(uz, hn::IfThenElseZero(outside, hn::LoadU(di, th2 + j)));
+            vx = hn::Sub(vx, hn::IfThenElseZero(outside, hn::LoadU(di, tv0 + j)));
+            vy = hn::Sub(vy, hn::IfThenElseZero(outside, hn::LoadU(di, tv1 + j)));
+            vz = hn::Sub(vz, hn::IfThenElseZero(outside, hn::LoadU(di, tv2 + j)));
         }
     }
 }
@@ -172,26 +181,30 @@ void robust_normals_row(const PassContext& c, const RobustWindowRow& sums, std::
                                    hn::Not(hn::Gt(hn::LoadU(di, sums.max + x), hn::Add(zi, jump))));
         // The box sums (wrapping, as the tables do) over columns x - r .. x + r, less the non-members where a
         // window holds any.
-        VI s[6];
-        for (std::size_t k = 0; k < 6; ++k) {
-            const VI a = hn::LoadU(di, reinterpret_cast<const std::int32_t*>(sums.bottom[k] + x + r + 1));
-            const VI b = hn::LoadU(di, reinterpret_cast<const std::int32_t*>(sums.top[k] + x + r + 1));
-            const VI cc = hn::LoadU(di, reinterpret_cast<const std::int32_t*>(sums.bottom[k] + x - r));
-            const VI d = hn::LoadU(di, reinterpret_cast<const std::int32_t*>(sums.top[k] + x - r));
-            s[k] = hn::BitCast(
-                di, hn::Add(hn::Sub(hn::Sub(hn::BitCast(DU(), a), hn::BitCast(DU(), b)), hn::BitCast(DU(), cc)),
-                            hn::BitCast(DU(), d)));
-        }
+        const auto box = [&](std::size_t k) {
+            const VU a = hn::LoadU(DU(), sums.bottom[k] + x + r + 1);
+            const VU b = hn::LoadU(DU(), sums.top[k] + x + r + 1);
+            const VU cc = hn::LoadU(DU(), sums.bottom[k] + x - r);
+            const VU d = hn::LoadU(DU(), sums.top[k] + x - r);
+            return hn::BitCast(di, hn::Add(hn::Sub(hn::Sub(a, b), cc), d));
+        };
+        // (Six vectors, not an array: SVE's are sizeless.)
+        VI ux = box(0);
+        VI uy = box(1);
+        VI uz = box(2);
+        VI vx = box(3);
+        VI vy = box(4);
+        VI vz = box(5);
         if (!hn::AllFalse(di, hn::AndNot(members, valid)))
-            subtract_non_members(c.robust_texels, w, x, y0, y1, r, zi, jump, s);
-        const MI u_zero = hn::Eq(hn::Or(hn::Or(s[0], s[1]), s[2]), hn::Zero(di));
-        const MI v_zero = hn::Eq(hn::Or(hn::Or(s[3], s[4]), s[5]), hn::Zero(di));
+            subtract_non_members(c.robust_texels, w, x, y0, y1, r, zi, jump, ux, uy, uz, vx, vy, vz);
+        const MI u_zero = hn::Eq(hn::Or(hn::Or(ux, uy), uz), hn::Zero(di));
+        const MI v_zero = hn::Eq(hn::Or(hn::Or(vx, vy), vz), hn::Zero(di));
         const MI defined = hn::AndNot(hn::Or(u_zero, v_zero), valid);
-        robust_to_15_bits(s[0], s[1], s[2]);
-        robust_to_15_bits(s[3], s[4], s[5]);
+        robust_to_15_bits(ux, uy, uz);
+        robust_to_15_bits(vx, vy, vz);
         VI dx, dy, dz, qx, qy, qz;  // NOLINT(readability-isolate-declaration)
         MI some;
-        normal_direction(s[0], s[1], s[2], s[3], s[4], s[5], defined, dx, dy, dz, some);
+        normal_direction(ux, uy, uz, vx, vy, vz, defined, dx, dy, dz, some);
         normal_from_direction(dx, dy, dz, some, px, py, pz, qx, qy, qz);
         store_normals(qx, qy, qz, out + 3 * x);
         if (x + n >= x_end) break;
