@@ -1,0 +1,13 @@
+// read_pcd on whole files: header, ascii, binary and binary_compressed (liblzf) data.
+#include <cstddef>
+#include <cstdint>
+
+#include "pyrseg/io.hpp"
+#include "tests/fuzz/cloud_checks.hpp"
+#include "tests/fuzz/fuzz_input.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    const auto path = pyrseg::fuzz::write_input(data, size, ".pcd");
+    pyrseg::fuzz::tolerate_format_errors([&] { pyrseg::fuzz::check_cloud(pyrseg::io::read_pcd(path)); });
+    return 0;
+}
