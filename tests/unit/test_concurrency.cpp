@@ -1,0 +1,135 @@
+// The CPU backend under concurrency, the suite ThreadSanitizer runs (scripts/test.sh --tsan): Segmenters in several
+// threads at once, and one Segmenter's thread pool at several sizes, give the labels of one thread. Frames are
+// chosen to reach every parallel pass: fragmented masks (noise), anchored fills, several edge rounds and the robust
+// metric's windows (a sensor preset), estimated and given normals, depth images.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pyrseg/presets.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
+#include "support/cpu_targets.hpp"
+
+namespace pyrseg::test {
+namespace {
+
+struct Frame {
+    std::string name;
+    int w = 0, h = 0;
+    std::vector<float> points;
+    std::vector<float> normals;  // empty: estimated
+    Params params;
+};
+
+std::vector<Frame> frames() {
+    std::vector<Frame> out;
+    std::uint64_t seed = 101;
+    for (const int width : {97, 160}) {
+        const int height = width * 3 / 4;
+        for (const bool noisy : {false, true}) {
+            for (const bool robust : {false, true}) {
+                synthetic::SceneOptions o;
+                o.width = width;
+                o.height = height;
+                o.seed = seed++;
+                o.threads = 1;
+                o.noise_mm = noisy ? 1.5 : 0.1;  // a fragmented mask at 1.5 mm
+                o.sensor = robust ? synthetic::Sensor::kinect_v1 : synthetic::Sensor::structured_light;
+                const synthetic::Scene scene = synthetic::generate(o);
+                Frame f;
+                f.w = width;
+                f.h = height;
+                f.points = scene.points;
+                if (!robust && !noisy) f.normals = scene.normals;
+                f.params = robust ? sensor_preset(SensorKind::kinect_v1) : Params{};
+                std::ostringstream name;
+                name << width << "x" << height << (noisy ? "_noisy" : "") << (robust ? "_kinect" : "_paper")
+                     << (f.normals.empty() ? "_estimated" : "_given");
+                f.name = name.str();
+                out.push_back(std::move(f));
+            }
+        }
+    }
+    return out;
+}
+
+Result segment(Segmenter& segmenter, const Frame& f) {
+    Result r;
+    segmenter.segment(CloudView{f.points.data(), f.normals.empty() ? nullptr : f.normals.data(), f.w, f.h}, r);
+    return r;
+}
+
+// What one thread (a pool of one) makes of each frame.
+std::vector<Result> alone(const std::vector<Frame>& all) {
+    const ScopedEnv one("PYRSEG_THREADS", "1");
+    std::vector<Result> out;
+    for (const Frame& f : all) {
+        Segmenter s(f.w, f.h, f.params, "cpu");
+        out.push_back(segment(s, f));
+    }
+    return out;
+}
+
+TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
+    const std::vector<Frame> all = frames();
+    const std::vector<Result> expected = alone(all);
+    for (const char* threads : {"2", "3", "4", "7"}) {
+        const ScopedEnv env("PYRSEG_THREADS", threads);
+        for (std::size_t i = 0; i < all.size(); ++i) {
+            SCOPED_TRACE(all[i].name + " threads=" + threads);
+            Segmenter s(all[i].w, all[i].h, all[i].params, "cpu");
+            for (int repeat = 0; repeat < 2; ++repeat) {
+                const Result r = segment(s, all[i]);
+                ASSERT_EQ(r.labels, expected[i].labels);
+                ASSERT_EQ(r.segment_count, expected[i].segment_count);
+            }
+        }
+    }
+    std::uint32_t segments = 0;
+    for (const Result& r : expected) segments += r.segment_count;
+    EXPECT_GT(segments, 30u) << "the frames must have segments for the labels to say much";
+}
+
+// Four threads, each with its own Segmenter (pools of 2), over every frame in a different order, at the same time.
+TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
+    const std::vector<Frame> all = frames();
+    const std::vector<Result> expected = alone(all);
+    const ScopedEnv env("PYRSEG_THREADS", "2");
+    constexpr int kThreads = 4;
+    std::vector<std::string> failures(kThreads);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+        threads.emplace_back([&, t] {
+            for (std::size_t k = 0; k < 2 * all.size(); ++k) {
+                const std::size_t i = (k * 3 + std::size_t(t)) % all.size();
+                Segmenter s(all[i].w, all[i].h, all[i].params, "cpu");
+                const Result r = segment(s, all[i]);
+                if (r.labels != expected[i].labels && failures[std::size_t(t)].empty())
+                    failures[std::size_t(t)] = all[i].name;
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    for (int t = 0; t < kThreads; ++t) EXPECT_EQ(failures[std::size_t(t)], "") << "thread " << t << ": labels differ";
+}
+
+// One Segmenter handed from thread to thread (one at a time, as a pipeline's stages would): the same labels.
+TEST(Concurrency, ASegmenterMovesBetweenThreads) {
+    const std::vector<Frame> all = frames();
+    const std::vector<Result> expected = alone(all);
+    const Frame& f = all.back();
+    Segmenter s(f.w, f.h, f.params, "cpu");
+    for (int t = 0; t < 4; ++t) {
+        Result r;
+        std::thread([&] { r = segment(s, f); }).join();
+        EXPECT_EQ(r.labels, expected.back().labels) << "in thread " << t;
+    }
+}
+
+}  // namespace
+}  // namespace pyrseg::test
