@@ -45,10 +45,19 @@ constexpr KernelFn kKernelFns[] = {
 };
 static_assert(std::size(kKernelFns) == gpu::kKernelCount);
 
+// Allocation failures are the caller's to handle; a launch failure or an illegal address leaves the context unusable
+// (a sticky error), so this Segmenter cannot run on it any more. Anything else is pyrseg's bug.
 [[noreturn]] void fail(cudaError_t err, const char* what) {
-    const ErrorCode code = err == cudaErrorMemoryAllocation ? ErrorCode::out_of_memory : ErrorCode::internal;
+    ErrorCode code = ErrorCode::internal;
+    std::string after;
+    if (err == cudaErrorMemoryAllocation) {
+        code = ErrorCode::out_of_memory;
+    } else if (err == cudaErrorLaunchFailure || err == cudaErrorIllegalAddress) {
+        code = ErrorCode::backend_unavailable;
+        after = "; the device failed: this Segmenter cannot run it any more";
+    }
     throw Error(code, std::string("CUDA: ") + what + " failed: " + cudaGetErrorName(err) + " (" +
-                          cudaGetErrorString(err) + ")");
+                          cudaGetErrorString(err) + ")" + after);
 }
 
 void check(cudaError_t err, const char* what) {
@@ -339,6 +348,10 @@ public:
             inline_.insert(inline_.end(), from + done, from + done + op.bytes);
             enqueue(op);
         }
+    }
+
+    [[noreturn]] void fail_like(gpu::Fault fault, const char* what) const override {
+        fail(fault == gpu::Fault::out_of_memory ? cudaErrorMemoryAllocation : cudaErrorLaunchFailure, what);
     }
 
     // The device frame's commands, in order, on the caller's stream; nothing waits.

@@ -61,6 +61,9 @@ void OpenclDevice::create_kernels() {
 }
 
 OpenclDevice::~OpenclDevice() {
+    // A frame an error abandoned may still have reads into the executor's host memory queued, which dies with it;
+    // the queue's own error, if any, was reported already.
+    drain();
     release_marks();
     if (done_ != nullptr) clReleaseEvent(done_);
     for (cl_mem m : buffers_) {
@@ -96,11 +99,13 @@ void OpenclDevice::allocate(const gpu::BufferSizes& sizes, uint32_t image_width)
 }
 
 void OpenclDevice::upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) {
+    host_pending_ = true;
     check(clEnqueueWriteBuffer(queue_, buffer(b), CL_FALSE, offset, bytes, src, 0, nullptr, nullptr),
           "clEnqueueWriteBuffer");
 }
 
 void OpenclDevice::download(gpu::Buffer b, size_t offset, void* dst, size_t bytes) {
+    host_pending_ = true;
     check(clEnqueueReadBuffer(queue_, buffer(b), CL_FALSE, offset, bytes, dst, 0, nullptr, nullptr),
           "clEnqueueReadBuffer");
 }
@@ -137,6 +142,26 @@ void OpenclDevice::mark(const char* pass) {
 
 void OpenclDevice::finish() {
     check(clFinish(queue_), "clFinish");
+    host_pending_ = false;
+}
+
+void OpenclDevice::fail_like(gpu::Fault fault, const char* what) const {
+    if (fault == gpu::Fault::device_lost) rt_->faulted = true;
+    drain();
+    fail(fault == gpu::Fault::out_of_memory ? CL_MEM_OBJECT_ALLOCATION_FAILURE : CL_OUT_OF_RESOURCES, what);
+}
+
+void OpenclDevice::check(cl_int code, const char* what) const {
+    if (code == CL_SUCCESS) return;
+    if (code == CL_OUT_OF_RESOURCES) rt_->faulted = true;
+    drain();
+    fail(code, what);
+}
+
+// Before an error leaves the device: the frame's queued transfers may read the caller's frame (uploads go straight
+// from it), which the caller may free as soon as segment() throws. Only on the error path: frames pay nothing.
+void OpenclDevice::drain() const {
+    if (host_pending_) clFinish(queue_);
 }
 
 // Each pass runs from its marker to the next one. A caller's queue without profiling keeps no times.

@@ -39,6 +39,7 @@ public:
                   std::size_t row_bytes, std::size_t rows) override;
     void upload_inline(gpu::Buffer b, std::size_t offset, const void* src, std::size_t bytes) override;
     void submit() override;
+    [[noreturn]] void fail_like(gpu::Fault fault, const char* what) const override;
 
     // For the interop functions: the queue and context, what the next device frame waits for, and the event that
     // completes with the last submitted one (the caller owns it once taken).
@@ -48,6 +49,10 @@ public:
     [[nodiscard]] cl_event take_done_event();
 
 private:
+    // Every cl_int of the device goes through here: a faulted context is marked on the shared runtime.
+    void check(cl_int code, const char* what) const;
+    // Waits for the queued transfers to or from host memory, if any; errors are the caller's to report.
+    void drain() const;
     struct Mark {
         const char* pass;
         cl_event event;
@@ -68,6 +73,7 @@ private:
     std::array<cl_mem, gpu::kBufferCount> buffers_{};
     std::vector<Mark> marks_;
     cl_event done_ = nullptr;
+    bool host_pending_ = false;  // transfers to or from host memory queued and not yet finished
 };
 
 }  // namespace pyrseg::opencl

@@ -2,10 +2,12 @@
 
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "core/device_choice.hpp"
+#include "core/gpu/device_fault.hpp"
 #include "pyrseg/error.hpp"
 
 extern const char kOpenclKernelSource[];  // shaders/pyr_opencl.cl with its includes, embedded at build time
@@ -100,9 +102,20 @@ const char* error_name(cl_int code) {
     }
 }
 
+// Allocation failures are the caller's to handle (a smaller frame, fewer Segmenters); CL_OUT_OF_RESOURCES is what
+// drivers report once a context has faulted (NVIDIA after a kernel error), so the device cannot run this Segmenter
+// any more. Anything else is pyrseg's bug.
 void fail(cl_int code, const char* what) {
-    throw Error(ErrorCode::internal,
-                std::string("OpenCL: ") + what + " failed: " + error_name(code) + " (" + std::to_string(code) + ")");
+    ErrorCode kind = ErrorCode::internal;
+    std::string after;
+    if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_HOST_MEMORY) {
+        kind = ErrorCode::out_of_memory;
+    } else if (code == CL_OUT_OF_RESOURCES) {
+        kind = ErrorCode::backend_unavailable;
+        after = "; the device failed: this Segmenter cannot run it any more (make a new one, or use another backend)";
+    }
+    throw Error(kind, std::string("OpenCL: ") + what + " failed: " + error_name(code) + " (" + std::to_string(code) +
+                          ")" + after);
 }
 
 std::vector<DeviceRef> enumerate_devices(std::string* why_none) {
@@ -171,8 +184,7 @@ Runtime::~Runtime() {
 namespace {
 
 // The program for `device` in rt.context; a failed build throws with the device's build log.
-void build_program(Runtime& rt) {
-    const char* source = kOpenclKernelSource;
+void build_program(Runtime& rt, const char* source = kOpenclKernelSource) {
     cl_int err = CL_SUCCESS;
     rt.program = clCreateProgramWithSource(rt.context, 1, &source, nullptr, &err);
     check(err, "clCreateProgramWithSource");
@@ -199,7 +211,12 @@ std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device) {
     static std::mutex mutex;
     static std::map<cl_device_id, std::shared_ptr<const Runtime>> cache;
     const std::lock_guard lock(mutex);
-    if (auto it = cache.find(device.device); it != cache.end()) return it->second;
+    // A test's program (core/gpu/device_fault.hpp) is built on a context of its own, never cached.
+    const std::optional<std::string> test_source = gpu::test_kernel_source();
+    if (auto it = cache.find(device.device); it != cache.end() && !test_source) {
+        if (!it->second->faulted) return it->second;
+        cache.erase(it);  // released with the last Segmenter on it
+    }
 
     auto rt = std::make_shared<Runtime>();
     rt->device = device.device;
@@ -210,6 +227,10 @@ std::shared_ptr<const Runtime> runtime_for(const DeviceRef& device) {
     cl_int err = CL_SUCCESS;
     rt->context = clCreateContext(properties, 1, &device.device, nullptr, nullptr, &err);
     check(err, "clCreateContext");
+    if (test_source) {
+        build_program(*rt, test_source->c_str());
+        return rt;
+    }
     build_program(*rt);
     cache.emplace(device.device, rt);
     return rt;

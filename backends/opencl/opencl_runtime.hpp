@@ -4,6 +4,7 @@
 #define CL_TARGET_OPENCL_VERSION 120
 #include <CL/cl.h>
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,6 +33,8 @@ struct Runtime {
     std::string description;
     cl_ulong max_alloc = 0;   // CL_DEVICE_MAX_MEM_ALLOC_SIZE
     cl_ulong global_mem = 0;  // CL_DEVICE_GLOBAL_MEM_SIZE
+    // CL_OUT_OF_RESOURCES was seen on it: the Segmenters on it keep failing, the next ones get a new context.
+    mutable std::atomic<bool> faulted{false};
     ~Runtime();
 };
 

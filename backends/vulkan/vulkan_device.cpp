@@ -178,6 +178,17 @@ void VulkanDevice::finish() {
     staging_.complete();
 }
 
+void VulkanDevice::fail_like(gpu::Fault fault, const char* what) const {
+    if (fault == gpu::Fault::device_lost) rt_->lost = true;
+    fail(fault == gpu::Fault::out_of_memory ? VK_ERROR_OUT_OF_DEVICE_MEMORY : VK_ERROR_DEVICE_LOST, what);
+}
+
+void VulkanDevice::check(VkResult result, const char* what) const {
+    if (result == VK_SUCCESS) return;
+    if (result == VK_ERROR_DEVICE_LOST) rt_->lost = true;
+    fail(result, what);
+}
+
 bool VulkanDevice::pass_times(std::vector<PassTiming>& timings) {
     if (!rt_->timestamps || timestamp_count_ < 2) return false;
     std::array<std::uint64_t, kMaxTimestamps> ticks{};

@@ -47,6 +47,7 @@ public:
                   std::size_t row_bytes, std::size_t rows) override;
     void upload_inline(gpu::Buffer b, std::size_t offset, const void* src, std::size_t bytes) override;
     void submit() override;
+    [[noreturn]] void fail_like(gpu::Fault fault, const char* what) const override;
 
     // For the interop functions, once a device frame's checks passed and before its passes are queued: the frame
     // is recorded into the caller's command buffer (submit() then only closes it with the final barrier), or into
@@ -60,6 +61,8 @@ public:
     void abandon_frame() { abandon(); }
 
 private:
+    // Every VkResult of the device goes through here: a lost device is marked on the shared runtime.
+    void check(VkResult result, const char* what) const;
     enum class Mode { host, record, submit };
     static constexpr std::size_t kRingSize = 3;  // pyrseg's command buffers for submitted device frames
 

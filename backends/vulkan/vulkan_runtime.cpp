@@ -226,12 +226,19 @@ const char* result_name(VkResult result) {
     }
 }
 
+// Allocation failures are the caller's to handle (a smaller frame, fewer Segmenters); a lost device cannot run this
+// Segmenter any more. Anything else is pyrseg's bug.
 void fail(VkResult result, const char* what) {
-    const ErrorCode code = (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY)
-                               ? ErrorCode::out_of_memory
-                               : ErrorCode::internal;
+    ErrorCode code = ErrorCode::internal;
+    std::string after;
+    if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
+        code = ErrorCode::out_of_memory;
+    } else if (result == VK_ERROR_DEVICE_LOST) {
+        code = ErrorCode::backend_unavailable;
+        after = "; the device was lost: this Segmenter cannot run it any more (make a new one, or use another backend)";
+    }
     throw Error(code, std::string("Vulkan: ") + what + " failed: " + result_name(result) + " (" +
-                          std::to_string(int(result)) + ")");
+                          std::to_string(int(result)) + ")" + after);
 }
 
 void throw_on_validation_messages(const char* during) {
@@ -397,7 +404,10 @@ std::shared_ptr<Runtime> runtime_for(const DeviceRef& device) {
     static std::mutex mutex;
     static std::map<VkPhysicalDevice, std::shared_ptr<Runtime>> cache;
     const std::lock_guard lock(mutex);
-    if (auto it = cache.find(device.physical); it != cache.end()) return it->second;
+    if (auto it = cache.find(device.physical); it != cache.end()) {
+        if (!it->second->lost) return it->second;
+        cache.erase(it);  // destroyed with the last Segmenter on it
+    }
 
     auto rt = std::make_shared<Runtime>();
     rt->description = device.description;

@@ -7,6 +7,7 @@
 #include <vulkan/vulkan.h>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -57,6 +58,8 @@ struct Runtime {
     VkDeviceSize max_allocation = 0;  // maxMemoryAllocationSize (Vulkan 1.1)
     bool timestamps = false;          // the queue family writes timestamps
     bool owns_device = true;          // false: the caller's device, which pyrseg never destroys
+    // VK_ERROR_DEVICE_LOST was seen on it: the Segmenters on it keep failing, the next ones get a new device.
+    std::atomic<bool> lost{false};
     std::string description;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;

@@ -40,6 +40,14 @@ inline constexpr std::size_t kBufferCount = std::size_t(Buffer::count);
 [[nodiscard]] const char* buffer_name(Buffer b);
 using BufferSizes = std::array<std::size_t, kBufferCount>;  // bytes
 
+// What a device can fail with mid-frame, in API-neutral terms: each backend's Device::fail_like turns one into its
+// API's own error (the fault hook of core/gpu/device_fault.hpp fails a device through it).
+enum class Fault : std::uint8_t {
+    out_of_memory,  // VK_ERROR_OUT_OF_DEVICE_MEMORY, CL_MEM_OBJECT_ALLOCATION_FAILURE, cudaErrorMemoryAllocation
+    device_lost,    // VK_ERROR_DEVICE_LOST, CL_OUT_OF_RESOURCES (a faulted context), cudaErrorLaunchFailure
+};
+[[nodiscard]] const char* fault_name(Fault f);
+
 struct DeviceLimits {
     BufferSizes max_buffer_bytes{};    // per buffer, the largest one the device can allocate and its kernels bind
     std::string max_buffer_what;       // where those limits come from, for errors: "maxStorageBufferRange"
@@ -94,6 +102,10 @@ public:
     // Ends a device-resident frame: what is queued goes to the device in the API's own order (the caller's queue,
     // stream, command buffer or semaphores), with no host wait.
     virtual void submit();
+
+    // Throws exactly what this API's error path throws when `what` fails with the API's code for `fault`, so that
+    // an injected fault reads like a real one. The default (a device without it) throws ErrorCode::internal.
+    [[noreturn]] virtual void fail_like(Fault fault, const char* what) const;
 };
 
 }  // namespace pyrseg::gpu

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/depth_tables.hpp"
+#include "core/gpu/device_fault.hpp"
 #include "core/segment_stats.hpp"
 #include "core/staging.hpp"
 #include "pyrseg/error.hpp"
@@ -65,6 +66,12 @@ public:
         staged_.resize(core::StagedResults::kBytesPerPixel * px);
         host_stats_.resize(plan_.stats_words());
     }
+
+    // The device goes first: a frame an error abandoned may still have transfers queued into staged_ and the
+    // other host buffers, which its destructor waits for.
+    ~GpuExecutor() override { device_.reset(); }
+    GpuExecutor(const GpuExecutor&) = delete;
+    GpuExecutor& operator=(const GpuExecutor&) = delete;
 
     void bind_cloud(const CloudView& cloud) override {
         start_frame(false);
@@ -419,7 +426,7 @@ void check_fits(const core::Plan& plan, const BufferSizes& sizes, const DeviceLi
 }
 
 std::unique_ptr<core::PassExecutor> make_gpu_executor(const core::Plan& plan, std::unique_ptr<Device> device) {
-    return std::make_unique<GpuExecutor>(plan, std::move(device));
+    return std::make_unique<GpuExecutor>(plan, with_fault_plan(std::move(device)));
 }
 
 namespace {
@@ -443,6 +450,14 @@ void Device::upload_inline(Buffer /*b*/, size_t /*offset*/, const void* /*src*/,
 }
 void Device::submit() {
     no_device_buffers(*this);
+}
+void Device::fail_like(Fault fault, const char* what) const {
+    throw Error(ErrorCode::internal, description() + ": " + what + " failed: " + fault_name(fault) +
+                                         " (this backend cannot fail in its API's words)");
+}
+
+const char* fault_name(Fault f) {
+    return f == Fault::out_of_memory ? "out of memory" : "device lost";
 }
 
 }  // namespace pyrseg::gpu
