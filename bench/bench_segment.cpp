@@ -99,6 +99,19 @@ int register_all() {
                                              [=](benchmark::State& st) { pipeline(st, b.name, w, h, given); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
+                // The same surface neighbourhood as the default radius on the PhoXi frame: at 4128x3088 (half the
+                // pixel spacing, the same 0.1 mm noise) radius 2 sees noise that fragments the mask
+                // (docs/performance.md, "Time per pixel"), so the frame size alone is compared on this row.
+                if (const int same_footprint = int(std::lround(kDefaultNormalRadius * double(w) / 2064.0));
+                    !given && same_footprint > kDefaultNormalRadius) {
+                    Params wider;
+                    wider.normal_radius = same_footprint;
+                    benchmark::RegisterBenchmark(
+                        ("pipeline/" + b.name + "/" + suffix + "_radius" + std::to_string(same_footprint)).c_str(),
+                        [=](benchmark::State& st) { pipeline(st, b.name, w, h, false, wider); })
+                        ->Unit(benchmark::kMillisecond)
+                        ->UseRealTime();
+                }
                 const Params robust = sensor_preset(SensorKind::kinect_v1);
                 benchmark::RegisterBenchmark(("pipeline_robust/" + b.name + "/" + suffix).c_str(),
                                              [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, robust); })

@@ -27,6 +27,7 @@ const char* const kParameterHelp =
     "                        3 for scenes with many bridges).\n"
     "  --unjoinable-gap G    levels between the seeding level and the level whose regions never merge (default 2).\n"
     "  --normal-radius R     neighbour distance in pixels for estimated normals (default 2); larger smooths noise.\n"
+    "                        Scale it with pixel density: twice the pixels across the same view, twice the radius.\n"
     "  --metric NAME         paper (default: the contract's metric, for low-noise scanners) or robust (window\n"
     "                        normals, thresholds that grow with depth; for consumer depth cameras).\n"
     "  --normal-window R     robust: estimated normals sum tangents over a (2R+1)^2 window (1..7, default 3).\n"

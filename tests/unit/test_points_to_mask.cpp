@@ -52,11 +52,11 @@ class CpuPointsToMask : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CpuPointsToMask, MatchesTheReferenceWhateverTheWindowsAndOutputs) {
     const ScopedEnv simd("PYRSEG_CPU_SIMD", GetParam());
-    // The point rows' ring holds 2r + 1 rows up to about 512 KiB: 4096 wide with radius 2 keeps its 5 rows, 11000
-    // wide and 4096 wide with radius 6 split three rows for each row of normals; radius 40 keeps more rows than
-    // the image has.
+    // The point rows' ring holds 2r + 1 rows up to about 1 MiB: 4096 and 11000 wide with radius 2 keep their 5
+    // rows, 4096 wide with radius 10 splits three rows for each row of normals; radius 40 keeps more rows than the
+    // image has.
     const Case cases[] = {{4096, 150, false},       {4096, 150, true},         {11000, 40, false},
-                          {64, 300, false},         {300, 2, false},           {4096, 60, false, 6, 4, 3},
+                          {64, 300, false},         {300, 2, false},           {4096, 60, false, 10, 4, 3},
                           {640, 90, true, 2, 4, 2}, {640, 90, false, 1, 4, 0}, {131, 70, false, 40}};
     Outputs mask_only;
     mask_only.fillable_mask = true;
