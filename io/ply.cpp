@@ -771,6 +771,32 @@ void add_field(pcl::PCLPointCloud2& blob, const char* name) {
     blob.point_step += 4;
 }
 
+// PCL's writer reports no write error: a file a full disk cut short comes back with status 0. So what it wrote is
+// read back through the reader's own header and data checks (the walk finds a file that ends inside an element),
+// and an ascii file must end with its last line's newline.
+void check_written(const fs::path& written, const fs::path& named) {
+    try {
+        std::uint64_t file_size = 0;
+        const std::string head = read_head(written, file_size);
+        const PlyHeader header = HeaderParser(written, head).parse(file_size);
+        check_data_size(header, written);
+        DataWalker(header, written).walk();
+        if (header.format == PlyFormat::ascii && header.data_bytes > 0) {
+            detail::InputFile file(written);
+            char last = 0;
+            file.seek(file.size() - 1);
+            file.read_exact(&last, 1, "its last byte");
+            if (last != '\n') fail(ErrorCode::format, written, "the last line has no newline");
+        }
+    } catch (const Error& e) {
+        // The temporary file's name means nothing to the caller: the reason after it is what counts.
+        std::string reason = e.what();
+        const std::string prefix = written.string() + ": ";
+        if (const std::size_t at = reason.find(prefix); at != std::string::npos) reason.erase(0, at + prefix.size());
+        fail(ErrorCode::io, named, "write error: PCL's PLY writer left an incomplete file (a full disk?): " + reason);
+    }
+}
+
 PointCloud read_ply_file(const std::filesystem::path& path) {
     std::uint64_t file_size = 0;
     const std::string head = read_head(path, file_size);
@@ -874,6 +900,7 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud, const
             }
         }
         if (status != 0) fail(ErrorCode::io, path, "PCL's PLY writer could not write the file");
+        check_written(temporary, path);
     });
 }
 

@@ -297,10 +297,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         files.stage(*out.figure, [&](const fs::path& to) { write_png(to.string(), comparison_figure(result)); });
     }
     if (out.ply) {
-        files.stage(*out.ply, [&](const fs::path& to) {
-            io::write_ply(to, cloud, result.labels.data(), true);
-            check_ply_complete(to, *out.ply);
-        });
+        files.stage(*out.ply, [&](const fs::path& to) { io::write_ply(to, cloud, result.labels.data(), true); });
     }
     if (out.pcd) {
         files.stage(*out.pcd, [&](const fs::path& to) {

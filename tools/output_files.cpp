@@ -4,12 +4,9 @@
 
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -66,15 +63,6 @@ std::vector<char> read_all(const fs::path& path, const fs::path& named) {
     while ((n = std::fread(chunk, 1, sizeof chunk, file.get())) > 0) bytes.insert(bytes.end(), chunk, chunk + n);
     if (std::ferror(file.get())) fail(named, "cannot read back the temporary file: " + errno_text(errno));
     return bytes;
-}
-
-std::optional<std::uint64_t> ply_type_size(const std::string& type) {
-    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
-        return 4;
-    if (type == "double" || type == "float64") return 8;
-    return std::nullopt;
 }
 
 }  // namespace
@@ -146,64 +134,6 @@ void write_text_file(const fs::path& path, std::string_view text) {
     OutputFiles files;
     files.stage(path, [&](const fs::path& temporary) { write_checked(temporary, text.data(), text.size(), path); });
     files.commit();
-}
-
-void check_ply_complete(const fs::path& written, const fs::path& named) {
-    std::error_code ec;
-    const std::uintmax_t size = fs::file_size(written, ec);
-    if (ec) fail(named, "cannot check the written file: " + ec.message());
-    std::vector<char> head(std::min<std::uintmax_t>(size, 1 << 16));
-    {
-        File file(std::fopen(written.c_str(), "rb"));
-        if (!file || std::fread(head.data(), 1, head.size(), file.get()) != head.size()) {
-            fail(named, "cannot check the written file");
-        }
-    }
-    const std::string text(head.begin(), head.end());
-    const std::size_t end = text.find("end_header\n");
-    if (end == std::string::npos) fail(named, "write error: the PLY file was cut short (in its header)");
-    // Elements of fixed-size properties, and PCL's range_grid: one count (0 or 1) per pixel, one index per vertex.
-    std::uint64_t expected = end + 11;
-    std::uint64_t vertices = 0;
-    std::istringstream lines(text.substr(0, end));
-    std::string line;
-    std::string element;
-    std::uint64_t count = 0;
-    std::uint64_t stride = 0;
-    const auto close_element = [&] { expected += count * stride; };
-    while (std::getline(lines, line)) {
-        std::istringstream words(line);
-        std::string keyword;
-        words >> keyword;
-        if (keyword == "format" && line.find("binary_little_endian") == std::string::npos) return;  // ascii: no size
-        if (keyword == "element") {
-            close_element();
-            words >> element >> count;
-            stride = 0;
-            if (element == "vertex") vertices = count;
-        } else if (keyword == "property") {
-            std::string type;
-            words >> type;
-            if (type == "list") {
-                std::string count_type;
-                std::string index_type;
-                words >> count_type >> index_type;
-                const auto c = ply_type_size(count_type);
-                const auto i = ply_type_size(index_type);
-                if (element != "range_grid" || !c || !i) return;  // a layout this check does not know
-                expected += count * *c + vertices * *i;
-            } else if (const auto s = ply_type_size(type)) {
-                stride += *s;
-            } else {
-                return;
-            }
-        }
-    }
-    close_element();
-    if (size != expected) {
-        fail(named, "write error: the PLY file has " + std::to_string(size) + " bytes, its header says " +
-                        std::to_string(expected) + " (a full disk?)");
-    }
 }
 
 }  // namespace pyrseg::cli

@@ -36,8 +36,4 @@ private:
 // A text file (a report), whole or not at all.
 void write_text_file(const std::filesystem::path& path, std::string_view text);
 
-// PCL's PLY writer reports no write error: a binary PLY it cut short (a full disk) is found by comparing the file's
-// size with the size its header implies. pyrseg::Error naming `named` when they differ.
-void check_ply_complete(const std::filesystem::path& written, const std::filesystem::path& named);
-
 }  // namespace pyrseg::cli

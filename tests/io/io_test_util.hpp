@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -58,6 +59,14 @@ private:
 inline std::string read_bytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The names of the entries of `dir` (a write must leave no temporary file behind).
+inline std::vector<fs::path> files_in(const fs::path& dir) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path().filename());
+    std::sort(files.begin(), files.end());
+    return files;
 }
 
 inline void write_bytes(const fs::path& path, const std::string& bytes) {

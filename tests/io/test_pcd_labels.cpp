@@ -24,12 +24,6 @@ std::vector<std::uint32_t> make_labels(const PointCloud& cloud) {
     return labels;
 }
 
-std::vector<fs::path> files_in(const fs::path& dir) {
-    std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path().filename());
-    return files;
-}
-
 TEST(PcdLabels, BinaryIsPointXYZL) {
     ScratchDir dir;
     const PointCloud cloud = make_cloud(5, 3, false);
