@@ -1063,6 +1063,30 @@ HWY_INLINE void or_bits(std::uint64_t* words, std::size_t x, std::uint64_t bits,
     if (shift != 0 && shift + n > 64) words[x / 64 + 1] |= bits >> (64 - shift);
 }
 
+// A mask of at most 64 lanes as the low bits of a word, lane i in bit i, and back: Highway stores mask bits as
+// bytes, and lanes are little-endian bits on every target.
+template <class D, class M>
+HWY_INLINE std::uint64_t mask_to_bits(D d, M mask) {
+    std::uint8_t bytes[8] = {};
+    hn::StoreMaskBits(d, mask, bytes);
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, bytes, sizeof bits);
+    return bits;
+}
+
+template <class D>
+HWY_INLINE auto bits_to_mask(D d, std::uint64_t bits) {
+    std::uint8_t bytes[8] = {};
+    std::memcpy(bytes, &bits, sizeof bits);
+    return hn::LoadMaskBits(d, bytes);
+}
+
+// ORs the lanes of `mask` (pixels x .. x + Lanes(d) - 1) into the pixel bitmap.
+template <class D, class M>
+HWY_INLINE void or_mask_bits(D d, M mask, std::uint64_t* words, std::size_t x) {
+    or_bits(words, x, mask_to_bits(d, mask), hn::Lanes(d));
+}
+
 bool inherit_row(const std::uint8_t* mask, const std::uint32_t* parent, std::uint32_t w, std::uint32_t* out,
                  std::uint64_t* unlabelled) {
     if (unlabelled != nullptr) std::memset(unlabelled, 0, (std::size_t(w) + 63) / 64 * sizeof(std::uint64_t));
@@ -1087,11 +1111,7 @@ bool inherit_row(const std::uint8_t* mask, const std::uint32_t* parent, std::uin
             if (unlabelled == nullptr) continue;
             const auto hole = hn::And(fillable, hn::Eq(v, hn::Zero(du)));
             if (hn::AllFalse(du, hole)) continue;
-            std::uint8_t bytes[8] = {};
-            hn::StoreMaskBits(du, hole, bytes);
-            std::uint64_t bits = 0;
-            std::memcpy(&bits, bytes, sizeof bits);
-            or_bits(unlabelled, x, bits, n);
+            or_mask_bits(du, hole, unlabelled, x);
             any = true;
         }
     }
@@ -1128,16 +1148,10 @@ HWY_INLINE std::size_t for_each_edge_part(const std::uint8_t* mask, const std::u
         const auto invalid = hn::Eq(hn::LoadU(d8, valid + x), hn::Zero(d8));
         const auto edge = hn::AndNot(invalid, not_fillable);
         if (hn::AllFalse(d8, edge)) continue;
-        std::uint8_t bytes[8] = {};
-        hn::StoreMaskBits(d8, edge, bytes);
-        std::uint64_t edges = 0;
-        std::memcpy(&edges, bytes, sizeof edges);
+        std::uint64_t edges = mask_to_bits(d8, edge);
         for (std::size_t s = x; s < x + n8; s += n, edges >>= n % 64) {
             const std::uint64_t bits = edges & lanes;
-            if (bits == 0) continue;
-            std::uint8_t lane_bytes[8] = {};
-            std::memcpy(lane_bytes, &bits, sizeof bits);  // lanes are little-endian bits on every target
-            part(s, hn::LoadMaskBits(du, lane_bytes));
+            if (bits != 0) part(s, bits_to_mask(du, bits));
         }
     }
     return x;
@@ -1218,7 +1232,6 @@ bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
     };
     const DU du;
     const hn::Rebind<std::uint8_t, DU> d8q;
-    const std::size_t n = hn::Lanes(du);
     const VU one = hn::Set(du, 1u);
     const VU none = hn::Set(du, ~0u);
     const VU fillable_bit = hn::Set(du, PYR_MASK_FILLABLE);
@@ -1240,11 +1253,7 @@ bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
         const auto takes = hn::And(open, hn::Ne(best, none));
         if (hn::AllFalse(du, takes)) return;
         hn::StoreU(hn::Add(best, one), du, out + s);
-        std::uint8_t bytes[8] = {};
-        hn::StoreMaskBits(du, takes, bytes);
-        std::uint64_t bits = 0;
-        std::memcpy(&bits, bytes, sizeof bits);
-        or_bits(changed, s, bits, n);
+        or_mask_bits(du, takes, changed, s);
         any = true;
     });
     if (w > 0) scalar(0);
@@ -1319,19 +1328,13 @@ bool column_step(const std::uint8_t* from_mask, const std::uint32_t* from, std::
             for (std::size_t k = 0; k < 64; k += n) {
                 const std::uint64_t part = (bits >> k) & lanes;
                 if (part == 0) continue;
-                std::uint8_t in[8] = {};
-                std::memcpy(in, &part, sizeof part);  // lanes are little-endian bits on every target
                 const VU label = hn::LoadU(du, from + base + k);
                 const VU fillable = hn::And(hn::PromoteTo(du, hn::LoadU(d8, from_mask + base + k)), one);
-                const auto take = hn::And(hn::LoadMaskBits(du, in),
+                const auto take = hn::And(bits_to_mask(du, part),
                                           hn::And(hn::Ne(fillable, hn::Zero(du)), hn::Ne(label, hn::Zero(du))));
                 if (hn::AllFalse(du, take)) continue;
                 hn::StoreU(hn::IfThenElse(take, label, hn::LoadU(du, row + base + k)), du, row + base + k);
-                std::uint8_t out[8] = {};
-                hn::StoreMaskBits(du, take, out);
-                std::uint64_t t = 0;
-                std::memcpy(&t, out, sizeof t);
-                took |= (t & lanes) << k;
+                took |= (mask_to_bits(du, take) & lanes) << k;
             }
         } else
 #endif
