@@ -14,20 +14,13 @@
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "support/cpu_targets.hpp"
+#include "support/test_frame.hpp"
 
 namespace pyrseg::test {
 namespace {
 
-struct Frame {
-    std::string name;
-    int w = 0, h = 0;
-    std::vector<float> points;
-    std::vector<float> normals;  // empty: estimated
-    Params params;
-};
-
-std::vector<Frame> frames() {
-    std::vector<Frame> out;
+std::vector<TestFrame> frames() {
+    std::vector<TestFrame> out;
     std::uint64_t seed = 101;
     for (const int width : {97, 160}) {
         const int height = width * 3 / 4;
@@ -41,7 +34,7 @@ std::vector<Frame> frames() {
                 o.noise_mm = noisy ? 1.5 : 0.1;  // a fragmented mask at 1.5 mm
                 o.sensor = robust ? synthetic::Sensor::kinect_v1 : synthetic::Sensor::structured_light;
                 const synthetic::Scene scene = synthetic::generate(o);
-                Frame f;
+                TestFrame f;
                 f.w = width;
                 f.h = height;
                 f.points = scene.points;
@@ -58,25 +51,19 @@ std::vector<Frame> frames() {
     return out;
 }
 
-Result segment(Segmenter& segmenter, const Frame& f) {
-    Result r;
-    segmenter.segment(CloudView{f.points.data(), f.normals.empty() ? nullptr : f.normals.data(), f.w, f.h}, r);
-    return r;
-}
-
 // What one thread (a pool of one) makes of each frame.
-std::vector<Result> alone(const std::vector<Frame>& all) {
+std::vector<Result> alone(const std::vector<TestFrame>& all) {
     const ScopedEnv one("PYRSEG_THREADS", "1");
     std::vector<Result> out;
-    for (const Frame& f : all) {
+    for (const TestFrame& f : all) {
         Segmenter s(f.w, f.h, f.params, "cpu");
-        out.push_back(segment(s, f));
+        out.push_back(segment_frame(s, f));
     }
     return out;
 }
 
 TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
-    const std::vector<Frame> all = frames();
+    const std::vector<TestFrame> all = frames();
     const std::vector<Result> expected = alone(all);
     for (const char* threads : {"2", "3", "4", "7"}) {
         const ScopedEnv env("PYRSEG_THREADS", threads);
@@ -84,7 +71,7 @@ TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
             SCOPED_TRACE(all[i].name + " threads=" + threads);
             Segmenter s(all[i].w, all[i].h, all[i].params, "cpu");
             for (int repeat = 0; repeat < 2; ++repeat) {
-                const Result r = segment(s, all[i]);
+                const Result r = segment_frame(s, all[i]);
                 ASSERT_EQ(r.labels, expected[i].labels);
                 ASSERT_EQ(r.segment_count, expected[i].segment_count);
             }
@@ -97,7 +84,7 @@ TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
 
 // Four threads, each with its own Segmenter (pools of 2), over every frame in a different order, at the same time.
 TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
-    const std::vector<Frame> all = frames();
+    const std::vector<TestFrame> all = frames();
     const std::vector<Result> expected = alone(all);
     const ScopedEnv env("PYRSEG_THREADS", "2");
     constexpr int kThreads = 4;
@@ -108,7 +95,7 @@ TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
             for (std::size_t k = 0; k < 2 * all.size(); ++k) {
                 const std::size_t i = (k * 3 + std::size_t(t)) % all.size();
                 Segmenter s(all[i].w, all[i].h, all[i].params, "cpu");
-                const Result r = segment(s, all[i]);
+                const Result r = segment_frame(s, all[i]);
                 if (r.labels != expected[i].labels && failures[std::size_t(t)].empty())
                     failures[std::size_t(t)] = all[i].name;
             }
@@ -120,13 +107,13 @@ TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
 
 // One Segmenter handed from thread to thread (one at a time, as a pipeline's stages would): the same labels.
 TEST(Concurrency, ASegmenterMovesBetweenThreads) {
-    const std::vector<Frame> all = frames();
+    const std::vector<TestFrame> all = frames();
     const std::vector<Result> expected = alone(all);
-    const Frame& f = all.back();
+    const TestFrame& f = all.back();
     Segmenter s(f.w, f.h, f.params, "cpu");
     for (int t = 0; t < 4; ++t) {
         Result r;
-        std::thread([&] { r = segment(s, f); }).join();
+        std::thread([&] { r = segment_frame(s, f); }).join();
         EXPECT_EQ(r.labels, expected.back().labels) << "in thread " << t;
     }
 }

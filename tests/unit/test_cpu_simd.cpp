@@ -27,6 +27,7 @@
 #include "support/cpu_targets.hpp"
 #include "support/guarded_array.hpp"
 #include "support/oracle.hpp"
+#include "support/test_frame.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -788,14 +789,6 @@ INSTANTIATE_TEST_SUITE_P(Targets, CpuSimdRows, ::testing::ValuesIn(target_names(
 
 // ---- Whole segmentations
 
-struct Frame {
-    std::string name;
-    int w = 0, h = 0;
-    std::vector<float> points;
-    std::vector<float> normals;  // empty: estimated
-    Params params;
-};
-
 // Given normals at lengths from 0.985 to 1.02 (components past +-1 clamp when quantized), so that most pixels still
 // pass the curvature test while no quantized component is the one of the unit normal; a few much shorter or longer.
 std::vector<float> lengthen(std::vector<float> normals, std::uint32_t seed) {
@@ -808,8 +801,8 @@ std::vector<float> lengthen(std::vector<float> normals, std::uint32_t seed) {
     return normals;
 }
 
-std::vector<Frame> frames() {
-    std::vector<Frame> out;
+std::vector<TestFrame> frames() {
+    std::vector<TestFrame> out;
     const Size sizes[] = {{131, 97}, {67, 45}, {1, 1}, {2, 3}, {17, 300}, {33, 1}, {1, 29}, {200, 7}};
     std::uint32_t seed = 11;
     for (const Size s : sizes) {
@@ -822,7 +815,7 @@ std::vector<Frame> frames() {
                 o.object_count = 6;
                 o.threads = 1;
                 const synthetic::Scene scene = synthetic::generate(o);
-                Frame f;
+                TestFrame f;
                 f.w = s.w;
                 f.h = s.h;
                 f.points = scene.points;
@@ -845,7 +838,7 @@ std::vector<Frame> frames() {
     for (const float scale : scales) {
         for (const Size s : {Size{131, 97}, Size{67, 45}, Size{17, 300}, Size{2, 3}}) {
             for (const bool given : {false, true}) {
-                Frame f;
+                TestFrame f;
                 f.w = s.w;
                 f.h = s.h;
                 f.points = make_points(s.w, s.h, scale, 0.03, seed);
@@ -877,32 +870,19 @@ std::vector<Frame> frames() {
     return out;
 }
 
-Result segment_with(const std::string& mode, const Frame& f) {
-    const ScopedEnv env("PYRSEG_CPU_SIMD", mode);
-    Segmenter segmenter(f.w, f.h, f.params, "cpu", everything());
-    CloudView view;
-    view.points = f.points.data();
-    view.normals = f.normals.empty() ? nullptr : f.normals.data();
-    view.width = f.w;
-    view.height = f.h;
-    Result result;
-    segmenter.segment(view, result);
-    return result;
-}
-
 class CpuSimdFrames : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CpuSimdFrames, MatchTheScalarPathAndTheReference) {
     const std::string& mode = GetParam();
     std::uint32_t segments = 0;
-    for (const Frame& f : frames()) {
+    for (const TestFrame& f : frames()) {
         SCOPED_TRACE(f.name);
         const pyrseg_ref::Output ref = pyrseg_ref::segment(
             f.points.data(), f.normals.empty() ? nullptr : f.normals.data(), f.w, f.h, to_reference(f.params));
         ASSERT_TRUE(ref.ok) << ref.error;
         segments += ref.segment_count;
-        const Result scalar = segment_with("scalar", f);
-        const Result r = segment_with(mode, f);
+        const Result scalar = segment_on_target("scalar", f, everything());
+        const Result r = segment_on_target(mode, f, everything());
         EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, f.w, 3));
         EXPECT_TRUE(same_bytes("fillable mask", r.fillable_mask, ref.fillable, f.w));
         EXPECT_TRUE(same_bytes("raw labels", r.raw_labels, ref.raw_labels, f.w));

@@ -23,6 +23,7 @@
 #include "pyrseg/synthetic.hpp"
 #include "support/cpu_targets.hpp"
 #include "support/oracle.hpp"
+#include "support/test_frame.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -302,15 +303,8 @@ INSTANTIATE_TEST_SUITE_P(Targets, CpuSimdRobustRows, ::testing::ValuesIn(target_
 
 // ---- Whole segmentations with the robust metric
 
-struct Frame {
-    std::string name;
-    int w = 0, h = 0;
-    std::vector<float> points;
-    Params params;
-};
-
-std::vector<Frame> robust_frames() {
-    std::vector<Frame> out;
+std::vector<TestFrame> robust_frames() {
+    std::vector<TestFrame> out;
     const Size sizes[] = {{131, 97}, {67, 45}, {2, 3}, {17, 300}, {200, 7}};
     const SensorKind sensors[] = {SensorKind::kinect_v1, SensorKind::realsense_d435, SensorKind::azure_kinect};
     std::uint32_t seed = 41;
@@ -323,7 +317,7 @@ std::vector<Frame> robust_frames() {
             o.object_count = 6;
             o.threads = 1;
             const synthetic::Scene scene = synthetic::generate(o);
-            Frame f;
+            TestFrame f;
             f.w = s.w;
             f.h = s.h;
             f.points = scene.points;
@@ -337,25 +331,17 @@ std::vector<Frame> robust_frames() {
     return out;
 }
 
-Result segment_robust(const std::string& mode, const Frame& f) {
-    const ScopedEnv env("PYRSEG_CPU_SIMD", mode);
-    Segmenter segmenter(f.w, f.h, f.params, "cpu", everything());
-    Result result;
-    segmenter.segment(CloudView{f.points.data(), nullptr, f.w, f.h}, result);
-    return result;
-}
-
 class CpuSimdRobustFrames : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CpuSimdRobustFrames, MatchTheScalarPathAndTheReference) {
     std::uint32_t segments = 0;
-    for (const Frame& f : robust_frames()) {
+    for (const TestFrame& f : robust_frames()) {
         SCOPED_TRACE(f.name);
         const pyrseg_ref::Output ref = pyrseg_ref::segment(f.points.data(), nullptr, f.w, f.h, to_reference(f.params));
         ASSERT_TRUE(ref.ok) << ref.error;
         segments += ref.segment_count;
-        const Result scalar = segment_robust("scalar", f);
-        const Result r = segment_robust(GetParam(), f);
+        const Result scalar = segment_on_target("scalar", f, everything());
+        const Result r = segment_on_target(GetParam(), f, everything());
         EXPECT_TRUE(same_bytes("normals", r.normals, ref.normals, f.w, 3));
         EXPECT_TRUE(same_bytes("fillable mask", r.fillable_mask, ref.fillable, f.w));
         EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, f.w));
