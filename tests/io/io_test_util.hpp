@@ -104,6 +104,31 @@ inline std::string outcome_of_write_past_size_limit(const std::function<void()>&
     }
 }
 
+// `value`'s bytes appended to `out`, in host (little-endian) or big-endian order.
+template <typename T>
+void put(std::string& out, T value, bool big_endian = false) {
+    char bytes[sizeof value];
+    std::memcpy(bytes, &value, sizeof value);
+    if (big_endian) std::reverse(bytes, bytes + sizeof value);
+    out.append(bytes, sizeof value);
+}
+
+// PLY headers: x y z float vertices with `extra` lines before the vertex element and `after` lines after it.
+inline std::string xyz_header(const std::string& format, int vertices, const std::string& extra,
+                              const std::string& after = "") {
+    return "ply\nformat " + format + " 1.0\n" + extra + "element vertex " + std::to_string(vertices) +
+           "\nproperty float x\nproperty float y\nproperty float z\n" + after + "end_header\n";
+}
+
+inline std::string grid_lines(int w, int h) {
+    return "obj_info num_cols " + std::to_string(w) + "\nobj_info num_rows " + std::to_string(h) + "\n";
+}
+
+// PCL's range_grid element: one list of vertex indices per grid cell.
+inline std::string range_grid_lines(std::size_t cells) {
+    return "element range_grid " + std::to_string(cells) + "\nproperty list uchar int vertex_indices\n";
+}
+
 // A small organized cloud: a tilted plane with a few NaN points (and NaN normals at the same pixels).
 inline PointCloud make_cloud(int width, int height, bool normals) {
     PointCloud c;

@@ -157,24 +157,14 @@ void expect_refused(const std::function<void()>& read, const fs::path& file, con
     }
 }
 
-template <typename T>
-void put(std::string& out, T value, bool big_endian = false) {
-    char bytes[sizeof value];
-    std::memcpy(bytes, &value, sizeof value);
-    if (big_endian) std::reverse(bytes, bytes + sizeof value);
-    out.append(bytes, sizeof value);
-}
-
 // ---- PLY
 
 #if PYRSEG_HAVE_PLY
 
 // A 2 x 2 organized binary PLY of `vertices` vertices whose range_grid cells hold the indices `cells`.
 std::string range_grid_ply(bool big_endian, const std::vector<std::vector<std::int32_t>>& cells, int vertices = 2) {
-    std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
-                    " 1.0\nobj_info num_cols 2\nobj_info num_rows 2\nelement vertex " + std::to_string(vertices) +
-                    "\nproperty float x\nproperty float y\nproperty float z\nelement range_grid " +
-                    std::to_string(cells.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string s = xyz_header(big_endian ? "binary_big_endian" : "binary_little_endian", vertices, grid_lines(2, 2),
+                               range_grid_lines(cells.size()));
     for (int v = 0; v < vertices; ++v) {
         for (float f : {float(v), float(-v), 1.0f + float(v)}) put(s, f, big_endian);
     }
@@ -186,10 +176,7 @@ std::string range_grid_ply(bool big_endian, const std::vector<std::vector<std::i
 }
 
 std::string range_grid_ply_ascii(const std::vector<std::string>& cells) {
-    std::string s =
-        "ply\nformat ascii 1.0\nobj_info num_cols 2\nobj_info num_rows 2\nelement vertex 2\nproperty float x\n"
-        "property float y\nproperty float z\nelement range_grid " +
-        std::to_string(cells.size()) + "\nproperty list uchar int vertex_indices\nend_header\n0 0 1\n1 -1 2\n";
+    std::string s = xyz_header("ascii", 2, grid_lines(2, 2), range_grid_lines(cells.size())) + "0 0 1\n1 -1 2\n";
     for (const std::string& c : cells) s += c + "\n";
     return s;
 }

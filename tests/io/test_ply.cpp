@@ -19,23 +19,6 @@ namespace {
 
 // ---- building PLY files byte by byte
 
-template <typename T>
-void put(std::string& out, T value, bool big_endian = false) {
-    char bytes[sizeof value];
-    std::memcpy(bytes, &value, sizeof value);
-    if (big_endian) std::reverse(bytes, bytes + sizeof value);
-    out.append(bytes, sizeof value);
-}
-
-std::string xyz_header(const std::string& format, int vertices, const std::string& extra) {
-    return "ply\nformat " + format + " 1.0\n" + extra + "element vertex " + std::to_string(vertices) +
-           "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-}
-
-std::string grid_lines(int w, int h) {
-    return "obj_info num_cols " + std::to_string(w) + "\nobj_info num_rows " + std::to_string(h) + "\n";
-}
-
 // An organized W x H binary cloud of x y z floats: point i is (i, -i, 1 + i).
 std::string grid_binary(int w, int h) {
     std::string s = xyz_header("binary_little_endian", w * h, grid_lines(w, h));
