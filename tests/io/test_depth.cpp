@@ -59,28 +59,6 @@ TEST(DepthImage, FloatTiffRoundTripsBitForBit) {
     EXPECT_EQ(0, std::memcmp(d.depth.data(), depth.data(), depth.size() * sizeof(float)));
 }
 
-// A float TIFF written over an old one: whole or not at all. A write that fails halfway (the file size limit, as a
-// full disk would) is an io error naming the file and leaves the old file as it was, with no temporary file beside
-// it; /dev/full (written in place: it cannot be replaced) is an io error too. In a child process: the limit is
-// process-wide.
-TEST(DepthImage, FloatTiffWritesAreAllOrNothing) {
-    ScratchDir dir;
-    std::vector<float> small(4, 2.0f);
-    write_tiff_float(dir / "d.tif", small.data(), 2, 2);
-    const std::string before = read_bytes(dir / "d.tif");
-    const std::vector<float> large(std::size_t(400) * 300, 1.5f);  // 480 KB: far past the limit below
-    EXPECT_EQ(
-        outcome_of_write_past_size_limit([&] { write_tiff_float(dir / "d.tif", large.data(), 400, 300); }, "d.tif"),
-        "io error naming d.tif");
-    EXPECT_TRUE(read_bytes(dir / "d.tif") == before) << "the old file was changed";
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::directory_iterator(dir.path())) files.push_back(e.path().filename());
-    EXPECT_EQ(files, std::vector<std::filesystem::path>{"d.tif"});
-    if (std::filesystem::exists("/dev/full")) {
-        EXPECT_EQ(error_of([&] { write_tiff_float("/dev/full", large.data(), 400, 300); }), ErrorCode::io);
-    }
-}
-
 TEST(DepthImage, ImagesThatAreNotDepthAreRefusedNamingTheFile) {
     ScratchDir dir;
     const std::vector<std::uint8_t> gray(12, 9);

@@ -146,19 +146,5 @@ TEST(AtomicWrite, ReplacesTheFileAndLeavesNothingElse) {
     EXPECT_EQ(files_in(dir.path()).size(), 2u);
 }
 
-// A write that fails halfway (here: the file size limit, as a full disk would) leaves the old file as it was and
-// no partial file: in a child process, since the limit is process-wide.
-TEST(AtomicWrite, AFailedWriteLeavesTheOldFile) {
-    ScratchDir dir;
-    const PointCloud small = make_cloud(2, 2, false);
-    write_pcd(dir / "c.pcd", small, PcdEncoding::binary);
-    const std::string before = read_bytes(dir / "c.pcd");
-    const PointCloud large = make_cloud(200, 100, true);  // 480 KB: far past the limit below
-    EXPECT_EQ(outcome_of_write_past_size_limit([&] { write_pcd(dir / "c.pcd", large, PcdEncoding::binary); }, "c.pcd"),
-              "io error naming c.pcd");
-    EXPECT_EQ(read_bytes(dir / "c.pcd"), before);
-    EXPECT_EQ(files_in(dir.path()), std::vector<fs::path>{"c.pcd"});
-}
-
 }  // namespace
 }  // namespace pyrseg::io::test
