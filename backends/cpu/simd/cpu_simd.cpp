@@ -329,6 +329,26 @@ HWY_INLINE void store_quant_of_normal(VI qx, VI qy, VI qz, VF z, std::uint32_t* 
     hn::StoreInterleaved3(w0, w1, hn::BitCast(du, z), du, out);
 }
 
+// A row of w pixels whose pixels r .. w - r - 1 have both horizontal neighbours at distance r: vector(x) for whole
+// vectors of n pixels over those (the last ending at w - r, overlapping the one before: vector must write the same
+// wherever they do), scalar(x) for the others, and for every pixel of a row too short for one vector.
+template <class Scalar, class Vector>
+HWY_INLINE void interior_vectors(std::uint32_t w, std::uint32_t r, std::size_t n, const Scalar& scalar,
+                                 const Vector& vector) {
+    if (std::size_t(w) < 2 * std::size_t(r) + n) {
+        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
+        return;
+    }
+    const std::uint32_t x_end = w - r;
+    for (std::uint32_t x = 0; x < r; ++x) scalar(x);
+    for (std::uint32_t x = x_end; x < w; ++x) scalar(x);
+    for (std::size_t x = r;; x += n) {
+        x = std::min(x, std::size_t(x_end) - n);
+        vector(x);
+        if (x + n >= x_end) break;
+    }
+}
+
 // Row y of the paper metric's normals, as floats (normals, unless null) and as quantize's words (quant, unless
 // null): what normals_row and then quantize_row write, in one pass over the row's points.
 void normals_to_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
@@ -346,14 +366,6 @@ void normals_to_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std:
         const PyrQuant pq = kernels::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
         store_quant(quant + kQuantWords * x, pq.qx, pq.qy, pq.qz, pq.valid, p[2]);
     };
-    // Pixels r .. w - r - 1 have both horizontal neighbours; the others are the scalar code's.
-    if (std::size_t(w) < 2 * std::size_t(r) + n) {
-        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
-        return;
-    }
-    const std::uint32_t x_end = w - r;
-    for (std::uint32_t x = 0; x < r; ++x) scalar(x);
-    for (std::uint32_t x = x_end; x < w; ++x) scalar(x);
     const std::size_t pf = c.point_floats;
     const float* row = c.points + std::size_t(y) * c.row_floats;
     const bool up_exists = y >= r;
@@ -362,16 +374,13 @@ void normals_to_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std:
     const float* down = down_exists ? row + std::size_t(r) * c.row_floats : row;
     const MI has_up_row = hn::Ne(hn::Set(di, up_exists ? 1 : 0), hn::Zero(di));
     const MI has_down_row = hn::Ne(hn::Set(di, down_exists ? 1 : 0), hn::Zero(di));
-    // Whole vectors; the last one ends at x_end, overlapping the one before (the same bytes are written again).
-    for (std::size_t x = r;; x += n) {
-        x = std::min(x, std::size_t(x_end) - n);
+    interior_vectors(w, r, n, scalar, [&](std::size_t x) {
         VI qx, qy, qz;  // NOLINT(readability-isolate-declaration)
         VF z;
         normal_q_vector(row, up, down, pf, x, r, has_up_row, has_down_row, qx, qy, qz, z);
         if (normals != nullptr) store_normals(qx, qy, qz, normals + 3 * x);
         if (quant != nullptr) store_quant_of_normal(qx, qy, qz, z, quant + kQuantWords * x);
-        if (x + n >= x_end) break;
-    }
+    });
 }
 
 void normals_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r, float* out) {

@@ -1,7 +1,8 @@
 // The robust metric's vector rows (docs/algorithm.md sections 2b and 8b; shaders/pyr_robust.h): texels, normals from
 // window sums and the fillable test, each the scalar function's operations lane by lane. Included by cpu_simd.cpp
 // inside each target's namespace, after the helpers it shares with the paper metric's rows (load_points,
-// point_valid, msb, shift_magnitude, normal_direction, normal_from_direction, store_normals, load_quant, or_bits),
+// point_valid, msb, shift_magnitude, normal_direction, normal_from_direction, store_normals, load_quant, or_bits,
+// interior_vectors),
 // once per target like the rest of that file: no include guard.
 // NOLINTBEGIN(llvm-header-guard)
 
@@ -22,14 +23,6 @@ void robust_texels_row(const PassContext& c, std::uint32_t w, std::uint32_t h, s
     const DF df;
     const DI di;
     const std::size_t n = hn::Lanes(df);
-    // Pixels r .. w - r - 1 have both horizontal neighbours; the others are the scalar code's.
-    if (std::size_t(w) < 2 * std::size_t(r) + n) {
-        for (std::uint32_t x = 0; x < w; ++x) scalar(x);
-        return;
-    }
-    const std::uint32_t x_end = w - r;
-    for (std::uint32_t x = 0; x < r; ++x) scalar(x);
-    for (std::uint32_t x = x_end; x < w; ++x) scalar(x);
     const std::size_t pf = c.point_floats;
     const float* row = c.points + std::size_t(y) * c.row_floats;
     const bool vertical = y >= r && std::size_t(y) + r < h;
@@ -37,9 +30,7 @@ void robust_texels_row(const PassContext& c, std::uint32_t w, std::uint32_t h, s
     const float* down = vertical ? row + std::size_t(r) * c.row_floats : row;
     const MI has_vertical = hn::Ne(hn::Set(di, vertical ? 1 : 0), hn::Zero(di));
     const VF s = hn::Set(df, scale);
-    // Whole vectors; the last one ends at x_end, overlapping the one before (the same words are written again).
-    for (std::size_t x = r;; x += n) {
-        x = std::min(x, std::size_t(x_end) - n);
+    interior_vectors(w, r, n, scalar, [&](std::size_t x) {
         VF cx, cy, cz, rx, ry, rz, lx, ly, lz, ux, uy, uz, dx, dy, dz;  // NOLINT(readability-isolate-declaration)
         load_points(df, row + x * pf, pf, cx, cy, cz);
         load_points(df, row + (x + r) * pf, pf, rx, ry, rz);
@@ -64,8 +55,7 @@ void robust_texels_row(const PassContext& c, std::uint32_t w, std::uint32_t h, s
         tangents(dx, ux, across, t.tv[0]);
         tangents(dy, uy, across, t.tv[1]);
         tangents(dz, uz, across, t.tv[2]);
-        if (x + n >= x_end) break;
-    }
+    });
 }
 
 void robust_range_row(const std::int32_t* in, std::uint32_t w, std::uint32_t r, std::int32_t* lo, std::int32_t* hi) {
