@@ -7,6 +7,7 @@
 #   scripts/fuzz.sh long [SECONDS] [TARGET...]   build, then each TARGET (default: all) for SECONDS (default 600) on
 #                                                JOBS processes (default: every core), growing build/fuzz/corpus/
 #   scripts/fuzz.sh repro TARGET FILE...         run TARGET once on each FILE (a finding, a regression input)
+#   scripts/fuzz.sh ledger                       executions per target over every `long` run so far
 #   scripts/fuzz.sh list                         the targets
 #
 # Findings (crash-*, leak-*, oom-*, timeout-*) go to $FUZZ_FINDINGS/TARGET/ (default build/fuzz/findings), logs to
@@ -34,6 +35,8 @@ build=$PWD/build/fuzz
 bin=$build/tests/fuzz
 findings_root=$(realpath -m "${FUZZ_FINDINGS:-$build/findings}")
 logs=$build/logs
+# One line per `long` run: target, executions, seconds, workers, date, commit (`scripts/fuzz.sh ledger` sums them).
+ledger=$logs/ledger.tsv
 # A single allocation or a process above this is a finding (an input that makes a reader balloon), as is an input
 # that takes longer than timeout seconds (a hang).
 limits=(-rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10)
@@ -192,17 +195,46 @@ cmd_long() {
       parallel=(-fork="$jobs" -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1)
     fi
     echo "== $name: ${seconds}s on $jobs processes; corpus $corpus, findings $artifacts, logs $workdir"
-    # -jobs writes fuzz-N.log into the working directory. FUZZ_FLAGS and the regression folder (absent or one path)
-    # are split on purpose.
-    local dict
+    # -jobs writes fuzz-N.log into the working directory; the previous run's are removed so that they are not
+    # counted again. FUZZ_FLAGS and the regression folder (absent or one path) are split on purpose.
+    rm -f "$workdir"/fuzz-*.log
+    local dict start=$SECONDS
     dict=$(dict_for "$name" "$dicts")
     # shellcheck disable=SC2046,SC2086
     (cd "$workdir" && "$bin/$name" -max_total_time="$seconds" "${parallel[@]}" "${limits[@]}" -dict="$dict" \
       -artifact_prefix="$artifacts" -print_final_stats=1 ${FUZZ_FLAGS:-} "$corpus" "$build/seeds/$name" \
-      $(regression_dir "$name")) || true
+      $(regression_dir "$name")) 2>&1 | tee "$workdir/run.log" || true
+    record_run "$name" "$workdir" $((SECONDS - start)) "$jobs"
     find "$artifacts" -type f -printf "  finding: %p\n"
   done
   clean_scratch
+}
+
+# Appends a `long` run's executions to the ledger: the workers' final stats (-jobs), or the last status line of
+# the -fork parent, whose children's stats it does not print.
+record_run() {
+  local name=$1 workdir=$2 seconds=$3 jobs=$4 execs
+  execs=$(cat "$workdir"/fuzz-*.log 2>/dev/null | grep -oE "number_of_executed_units:[[:space:]]*[0-9]+" |
+    grep -oE "[0-9]+$" | awk '{ n += $1 } END { if (NR) print n }' || true)
+  if [ -z "$execs" ]; then
+    execs=$(grep -oE "^#[0-9]+" "$workdir/run.log" | tail -1 | tr -d '#' || true)
+  fi
+  mkdir -p "$logs"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "${execs:-0}" "$seconds" "$jobs" "$(date -u +%FT%TZ)" \
+    "$(git rev-parse --short HEAD 2>/dev/null || echo unknown)" >>"$ledger"
+  echo "  $name: ${execs:-0} executions in ${seconds}s (ledger: $ledger)"
+}
+
+# The issue's bar: 10 million executions a target (or two hours for the slow ones).
+cmd_ledger() {
+  [ -f "$ledger" ] || { echo "no long runs recorded yet ($ledger)"; return; }
+  local t name
+  printf '%-16s %12s %8s %5s\n' target executions hours runs
+  for t in "${targets[@]}"; do
+    name=${t%% *}
+    awk -F'\t' -v n="$name" '$1 == n { e += $2; s += $3 * $4; r++ }
+      END { printf "%-16s %12d %8.2f %5d%s\n", n, e, s / 3600, r, (e >= 10000000 ? "  (10M reached)" : "") }' "$ledger"
+  done
 }
 
 cmd_repro() {
@@ -219,6 +251,7 @@ case "${1:-}" in
   regress) shift; cmd_regress "$@" ;;
   long) shift; cmd_long "$@" ;;
   repro) shift; cmd_repro "$@" ;;
+  ledger) cmd_ledger ;;
   list) for t in "${targets[@]}"; do echo "${t%% *}"; done ;;
   *) usage ;;
 esac
