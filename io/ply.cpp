@@ -184,25 +184,12 @@ struct FileCloser {
     void operator()(std::FILE* f) const noexcept { std::fclose(f); }
 };
 
-// The first bytes of the file (up to kMaxHeaderBytes) and its size.
+// The first bytes of the file (up to kMaxHeaderBytes, no more than it holds) and its size.
 std::string read_head(const fs::path& path, std::uint64_t& file_size) {
-    std::error_code ec;
-    const auto status = fs::status(path, ec);
-    if (ec || !fs::exists(status)) {
-        fail(ErrorCode::io, path,
-             "cannot open: " + (ec ? ec.message() : std::error_code(ENOENT, std::generic_category()).message()));
-    }
-    if (fs::is_directory(status)) fail(ErrorCode::io, path, "cannot read: is a directory");
-    if (!fs::is_regular_file(status)) fail(ErrorCode::io, path, "cannot read: not a regular file");
-    errno = 0;
-    const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-    if (!file) fail(ErrorCode::io, path, "cannot open: " + std::error_code(errno, std::generic_category()).message());
-    std::string head(kMaxHeaderBytes, '\0');
-    head.resize(std::fread(head.data(), 1, head.size(), file.get()));
-    if (std::ferror(file.get())) fail(ErrorCode::io, path, "read error");
-    file_size = fs::file_size(path, ec);
-    if (ec) fail(ErrorCode::io, path, "cannot read its size: " + ec.message());
-    return head;
+    detail::InputFile file(path);
+    file_size = file.size();
+    const std::vector<unsigned char> head = detail::read_head(file, kMaxHeaderBytes);
+    return {head.begin(), head.end()};
 }
 
 class HeaderParser {
