@@ -72,16 +72,7 @@ void robust_range_row(const std::int32_t* in, std::uint32_t w, std::uint32_t r, 
         hi[x] = b;
     };
     const DI di;
-    const std::size_t n = hn::Lanes(di);
-    if (std::size_t(w) < 2 * std::size_t(r) + n) {
-        for (std::size_t x = 0; x < w; ++x) scalar(x);
-        return;
-    }
-    const std::size_t x_end = w - r;
-    for (std::size_t x = 0; x < r; ++x) scalar(x);
-    for (std::size_t x = x_end; x < w; ++x) scalar(x);
-    for (std::size_t x = r;; x += n) {
-        x = std::min(x, x_end - n);
+    interior_vectors(w, r, hn::Lanes(di), scalar, [&](std::size_t x) {
         VI a = hn::LoadU(di, in + x - r);
         VI b = a;
         for (std::size_t j = x - r + 1; j <= x + r; ++j) {
@@ -91,8 +82,7 @@ void robust_range_row(const std::int32_t* in, std::uint32_t w, std::uint32_t r, 
         }
         hn::StoreU(a, di, lo + x);
         hn::StoreU(b, di, hi + x);
-        if (x + n >= x_end) break;
-    }
+    });
 }
 
 // pyr_robust_to_15_bits of (x, y, z), for lanes with |components| < 2^31; lanes of (0, 0, 0) compute with m = 1 (their
