@@ -4,9 +4,10 @@
 // read or written, ErrorCode::format when its contents are malformed or unsupported, ErrorCode::out_of_memory when a
 // well-formed file needs more memory than there is, ErrorCode::invalid_argument for bad arguments to a writer. No
 // other exception leaves a reader, and a reader allocates only what the file can hold (a header that claims more
-// than the file's bytes is a format error, found before the memory is taken). The writers of .npy, PNG, PCD, PLY and
-// statistics replace their file only once it is complete (a temporary file beside it, renamed): a failure leaves the
-// old file or none, never a partial one.
+// than the file's bytes is a format error, found before the memory is taken). The writers of .npy, PNG, TIFF, PCD,
+// PLY and statistics replace their file only once it is complete (a temporary file beside it, flushed, checked and
+// renamed; PCL's PLY writer reports no write error, so its file is read back through read_ply's checks): a failure,
+// a full disk included, is ErrorCode::io and leaves the old file or none, never a partial one.
 #include <array>
 #include <cstddef>
 #include <cstdint>
