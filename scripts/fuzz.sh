@@ -233,7 +233,7 @@ cmd_ledger() {
   for t in "${targets[@]}"; do
     name=${t%% *}
     awk -F'\t' -v n="$name" '$1 == n { e += $2; s += $3 * $4; r++ }
-      END { printf "%-16s %12d %8.2f %5d%s\n", n, e, s / 3600, r, (e >= 10000000 ? "  (10M reached)" : "") }' "$ledger"
+      END { printf "%-16s %12d %8.2f %5d%s\n", n, e, s / 3600, r, (e >= 10000000 ? "  (10M reached)" : s >= 7200 ? "  (2 h reached)" : "") }' "$ledger"
   done
 }
 
