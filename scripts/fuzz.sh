@@ -232,8 +232,9 @@ cmd_ledger() {
   printf '%-16s %12s %8s %5s\n' target executions hours runs
   for t in "${targets[@]}"; do
     name=${t%% *}
-    awk -F'\t' -v n="$name" '$1 == n { e += $2; s += $3 * $4; r++ }
-      END { printf "%-16s %12d %8.2f %5d%s\n", n, e, s / 3600, r, (e >= 10000000 ? "  (10M reached)" : s >= 7200 ? "  (2 h reached)" : "") }' "$ledger"
+    awk -F'\t' -v n="$name" -v bar_execs=10000000 -v bar_seconds=7200 '$1 == n { e += $2; s += $3 * $4; r++ }
+      END { reached = e >= bar_execs ? "  (10M reached)" : s >= bar_seconds ? "  (2 h reached)" : ""
+            printf "%-16s %12d %8.2f %5d%s\n", n, e, s / 3600, r, reached }' "$ledger"
   done
 }
 
