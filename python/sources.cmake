@@ -6,6 +6,7 @@
 set(PYRSEG_PYTHON_BINDINGS_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/src/segmenter.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/arrays.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/src/args.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/io.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/synthetic.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/device.cpp)

@@ -1,8 +1,11 @@
 #include "arrays.hpp"
 
+#include <algorithm>
 #include <bit>
+#include <cstdlib>
 #include <cstring>
 #include <string>
+#include <utility>
 
 namespace pyrseg::python {
 namespace {
@@ -82,6 +85,43 @@ bool float_steps(const py::array& a, std::size_t& point_step, std::size_t& row_s
     return true;
 }
 
+// The bytes [first, last) an array's elements span.
+std::pair<std::uintptr_t, std::uintptr_t> extent(const py::array& a) {
+    auto first = reinterpret_cast<std::uintptr_t>(a.data());
+    auto last = first;
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+        if (a.shape(i) == 0) return {first, first};
+        const py::ssize_t span = (a.shape(i) - 1) * a.strides(i);
+        if (span < 0) {
+            first -= std::uintptr_t(-span);
+        } else {
+            last += std::uintptr_t(span);
+        }
+    }
+    return {first, last + std::uintptr_t(a.itemsize())};
+}
+
+// The labels are written after the frame has read its input, so they would not be wrong: but the input would be
+// overwritten by what was computed from it, which no caller means.
+void refuse_shared(const py::array& out, const py::array& in, const char* what) {
+    const auto [a0, a1] = extent(out);
+    const auto [b0, b1] = extent(in);
+    if (a1 <= b0 || b1 <= a0) return;
+    // The spans meet, which interleaved fields do without sharing an element (labels into PCL's PointXYZL beside
+    // the points read in place): numpy decides whether any byte is shared; a problem too hard for it counts as one.
+    bool shared = true;
+    try {
+        shared = py::module_::import("numpy").attr("shares_memory")(out, in).cast<bool>();
+    } catch (const py::error_already_set&) {
+        shared = true;
+    }
+    if (shared) {
+        throw py::value_error(std::string("out= shares memory with ") + what +
+                              ": the labels would overwrite the frame they are computed from; give out= an array of "
+                              "its own (numpy.empty((H, W), numpy.uint32))");
+    }
+}
+
 }  // namespace
 
 bool is_native(const py::dtype& dtype, char kind, int bytes) {
@@ -128,6 +168,11 @@ CloudInput::CloudInput(const py::object& points, const py::object& normals, int 
     }
 }
 
+void CloudInput::refuse_alias(const py::array& out) const {
+    refuse_shared(out, points_, "the points");
+    if (normals_) refuse_shared(out, *normals_, "the normals");
+}
+
 CloudView CloudInput::view(Scratch& scratch) const {
     CloudView v;
     v.width = width_;
@@ -160,24 +205,77 @@ DepthInput::DepthInput(const py::object& depth) : depth_(as_array(depth, "depth"
         depth_ = py::array::ensure(depth_.attr("squeeze")(2));
     }
     if (depth_.ndim() != 2) throw py::value_error("depth must be H x W, got shape " + shape_text(depth_));
-    u16_ = is_native(depth_.dtype(), 'u', 2);
-    if (!u16_ && !is_float(depth_)) {
-        throw py::type_error("depth must be uint16 or float32 (float64 is converted), got " + dtype_text(depth_) +
-                             "; convert other integer depths with .astype(numpy.uint16)");
+    const py::dtype dt = depth_.dtype();
+    u16_ = is_native(dt, 'u', 2);
+    // Other integers are converted: numpy.asarray(PIL.Image.open(png)) is int32 for a 16-bit PNG, OpenCV's and
+    // the SDKs' are uint16 but in another byte order or widened by arithmetic.
+    integer_ = !u16_ && (dt.kind() == 'i' || dt.kind() == 'u') && dt.itemsize() <= 8;
+    if (!u16_ && !integer_ && !is_float(depth_)) {
+        throw py::type_error(
+            "depth must be an integer dtype (uint16 read in place, others converted) or float32 "
+            "(float64 converted), got " +
+            dtype_text(depth_));
     }
     height_ = int(depth_.shape(0));
     width_ = int(depth_.shape(1));
+    if (integer_) {
+        u16_ = true;
+        copy_ = true;
+        is_signed_ = dt.kind() == 'i';
+        swapped_ = dt.itemsize() > 1 && !is_native(dt, dt.kind(), int(dt.itemsize()));
+        return;
+    }
     const py::ssize_t sample = u16_ ? 2 : 4;
     const bool packed_samples = width_ <= 1 || depth_.strides(1) == sample;
     const bool rows_ok = height_ <= 1 || depth_.strides(0) >= width_ * sample;
     copy_ = depth_.itemsize() != sample || !packed_samples || !rows_ok;
 }
 
+void DepthInput::refuse_alias(const py::array& out) const {
+    refuse_shared(out, depth_, "the depth image");
+}
+
+namespace {
+
+// Integer samples of any size and byte order into uint16; ValueError for one outside 0..65535. No Python calls.
+void integer_depth(const py::array& a, bool is_signed, bool swapped, std::vector<std::uint16_t>& dst) {
+    const py::ssize_t h = a.shape(0), w = a.shape(1);
+    const auto size = std::size_t(a.itemsize());
+    const bool little = (std::endian::native == std::endian::little) != swapped;
+    const auto* base = static_cast<const unsigned char*>(a.data());
+    dst.resize(std::size_t(h * w));
+    for (py::ssize_t y = 0; y < h; ++y) {
+        for (py::ssize_t x = 0; x < w; ++x) {
+            const unsigned char* p = base + y * a.strides(0) + x * a.strides(1);
+            std::uint64_t bits = 0;
+            for (std::size_t i = 0; i < size; ++i) bits |= std::uint64_t(p[little ? i : size - 1 - i]) << (8 * i);
+            const bool negative = is_signed && ((bits >> (8 * size - 1)) & 1U) != 0;
+            if (negative || bits > 65535) {
+                const std::string value =
+                    negative ? std::to_string(size == 8 ? std::int64_t(bits)
+                                                        : std::int64_t(bits) - (std::int64_t(1) << (8 * size)))
+                             : std::to_string(bits);
+                throw py::value_error("depth holds " + value + " at (" + std::to_string(y) + ", " + std::to_string(x) +
+                                      "): integer depth samples must be 0..65535 (uint16, the sensor's units); "
+                                      "read 16-bit depth images with pyrseg.io.read_depth_image, which gives uint16");
+            }
+            dst[std::size_t(y * w + x)] = std::uint16_t(bits);
+        }
+    }
+}
+
+}  // namespace
+
 DepthView DepthInput::view(Scratch& scratch) const {
     DepthView v;
     v.width = width_;
     v.height = height_;
     v.format = u16_ ? DepthFormat::u16 : DepthFormat::f32;
+    if (integer_) {
+        integer_depth(depth_, is_signed_, swapped_, scratch.depth_u16);
+        v.depth = scratch.depth_u16.data();
+        return v;
+    }
     if (!copy_) {
         v.depth = depth_.data();
         v.row_step_bytes = height_ > 1 ? std::size_t(depth_.strides(0)) : 0;
@@ -242,6 +340,11 @@ MaskInput::MaskInput(const py::object& mask, const py::object& valid) : mask_(as
     }
 }
 
+void MaskInput::refuse_alias(const py::array& out) const {
+    refuse_shared(out, mask_, "the mask");
+    if (valid_) refuse_shared(out, *valid_, "valid");
+}
+
 MaskView MaskInput::view(Scratch& scratch) const {
     MaskView v;
     v.width = width_;
@@ -271,6 +374,21 @@ py::array check_labels_out(const py::object& out, int width, int height) {
                               "), got " + shape_text(a));
     }
     if (!a.writeable()) throw py::value_error("out is read-only");
+    // Distinct elements: steps of at least an element along the dimension of the smaller step, and along the other
+    // at least that dimension's whole span (a transposed array passes; rows that overlap do not).
+    py::ssize_t inner = std::abs(a.strides(1)), outer = std::abs(a.strides(0));
+    py::ssize_t inner_n = width, outer_n = height;
+    if (outer_n > 1 && (inner_n <= 1 || outer < inner)) {
+        std::swap(inner, outer);
+        std::swap(inner_n, outer_n);
+    }
+    const bool distinct = (inner_n <= 1 || inner >= 4) && (outer_n <= 1 || outer >= inner_n * inner);
+    if (!distinct) {
+        throw py::value_error("out= has elements that overlap (strides (" + std::to_string(a.strides(0)) + ", " +
+                              std::to_string(a.strides(1)) + ") for shape " + shape_text(a) +
+                              "): one label would overwrite another; give an array whose elements are distinct "
+                              "(numpy.empty((H, W), numpy.uint32))");
+    }
     return a;
 }
 

@@ -32,6 +32,8 @@ public:
     [[nodiscard]] bool copies() const { return copy_; }
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }
+    // ValueError when out= shares memory with the points or normals.
+    void refuse_alias(const py::array& out) const;
 
 private:
     py::array points_;
@@ -46,15 +48,19 @@ private:
 
 class DepthInput {
 public:
-    // depth: H x W (or H x W x 1) uint16 or float32 in place, float64 converted to float32.
+    // depth: H x W (or H x W x 1) uint16 or float32 in place, float64 converted to float32, any other integer
+    // dtype converted to uint16 (its values must be 0..65535: view() raises ValueError for one that is not).
     explicit DepthInput(const py::object& depth);
     DepthView view(Scratch& scratch) const;  // format, size, samples and row step; the caller adds the camera
     [[nodiscard]] bool copies() const { return copy_; }
+    void refuse_alias(const py::array& out) const;
 
 private:
     py::array depth_;
     bool copy_ = false;
-    bool u16_ = false;
+    bool u16_ = false;      // the samples are uint16 (DepthFormat::u16), in place or converted
+    bool integer_ = false;  // another integer dtype, converted to uint16
+    bool is_signed_ = false, swapped_ = false;
     int width_ = 0, height_ = 0;
 };
 
@@ -64,6 +70,7 @@ public:
     MaskInput(const py::object& mask, const py::object& valid);
     MaskView view(Scratch& scratch) const;
     [[nodiscard]] bool copies() const { return copy_; }
+    void refuse_alias(const py::array& out) const;
 
 private:
     py::array mask_;
@@ -73,7 +80,8 @@ private:
     int width_ = 0, height_ = 0;
 };
 
-// out=: a writable H x W uint32 array, any strides. Raises TypeError/ValueError naming the problem.
+// out=: a writable H x W uint32 array, any strides whose elements are distinct (as_strided views may repeat them:
+// one label would overwrite another). Raises TypeError/ValueError naming the problem.
 py::array check_labels_out(const py::object& out, int width, int height);
 // Writes W x H labels (row-major, packed) into `out` (as check_labels_out accepted it). No Python calls: it runs
 // without the GIL.

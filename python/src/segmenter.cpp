@@ -1,9 +1,11 @@
 // pyrseg.Segmenter, its parameters and results, pyrseg.Error, the backends and presets.
 #include <atomic>
+#include <climits>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <string>
 #include <utility>
@@ -11,6 +13,7 @@
 
 #include <pybind11/stl.h>
 
+#include "args.hpp"
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "device.hpp"
@@ -55,6 +58,8 @@ std::string known_presets() {
     return s;
 }
 
+constexpr const char* kInit = "Segmenter()";
+
 SensorKind preset_kind(const std::string& name) {
     const auto kind = sensor_kind_from_name(name);
     if (!kind) raise(ErrorCode::invalid_parameter, "unknown preset '" + name + "'; presets: " + known_presets());
@@ -63,41 +68,43 @@ SensorKind preset_kind(const std::string& name) {
 
 // One keyword argument onto Params; false when `key` is not a parameter.
 bool set_param(Params& p, const std::string& key, const py::handle& v) {
+    const char* name = key.c_str();
+    const auto whole = [&] { return int(integer(kInit, name, v, INT_MIN, INT_MAX)); };
     const auto optional_int = [&](std::optional<int>& field) {
-        field = v.is_none() ? std::nullopt : std::optional<int>(v.cast<int>());
+        field = v.is_none() ? std::nullopt : std::optional<int>(whole());
     };
     if (key == "ct") {
-        p.ct = v.cast<double>();
+        p.ct = number(kInit, name, v);
     } else if (key == "dt") {
-        p.dt = v.cast<double>();
+        p.dt = number(kInit, name, v);
     } else if (key == "unit_mm") {
-        p.unit_mm = v.cast<double>();
+        p.unit_mm = number(kInit, name, v);
     } else if (key == "bridge_levels") {
         optional_int(p.bridge_levels);
     } else if (key == "unjoinable_gap") {
         optional_int(p.unjoinable_gap);
     } else if (key == "label_edges") {
-        p.label_edges = v.cast<bool>();
+        p.label_edges = boolean(kInit, name, v);
     } else if (key == "edge_rounds") {
-        p.edge_rounds = v.cast<int>();
+        p.edge_rounds = whole();
     } else if (key == "compact") {
-        p.compact = v.cast<bool>();
+        p.compact = boolean(kInit, name, v);
     } else if (key == "normal_radius") {
-        p.normal_radius = v.cast<int>();
+        p.normal_radius = whole();
     } else if (key == "metric") {
-        const auto m = v.cast<std::string>();
+        const auto m = text(kInit, name, v);
         if (m != "paper" && m != "robust") {
             raise(ErrorCode::invalid_parameter, "metric must be 'paper' or 'robust', got '" + m + "'");
         }
         p.metric = m == "robust" ? Metric::robust : Metric::paper;
     } else if (key == "normal_window") {
-        p.normal_window = v.cast<int>();
+        p.normal_window = whole();
     } else if (key == "curvature_stride") {
-        p.curvature_stride = v.cast<int>();
+        p.curvature_stride = whole();
     } else if (key == "dt_per_m2") {
-        p.dt_per_m2 = v.cast<double>();
+        p.dt_per_m2 = number(kInit, name, v);
     } else if (key == "ct_growth_per_m2") {
-        p.ct_growth_per_m2 = v.cast<double>();
+        p.ct_growth_per_m2 = number(kInit, name, v);
     } else {
         return false;
     }
@@ -106,8 +113,14 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
 
 Outputs outputs_from(const py::handle& names) {
     Outputs o;
-    if (py::isinstance<py::str>(names)) throw py::type_error("outputs must be a sequence of names, not a string");
+    if (py::isinstance<py::str>(names) || !py::isinstance<py::iterable>(names)) {
+        throw py::type_error("Segmenter(): outputs must be a sequence of names (str), got " + type_name(names));
+    }
     for (const py::handle& n : names) {
+        if (!py::isinstance<py::str>(n)) {
+            throw py::type_error("Segmenter(): outputs must be a sequence of names (str), got " + type_name(n) +
+                                 " among them");
+        }
         const auto name = n.cast<std::string>();
         if (name == "raw_labels") {
             o.raw_labels = true;
@@ -128,10 +141,10 @@ Outputs outputs_from(const py::handle& names) {
 // preset= first (it sets every parameter, in unit_mm), then each parameter given over it.
 Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_stream) {
     double unit_mm = 1.0;
-    if (kwargs.contains("unit_mm")) unit_mm = kwargs["unit_mm"].cast<double>();
+    if (kwargs.contains("unit_mm")) unit_mm = number(kInit, "unit_mm", kwargs["unit_mm"]);
     Params p;
     if (kwargs.contains("preset") && !kwargs["preset"].is_none()) {
-        p = sensor_preset(preset_kind(kwargs["preset"].cast<std::string>()), unit_mm);
+        p = sensor_preset(preset_kind(text(kInit, "preset", kwargs["preset"])), unit_mm);
     }
     for (const auto& [k, v] : kwargs) {
         const auto key = k.cast<std::string>();
@@ -152,12 +165,21 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
 
 // --- the Segmenter ----------------------------------------------------------------------------------------------
 
+// The frame methods' parameters (Args binds them; their docstrings show them).
+constexpr Param kSegment[] = {{"points"}, {"normals", "None"}, {"out", "None"}, {"count", "None"}};
+constexpr Param kSegmentDepth[] = {{"depth"},           {"fx"},          {"fy"},           {"cx"}, {"cy"},
+                                   {"metres_per_unit"}, {"out", "None"}, {"count", "None"}};
+constexpr Param kSegmentMask[] = {{"mask"}, {"valid", "None"}, {"out", "None"}};
+
 class PySegmenter {
 public:
-    PySegmenter(int width, int height, const py::object& backend, const py::kwargs& kwargs) {
+    PySegmenter(const py::object& width, const py::object& height, const py::object& backend,
+                const py::kwargs& kwargs) {
+        const int w = int(integer(kInit, "width", width, INT_MIN, INT_MAX));
+        const int h = int(integer(kInit, "height", height, INT_MIN, INT_MAX));
         py::object cuda_stream = py::none();
         params_ = params_from(kwargs, outputs_, cuda_stream);
-        const std::string requested = backend.is_none() ? std::string() : backend.cast<std::string>();
+        const std::string requested = backend.is_none() ? std::string() : text(kInit, "backend", backend);
         // The device-array path needs the Segmenter pyrseg/cuda.hpp makes on a stream; it segments host frames
         // too, so every CUDA Segmenter is made that way.
         const std::string name = resolve_backend_name(requested);
@@ -169,38 +191,41 @@ public:
         // A GPU backend's setup (devices, kernels, buffers) can take a while: other Python threads go on meanwhile.
         const py::gil_scoped_release nogil;
         if (device_) {
-            segmenter_.emplace(device_->make_segmenter(width, height, params_, outputs_));
+            segmenter_.emplace(device_->make_segmenter(w, h, params_, outputs_));
         } else {
-            segmenter_.emplace(width, height, params_, name, outputs_);
+            segmenter_.emplace(w, h, params_, name, outputs_);
         }
     }
 
-    py::object segment(const py::object& points, const py::object& normals, const py::object& out,
-                       const py::object& count) {
+    py::object segment(const py::args& args, const py::kwargs& kwargs) {
+        const Args a("segment()", kSegment, args, kwargs);
+        const py::object points = a.object(0), normals = a.object(1), out = a.object(2), count = a.object(3);
         if (is_device_array(points)) {
             device().segment_cloud(*segmenter_, points, normals, out, count);
             return out;
         }
         no_count(count);
         const CloudInput input(points, normals, width(), height());
-        return run(input, out, [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment(input.view(s), r); });
+        return run(input, out, true,
+                   [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment(input.view(s), r); });
     }
 
-    py::object segment_depth(const py::object& depth, double fx, double fy, double cx, double cy,
-                             double metres_per_unit, const py::object& out, const py::object& count) {
+    py::object segment_depth(const py::args& args, const py::kwargs& kwargs) {
+        const Args a("segment_depth()", kSegmentDepth, args, kwargs);
+        const py::object depth = a.object(0), out = a.object(6), count = a.object(7);
         DepthView camera;
-        camera.fx = fx;
-        camera.fy = fy;
-        camera.cx = cx;
-        camera.cy = cy;
-        camera.metres_per_unit = metres_per_unit;
+        camera.fx = a.number(1);
+        camera.fy = a.number(2);
+        camera.cx = a.number(3);
+        camera.cy = a.number(4);
+        camera.metres_per_unit = a.number(5);
         if (is_device_array(depth)) {
             device().segment_depth(*segmenter_, depth, camera, out, count);
             return out;
         }
         no_count(count);
         const DepthInput input(depth);
-        return run(input, out, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
+        return run(input, out, true, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
             DepthView v = input.view(s);
             v.fx = camera.fx;
             v.fy = camera.fy;
@@ -211,9 +236,12 @@ public:
         });
     }
 
-    py::object segment_mask(const py::object& mask, const py::object& valid, const py::object& out) {
-        const MaskInput input(mask, valid);
-        return run(input, out, [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment_mask(input.view(s), r); });
+    py::object segment_mask(const py::args& args, const py::kwargs& kwargs) {
+        const Args a("segment_mask()", kSegmentMask, args, kwargs);
+        const MaskInput input(a.object(0), a.object(1));
+        // A mask has no points, so no normals: Result.normals is None for it whatever outputs= asks.
+        return run(input, a.object(2), false,
+                   [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment_mask(input.view(s), r); });
     }
 
     [[nodiscard]] int width() const { return segmenter_->width(); }
@@ -263,9 +291,10 @@ private:
 
     // One host frame: the result arrays made with the GIL, the frame and the copies into them without it.
     template <class Input, class Frame>
-    py::object run(const Input& input, const py::object& out, const Frame& frame) {
+    py::object run(const Input& input, const py::object& out, bool has_normals, const Frame& frame) {
         const int w = width(), h = height();
         py::array labels = out.is_none() ? new_array(cached.uint32, h, w) : check_labels_out(out, w, h);
+        if (!out.is_none()) input.refuse_alias(labels);
         py::object raw = py::none(), mask = py::none(), normals = py::none(), segments = py::none();
         void* raw_data = nullptr;
         void* mask_data = nullptr;
@@ -280,7 +309,7 @@ private:
             mask_data = a.mutable_data();
             mask = std::move(a);
         }
-        if (outputs_.normals) {
+        if (outputs_.normals && has_normals) {
             auto a = new_array(cached.float32, h, w, 3);
             normals_data = a.mutable_data();
             normals = std::move(a);
@@ -292,10 +321,23 @@ private:
             const std::lock_guard<std::mutex> lock(mutex_);
             frame(scratch_, *segmenter_, result_);
             last_copied_ = input.copies();
+            // A Result keeps its buffers' capacity from frame to frame: a size the frame did not give would copy
+            // an earlier frame's data, or read past the end.
+            const auto check = [](const auto& from, std::size_t n, const char* what) {
+                if (from.size() != n) {
+                    raise(ErrorCode::internal, std::string("the frame gave ") + std::to_string(from.size()) + " " +
+                                                   what + " values, not " + std::to_string(n));
+                }
+            };
+            const auto copy = [&check](void* to, const auto& from, std::size_t n, const char* what) {
+                check(from, n, what);
+                std::memcpy(to, from.data(), n * sizeof(from[0]));
+            };
+            check(result_.labels, pixels, "label");
             copy_labels(result_.labels.data(), labels);
-            if (raw_data != nullptr) std::memcpy(raw_data, result_.raw_labels.data(), pixels * 4);
-            if (mask_data != nullptr) std::memcpy(mask_data, result_.fillable_mask.data(), pixels);
-            if (normals_data != nullptr) std::memcpy(normals_data, result_.normals.data(), pixels * 12);
+            if (raw_data != nullptr) copy(raw_data, result_.raw_labels, pixels, "raw label");
+            if (mask_data != nullptr) copy(mask_data, result_.fillable_mask, pixels, "fillable mask");
+            if (normals_data != nullptr) copy(normals_data, result_.normals, pixels * 3, "normal");
             count = result_.segment_count;
             if (outputs_.segment_stats) {
                 // Under the lock, so that another thread's frame cannot overwrite the statistics being read.
@@ -321,6 +363,11 @@ private:
     std::atomic<bool> last_copied_{false};
     std::mutex mutex_;  // one frame at a time: Python threads may share a Segmenter, and run without the GIL
 };
+
+PySegmenter& segmenter_of(py::handle self) {
+    return live<PySegmenter>(self, "pyrseg.Segmenter",
+                             "the Segmenter was not initialised: call pyrseg.Segmenter(width, height, ...)");
+}
 
 // The package pyrseg re-exports its extension _pyrseg's names: its types say pyrseg.X, as users import them.
 std::string public_name(const py::module_& m) {
@@ -393,7 +440,7 @@ void bind_segmenter(py::module_& m) {
         py::arg("module") = module_name));
     m.attr("BackendInfo") = obj(cached.backend_type);
 
-    py::class_<PySegmenter>(m, "Segmenter", kLocal, R"(A segmenter for one backend and one frame size.
+    py::class_<PySegmenter> segmenter(m, "Segmenter", kLocal, R"(A segmenter for one backend and one frame size.
 
 Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, **params)
 
@@ -403,47 +450,65 @@ params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2 (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
-stream; None is the legacy default stream.)")
-        .def(py::init<int, int, const py::object&, const py::kwargs&>(), py::arg("width"), py::arg("height"),
-             py::arg("backend") = py::none())
-        .def("segment", &PySegmenter::segment, py::arg("points"), py::arg("normals") = py::none(),
-             py::arg("out") = py::none(), py::arg("count") = py::none(),
+stream; None is the legacy default stream.
+
+Every argument of the wrong type is a TypeError naming it; a Segmenter made by Segmenter.__new__ alone raises
+TypeError from every member, and a second __init__ on a Segmenter raises TypeError (make a new one).)");
+    segmenter.def(py::init<const py::object&, const py::object&, const py::object&, const py::kwargs&>(),
+                  py::arg("width"), py::arg("height"), py::arg("backend") = py::none());
+    def_args(segmenter, "segment", kSegment,
              R"(Segments an organized cloud and returns a pyrseg.Result.
 
 points: H x W x 3 (xyz), H x W x 4 (xyz and a pad, PCL's PointXYZ) or H x W x 6 (xyz then normals), float32 (read in
 place, any strides) or float64 (converted); normals: None (estimated) or H x W x 3. out: an H x W uint32 array
-to write the labels into. A CUDA device array (backend "cuda") is segmented on the device, asynchronously on the
-Segmenter's stream: out= (an H x W uint32 device array) is then required and returned, and count= (a uint32 device
-array) receives the segment count.)")
-        .def("segment_depth", &PySegmenter::segment_depth, py::arg("depth"), py::arg("fx"), py::arg("fy"),
-             py::arg("cx"), py::arg("cy"), py::arg("metres_per_unit"), py::arg("out") = py::none(),
-             py::arg("count") = py::none(),
-             R"(Segments a depth image (H x W uint16 or float32; float64 converted) back-projected with the pinhole
-intrinsics; metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 for float metres).)")
-        .def("segment_mask", &PySegmenter::segment_mask, py::arg("mask"), py::arg("valid") = py::none(),
-             py::arg("out") = py::none(),
+to write the labels into (its elements distinct, sharing no memory with the inputs). A CUDA device array (backend
+"cuda") is segmented on the device, asynchronously on the Segmenter's stream: out= (an H x W uint32 device array) is
+then required and returned, and count= (a uint32 device array) receives the segment count.)",
+             [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
+                 return segmenter_of(self).segment(args, kwargs);
+             });
+    def_args(segmenter, "segment_depth", kSegmentDepth,
+             R"(Segments a depth image back-projected with the pinhole intrinsics: H x W uint16 or float32 in place,
+float64 converted, any other integer dtype converted to uint16 when its values are 0..65535 (PIL gives int32 for
+16-bit PNGs). metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 for float metres).)",
+             [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
+                 return segmenter_of(self).segment_depth(args, kwargs);
+             });
+    def_args(segmenter, "segment_mask", kSegmentMask,
              "Labels a caller-made fillable mask (H x W bool or uint8); valid: which other pixels edge labelling "
-             "may label (None: all).")
-        .def_property_readonly("width", &PySegmenter::width)
-        .def_property_readonly("height", &PySegmenter::height)
-        .def_property_readonly("backend", &PySegmenter::backend)
-        .def_property_readonly("params", &PySegmenter::params)
-        .def_property_readonly("outputs", &PySegmenter::outputs)
-        .def_property_readonly("timings", &PySegmenter::timings,
-                               "Milliseconds of each pass of the last host frame, in pass order.")
-        .def_property_readonly("last_input_copied", &PySegmenter::last_input_copied,
-                               "Whether the last host frame had to be converted (float64, or a layout pyrseg's views "
-                               "cannot describe) rather than read in place.")
-        .def("__repr__", &PySegmenter::repr);
+             "may label (None: all). The result's fillable_mask is the mask (0 or 1) and its normals None: a mask has "
+             "no points.",
+             [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
+                 return segmenter_of(self).segment_mask(args, kwargs);
+             });
+    segmenter.def_property_readonly("width", [](const py::object& self) { return segmenter_of(self).width(); })
+        .def_property_readonly("height", [](const py::object& self) { return segmenter_of(self).height(); })
+        .def_property_readonly("backend", [](const py::object& self) { return segmenter_of(self).backend(); })
+        .def_property_readonly("params", [](const py::object& self) { return segmenter_of(self).params(); })
+        .def_property_readonly("outputs", [](const py::object& self) { return segmenter_of(self).outputs(); })
+        .def_property_readonly(
+            "timings", [](const py::object& self) { return segmenter_of(self).timings(); },
+            "Milliseconds of each pass of the last host frame, in pass order.")
+        .def_property_readonly(
+            "last_input_copied", [](const py::object& self) { return segmenter_of(self).last_input_copied(); },
+            "Whether the last host frame had to be converted (float64, another integer depth, or a layout pyrseg's "
+            "views cannot describe) rather than read in place.")
+        .def("__repr__", [](const py::object& self) {
+            if (py::isinstance<PySegmenter>(self) && !initialised(self))
+                return std::string("<pyrseg.Segmenter, not initialised>");
+            return segmenter_of(self).repr();
+        });
+    refuse_second_init(segmenter, "pyrseg.Segmenter");
 
     m.def("backends", &backends, "Every backend pyrseg knows, in preference order, and whether it can run here.");
-    m.def(
-        "choose_backend",
-        [](const py::object& requested) {
-            const BackendChoice c = choose_backend(requested.is_none() ? std::string() : requested.cast<std::string>());
-            return py::make_tuple(c.name, c.reason);
-        },
-        py::arg("requested") = py::none(), "The backend a request resolves to, and why: (name, reason).");
+    static constexpr Param kChooseBackend[] = {{"requested", "None"}};
+    def_args(m, "choose_backend", kChooseBackend, "The backend a request resolves to, and why: (name, reason).",
+             [](const py::args& args, const py::kwargs& kwargs) {
+                 const Args a("choose_backend()", kChooseBackend, args, kwargs);
+                 const py::object requested = a.object(0);
+                 const BackendChoice c = choose_backend(requested.is_none() ? std::string() : a.text(0, ""));
+                 return py::make_tuple(c.name, c.reason);
+             });
     m.def(
         "presets",
         [] {
@@ -452,34 +517,35 @@ intrinsics; metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 f
             return d;
         },
         "The sensor presets: name -> what it suits.");
-    m.def(
-        "preset",
-        [](const std::string& name, double unit_mm) {
-            return params_to_dict(sensor_preset(preset_kind(name), unit_mm));
-        },
-        py::arg("name"), py::arg("unit_mm") = 1.0, "A sensor preset's parameters, for clouds in units of unit_mm mm.");
+    static constexpr Param kPreset[] = {{"name"}, {"unit_mm", "1.0"}};
+    def_args(m, "preset", kPreset, "A sensor preset's parameters, for clouds in units of unit_mm mm.",
+             [](const py::args& args, const py::kwargs& kwargs) {
+                 const Args a("preset()", kPreset, args, kwargs);
+                 return params_to_dict(sensor_preset(preset_kind(a.text(0, "")), a.number(1, 1.0)));
+             });
     m.def(
         "default_params", [] { return params_to_dict(Params{}); }, "The algorithm contract's default parameters.");
-    m.def(
-        "measure_frame_noise",
-        [](const py::object& points, double unit_mm) {
-            const CloudInput input(points, py::none(), -1, -1);
-            Scratch scratch;
-            FrameNoise n;
-            {
-                const py::gil_scoped_release nogil;
-                n = measure_frame_noise(input.view(scratch), unit_mm);
-            }
-            py::dict d;
-            d["samples"] = n.samples;
-            d["median_depth_mm"] = n.median_depth_mm;
-            d["second_difference_mm"] = n.second_difference_mm;
-            d["suggested"] = sensor_kind_name(n.suggested);
-            d["reason"] = n.reason;
-            return d;
-        },
-        py::arg("points"), py::arg("unit_mm") = 1.0,
-        "How noisy a frame's depth is, and which preset it suggests (pyrseg/presets.hpp).");
+    static constexpr Param kFrameNoise[] = {{"points"}, {"unit_mm", "1.0"}};
+    def_args(m, "measure_frame_noise", kFrameNoise,
+             "How noisy a frame's depth is, and which preset it suggests (pyrseg/presets.hpp).",
+             [](const py::args& args, const py::kwargs& kwargs) {
+                 const Args a("measure_frame_noise()", kFrameNoise, args, kwargs);
+                 const double unit_mm = a.number(1, 1.0);
+                 const CloudInput input(a.object(0), py::none(), -1, -1);
+                 Scratch scratch;
+                 FrameNoise n;
+                 {
+                     const py::gil_scoped_release nogil;
+                     n = measure_frame_noise(input.view(scratch), unit_mm);
+                 }
+                 py::dict d;
+                 d["samples"] = n.samples;
+                 d["median_depth_mm"] = n.median_depth_mm;
+                 d["second_difference_mm"] = n.second_difference_mm;
+                 d["suggested"] = sensor_kind_name(n.suggested);
+                 d["reason"] = n.reason;
+                 return d;
+             });
 }
 
 void bind_errors(py::module_& m) {
@@ -501,14 +567,23 @@ void bind_errors(py::module_& m) {
     if (cached.error == nullptr) throw py::error_already_set();
     m.attr("Error") = obj(cached.error);
     // NOLINTNEXTLINE(performance-unnecessary-value-param): pybind11 takes void(*)(std::exception_ptr)
+    // std::bad_alloc too: a backend or the bindings themselves may let one out where the library's own checks
+    // (Error(out_of_memory)) did not foresee it, and every backend should say the same for the same failure.
     py::register_local_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const Error& e) {
+        const auto set = [](const Error& e) {
             const py::object instance = obj(cached.error)(e.what());
             instance.attr("code") = py::cast(e.code());
             instance.attr("message") = e.what();
             PyErr_SetObject(cached.error, instance.ptr());
+        };
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Error& e) {
+            set(e);
+        } catch (const std::bad_alloc&) {
+            set(Error(ErrorCode::out_of_memory,
+                      "out of memory: allocating the buffers of this image size failed "
+                      "(std::bad_alloc)"));
         }
     });
 }

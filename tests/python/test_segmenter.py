@@ -190,7 +190,7 @@ def test_depth_frames(scene):
         seg.segment_depth(depth, metres_per_unit=0, **k)
     assert e.value.code == pyrseg.ErrorCode.invalid_parameter
     with pytest.raises(TypeError, match="uint16"):
-        seg.segment_depth(depth.astype(np.int32), metres_per_unit=0.001, **k)
+        seg.segment_depth(depth.astype(np.float16), metres_per_unit=0.001, **k)
 
 
 def test_mask_frames():
