@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "core/depth_camera.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::core {
@@ -34,19 +35,7 @@ void make_depth_tables(const DepthView& depth, double unit_mm, DepthTables& tabl
     if (depth.row_step_bytes > std::numeric_limits<std::size_t>::max() / std::size_t(std::max(depth.height, 1))) {
         bad(ErrorCode::invalid_argument, "row_step_bytes " + std::to_string(depth.row_step_bytes) + " is too large");
     }
-    const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-    if (!positive(depth.metres_per_unit)) {
-        bad(ErrorCode::invalid_parameter,
-            "metres_per_unit must be finite and > 0, got " + std::to_string(depth.metres_per_unit));
-    }
-    if (!positive(depth.fx))
-        bad(ErrorCode::invalid_parameter, "fx must be finite and > 0, got " + std::to_string(depth.fx));
-    if (!positive(depth.fy))
-        bad(ErrorCode::invalid_parameter, "fy must be finite and > 0, got " + std::to_string(depth.fy));
-    if (!std::isfinite(depth.cx))
-        bad(ErrorCode::invalid_parameter, "cx must be finite, got " + std::to_string(depth.cx));
-    if (!std::isfinite(depth.cy))
-        bad(ErrorCode::invalid_parameter, "cy must be finite, got " + std::to_string(depth.cy));
+    check_depth_intrinsics(depth);
     const auto scale = static_cast<float>((depth.metres_per_unit * 1000.0) / unit_mm);
     if (!std::isfinite(scale) || scale < std::numeric_limits<float>::min()) {
         bad(ErrorCode::invalid_parameter, "metres_per_unit " + std::to_string(depth.metres_per_unit) +

@@ -68,6 +68,13 @@ void check_metric_parameters(const Params& p) {
 
 }  // namespace
 
+void check_unit_mm(double unit_mm) {
+    if (!std::isfinite(unit_mm) || unit_mm <= 0.0) {
+        bad_parameter("unit_mm must be a finite number of millimetres > 0 (1 for millimetres, 1000 for metres), got " +
+                      std::to_string(unit_mm));
+    }
+}
+
 Thresholds compute_thresholds(const Params& params) {
     if (!std::isfinite(params.ct) || params.ct < 0.0) {
         bad_parameter("ct (curvature threshold) must be a finite angle >= 0 radians, got " + std::to_string(params.ct));
@@ -75,9 +82,7 @@ Thresholds compute_thresholds(const Params& params) {
     if (std::isnan(params.dt) || params.dt < 0.0) {
         bad_parameter("dt (depth threshold) must be >= 0 millimetres (or +inf), got " + std::to_string(params.dt));
     }
-    if (!std::isfinite(params.unit_mm) || params.unit_mm <= 0.0) {
-        bad_parameter("unit_mm must be a finite number of millimetres > 0, got " + std::to_string(params.unit_mm));
-    }
+    check_unit_mm(params.unit_mm);
     Thresholds t{};
     // For ct >= pi the curvature test must always pass: -2^28 is below any k * (mean dot) >= k * -3 * 2^26, and
     // k * -2^28 still fits int32 for k <= 8.

@@ -24,6 +24,10 @@ struct Thresholds {
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.
 [[nodiscard]] Thresholds compute_thresholds(const Params& params);
 
+// unit_mm (Params, sensor_preset, measure_frame_noise): a finite number of millimetres > 0, else
+// pyrseg::Error(invalid_parameter) naming it.
+void check_unit_mm(double unit_mm);
+
 struct Plan {
     int width = 0;
     int height = 0;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/cloud_layout.hpp"
+#include "core/plan.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg {
@@ -87,6 +88,7 @@ const char* sensor_kind_summary(SensorKind kind) {
 }
 
 Params sensor_preset(SensorKind kind, double unit_mm) {
+    core::check_unit_mm(unit_mm);
     Params p;
     switch (kind) {
         case SensorKind::structured_light:
@@ -110,8 +112,9 @@ Params sensor_preset(SensorKind kind, double unit_mm) {
 }
 
 FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm) {
+    core::check_unit_mm(unit_mm);
     FrameNoise out;
-    if (cloud.points == nullptr || cloud.width < 3 || cloud.height < 1 || !(unit_mm > 0) || !std::isfinite(unit_mm)) {
+    if (cloud.points == nullptr || cloud.width < 3 || cloud.height < 1) {
         out.reason = "the frame is too small to measure its noise";
         return out;
     }

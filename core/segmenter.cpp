@@ -9,6 +9,7 @@
 
 #include "core/backend_registry.hpp"
 #include "core/cloud_layout.hpp"
+#include "core/depth_camera.hpp"
 #include "core/depth_tables.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
@@ -157,6 +158,12 @@ void Segmenter::segment(const DepthView& depth, Result& out) {
     Impl& impl = live(impl_);
     check_frame_size("the depth image", depth.width, depth.height, impl.plan);
     core::make_depth_tables(depth, impl.plan.params.unit_mm, impl.depth_tables);
+    // The sampled median catches a wrong depth scale. That is a property of the camera, not of each frame's content:
+    // once a frame with enough data has passed, the same camera is not checked again (a covered lens later in a
+    // stream cannot stop it).
+    if (!impl.checked_camera.same(depth) && check_depth_camera(depth).median_depth_m > 0) {
+        impl.checked_camera.remember(depth);
+    }
     run_frame(
         impl, core::InputKind::depth, [&] { impl.executor->bind_depth(depth, impl.depth_tables); }, out);
 }

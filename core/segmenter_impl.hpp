@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/depth_camera.hpp"
 #include "core/depth_tables.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
@@ -17,7 +18,8 @@ struct Segmenter::Impl {
     Outputs outputs;
     std::unique_ptr<core::PassExecutor> executor;
     std::vector<PassTiming> timings;
-    core::DepthTables depth_tables;  // a depth frame's constants, reused
+    core::DepthTables depth_tables;           // a depth frame's constants, reused
+    core::CheckedDepthCamera checked_camera;  // the camera whose frame check_depth_camera last passed
 };
 
 namespace core {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "file_util.hpp"
+#include "pyrseg/depth.hpp"
 #include "pyrseg/io.hpp"
 
 namespace pyrseg::io {
@@ -37,10 +38,6 @@ DepthImage from_png(const std::filesystem::path& path) {
 struct TiffCloser {
     void operator()(TIFF* t) const { TIFFClose(t); }
 };
-
-// The most pixels a depth image may have: 2^28 (16384 x 16384, 1 GiB of float depth), far beyond any depth camera.
-// A compressed strip may expand beyond its size in the file, so the file's size alone does not bound the image.
-constexpr std::uint64_t kMaxDepthPixels = std::uint64_t{1} << 28;
 
 // How many bytes one byte of a strip can decode to, for the codecs whose bound is known; 0 for the others.
 std::uint64_t max_expansion(std::uint16_t compression) {
@@ -120,13 +117,7 @@ DepthImage from_tiff(const std::filesystem::path& path) {
                                                 : "unsigned") +
                  " samples");
     }
-    if (width == 0 || height == 0 || width > 1u << 16 || height > 1u << 16 ||
-        std::uint64_t{width} * height > kMaxDepthPixels) {
-        fail(ErrorCode::format, path,
-             "TIFF size " + std::to_string(width) + " x " + std::to_string(height) +
-                 " is not a depth image size (at most 65536 on a side and " + std::to_string(kMaxDepthPixels) +
-                 " pixels)");
-    }
+    detail::check_image_size(path, "TIFF", width, height);
     if (TIFFIsTiled(tiff.get())) fail(ErrorCode::format, path, "unsupported TIFF layout (tiled)");
     const tmsize_t line = TIFFScanlineSize(tiff.get());
     if (line != tmsize_t(width) * (bits / 8)) fail(ErrorCode::format, path, "unsupported TIFF layout (tiled?)");
@@ -195,14 +186,25 @@ void write_tiff_float(const std::filesystem::path& path, const float* depth, int
     });
 }
 
-PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit) {
-    if (!(k.fx > 0) || !(k.fy > 0) || !std::isfinite(k.fx) || !std::isfinite(k.fy) || !std::isfinite(k.cx) ||
-        !std::isfinite(k.cy)) {
-        throw Error(ErrorCode::invalid_argument, "intrinsics need finite fx, fy > 0 and finite cx, cy");
+PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double metres_per_unit) {
+    if (image.width < 1 || image.height < 1 ||
+        image.depth.size() != std::size_t(image.width) * std::size_t(image.height)) {
+        throw Error(ErrorCode::invalid_argument, "depth_to_cloud: the depth image is " + std::to_string(image.width) +
+                                                     " x " + std::to_string(image.height) + " with " +
+                                                     std::to_string(image.depth.size()) + " samples");
     }
-    if (!(mm_per_unit > 0) || !std::isfinite(mm_per_unit)) {
-        throw Error(ErrorCode::invalid_argument, "the depth scale must be finite and > 0");
-    }
+    DepthView camera;
+    camera.depth = image.depth.data();
+    camera.format = DepthFormat::f32;
+    camera.width = image.width;
+    camera.height = image.height;
+    camera.metres_per_unit = metres_per_unit;
+    camera.fx = k.fx;
+    camera.fy = k.fy;
+    camera.cx = k.cx;
+    camera.cy = k.cy;
+    (void)check_depth_camera(camera);
+    const double mm_per_unit = metres_per_unit * 1000.0;
     PointCloud cloud;
     cloud.width = image.width;
     cloud.height = image.height;

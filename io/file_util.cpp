@@ -33,6 +33,25 @@ void fail(ErrorCode code, const std::filesystem::path& path, std::string_view wh
     throw Error(code, path.string() + ": " + std::string(what));
 }
 
+std::string printable(std::string_view bytes) {
+    std::string shown(bytes);
+    for (char& c : shown) {
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    }
+    return shown;
+}
+
+void check_image_size(const std::filesystem::path& path, std::string_view kind, std::uint64_t width,
+                      std::uint64_t height) {
+    if (width == 0 || height == 0 || width > kMaxImageSide || height > kMaxImageSide ||
+        width * height > kMaxImagePixels) {
+        fail(ErrorCode::format, path,
+             std::string(kind) + " size " + std::to_string(width) + " x " + std::to_string(height) +
+                 " is not an image size pyrseg reads (at most " + std::to_string(kMaxImageSide) + " on a side and " +
+                 std::to_string(kMaxImagePixels) + " pixels)");
+    }
+}
+
 InputFile::InputFile(const std::filesystem::path& path) : path_(path) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);

@@ -21,6 +21,19 @@ namespace pyrseg::io::detail {
 // "<path>: <what>", the shape every io message takes.
 [[noreturn]] void fail(ErrorCode code, const std::filesystem::path& path, std::string_view what);
 
+// A file's bytes quoted in a message: control and non-ASCII bytes as '?', so that a message stays one line of text.
+std::string printable(std::string_view bytes);
+
+// The largest image any reader decodes: 65536 on a side and 2^28 pixels in all (16384 x 16384, 1 GiB of float depth),
+// far beyond any camera. Compressed image data can expand far beyond its size in the file (deflate 1032-fold), so the
+// file's size alone does not bound what a reader allocates.
+constexpr std::uint64_t kMaxImageSide = std::uint64_t{1} << 16;
+constexpr std::uint64_t kMaxImagePixels = std::uint64_t{1} << 28;
+// ErrorCode::format naming the file (`kind`: "TIFF", "PNG") when width x height is not an image size the readers take;
+// called with the header's size, before anything is allocated for the pixels.
+void check_image_size(const std::filesystem::path& path, std::string_view kind, std::uint64_t width,
+                      std::uint64_t height);
+
 // read_file's default limit: what is read whole (a calibration file) is small; the readers of large formats (PCD,
 // PLY, PNG, TIFF, .npy) read from an InputFile instead, bounded by what the header claims and the file holds.
 inline constexpr std::uint64_t kMaxWholeFile = std::uint64_t{1} << 30;

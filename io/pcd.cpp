@@ -6,6 +6,7 @@
 #include <bit>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -164,12 +165,16 @@ void read_compressed(const PcdHeader& h, detail::InputFile& file, io::PointCloud
     gather_soa(h, raw.data(), cloud);
 }
 
+enum class Number { ok, not_a_number, out_of_range };
+
 // from_chars accepts nan and inf in any case but no leading '+', which some writers emit.
 template <typename T>
-bool parse_number(std::string_view token, T& value) {
+Number parse_number(std::string_view token, T& value) {
     if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
     const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    return ec == std::errc() && end == token.data() + token.size();
+    if (end != token.data() + token.size()) return Number::not_a_number;
+    if (ec == std::errc::result_out_of_range) return Number::out_of_range;
+    return ec == std::errc() ? Number::ok : Number::not_a_number;
 }
 
 class AsciiReader {
@@ -274,24 +279,29 @@ private:
     };
 
     void store(std::string_view token, const Target& t, std::uint64_t point, io::PointCloud& cloud) const {
-        bool ok = false;
+        Number parsed = Number::ok;
         float f = 0;
         if (t.index >= 0 && t.field->size == 4) {
-            ok = parse_number(token, f);
+            parsed = parse_number(token, f);
         } else {
             // Skipped fields are still checked: garbage anywhere means the file is not what it claims to be.
             // Doubles parse every integer PCL writes (it writes rgb as an unsigned integer despite TYPE F).
             double d = 0;
-            ok = parse_number(token, d);
-            f = static_cast<float>(d);
-        }
-        if (!ok) {
-            std::string shown(token.substr(0, 32));
-            for (char& c : shown) {
-                if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+            parsed = parse_number(token, d);
+            // A double point field's value must fit the float it is stored in (the conversion is undefined else).
+            if (parsed == Number::ok && t.index >= 0 && std::isfinite(d) &&
+                std::fabs(d) > double(std::numeric_limits<float>::max())) {
+                parsed = Number::out_of_range;
             }
+            if (parsed == Number::ok && t.index >= 0) f = static_cast<float>(d);
+        }
+        if (parsed != Number::ok) {
+            const std::string shown = detail::printable(token.substr(0, 32));
             fail("data line " + std::to_string(line_number_) + " (point " + std::to_string(point) + "): '" + shown +
-                 "' in field '" + t.field->name + "' is not a number");
+                 "' in field '" + t.field->name + "' " +
+                 (parsed == Number::out_of_range
+                      ? "is outside float32's range (about 1.2e-38 to 3.4e38 in magnitude, or 0)"
+                      : "is not a number"));
         }
         if (t.index < 0) return;
         auto& out = t.index < 3 ? cloud.points : cloud.normals;
@@ -313,7 +323,7 @@ PointCloud read_pcd(const std::filesystem::path& path) {
         detail::InputFile file(path);
         // The header from the file's first bytes: a file that is not a PCD is refused without reading it whole.
         const std::vector<unsigned char> head = detail::read_head(file, kMaxHeaderBytes);
-        const PcdHeader h = detail::parse_pcd_header(head, path);
+        const PcdHeader h = detail::parse_pcd_header(head, path, head.size() == file.size());
         if (head.size() < file.size() && h.data_offset == head.size() && head.back() != '\n') {
             fail(ErrorCode::format, path,
                  "the header is longer than " + std::to_string(kMaxHeaderBytes) + " bytes (not a PCD file?)");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 #include <string_view>
+#include <unordered_set>
 
 #include "file_util.hpp"
 
@@ -57,8 +58,8 @@ struct Line {
 
 class HeaderParser {
 public:
-    HeaderParser(const std::vector<unsigned char>& bytes, const std::filesystem::path& path)
-        : text_(reinterpret_cast<const char*>(bytes.data()), bytes.size()), path_(path) {}
+    HeaderParser(const std::vector<unsigned char>& bytes, const std::filesystem::path& path, bool whole_file)
+        : text_(reinterpret_cast<const char*>(bytes.data()), bytes.size()), path_(path), whole_file_(whole_file) {}
 
     PcdHeader parse() {
         read_lines();
@@ -120,6 +121,10 @@ private:
                 return;
             }
         }
+        if (!whole_file_) {
+            fail("no DATA line in the first " + std::to_string(text_.size()) +
+                 " bytes: the header is longer than pyrseg reads (not a PCD file?)");
+        }
         fail("no DATA line: the header is incomplete (truncated file, or not a PCD file)");
     }
 
@@ -149,13 +154,11 @@ private:
     void parse_fields(PcdHeader& h) const {
         const Line& line = required(fields);
         if (line.values.empty()) fail("FIELDS lists no fields");
+        // A set, not a scan of the names so far: a megabyte of FIELDS names is then read in linear time.
+        std::unordered_set<std::string_view> seen;
         for (const auto name : line.values) {
             // PCL names every padding field "_", so only real names must be unique.
-            if (name != "_") {
-                for (const auto& f : h.fields) {
-                    if (f.name == name) fail("FIELDS lists field " + quote(name) + " twice");
-                }
-            }
+            if (name != "_" && !seen.insert(name).second) fail("FIELDS lists field " + quote(name) + " twice");
             h.fields.push_back(PcdField{std::string(name)});
         }
     }
@@ -324,12 +327,14 @@ private:
     const std::filesystem::path& path_;
     std::array<Line, key_count> lines_{};
     std::size_t data_offset_ = 0;
+    bool whole_file_ = true;
 };
 
 }  // namespace
 
-PcdHeader parse_pcd_header(const std::vector<unsigned char>& bytes, const std::filesystem::path& path) {
-    return HeaderParser(bytes, path).parse();
+PcdHeader parse_pcd_header(const std::vector<unsigned char>& bytes, const std::filesystem::path& path,
+                           bool whole_file) {
+    return HeaderParser(bytes, path, whole_file).parse();
 }
 
 }  // namespace pyrseg::io::detail

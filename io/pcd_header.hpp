@@ -36,7 +36,8 @@ inline bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-// Throws pyrseg::Error (ErrorCode::format) naming the file and the offending line or field.
-PcdHeader parse_pcd_header(const std::vector<unsigned char>& bytes, const std::filesystem::path& path);
+// Throws pyrseg::Error (ErrorCode::format) naming the file and the offending line or field. whole_file: `bytes` is the
+// whole file, not only its first bytes (a header without DATA is then incomplete rather than too long).
+PcdHeader parse_pcd_header(const std::vector<unsigned char>& bytes, const std::filesystem::path& path, bool whole_file);
 
 }  // namespace pyrseg::io::detail

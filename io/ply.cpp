@@ -153,6 +153,29 @@ std::vector<std::string_view> split(std::string_view line) {
     return tokens;
 }
 
+// Whether an ascii token is a value of the scalar type PCL reads it as, exactly: PCL's parser turns a token that is
+// not a number into NaN (or 0) and casts what its type cannot hold, so "abc" or 300 for a uchar would be read silently.
+// Floating tokens may be nan or inf (PCL writes invalid points so); float32 ones must otherwise fit a float.
+bool is_ascii_value(std::string_view token, std::string_view type) {
+    if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+    const char* const end = token.data() + token.size();
+    if (is_floating(type)) {
+        double v = 0;
+        const auto [at, ec] = std::from_chars(token.data(), end, v);
+        if (ec != std::errc() || at != end) return false;
+        return type_size(type) == 8 || !std::isfinite(v) || std::fabs(v) <= double(std::numeric_limits<float>::max());
+    }
+    long long v = 0;
+    const auto [at, ec] = std::from_chars(token.data(), end, v);
+    if (ec != std::errc() || at != end) return false;
+    const int bits = 8 * type_size(type);
+    const bool is_signed =
+        type == "char" || type == "int8" || type == "short" || type == "int16" || type == "int" || type == "int32";
+    const long long low = is_signed ? -(1LL << (bits - 1)) : 0;
+    const long long high = is_signed ? (1LL << (bits - 1)) - 1 : (1LL << bits) - 1;
+    return v >= low && v <= high;
+}
+
 template <typename T>
 bool parse_unsigned(std::string_view token, T& value) {
     if (token.empty() || token[0] < '0' || token[0] > '9') return false;  // no sign, no space
@@ -587,20 +610,20 @@ private:
         detail::LineReader lines(file_, h_.data_offset, kMaxAsciiLine);
         std::string_view line;
         for (const PlyElement& e : h_.elements) {
-            bool grid = false;
-            for (const PlyProperty& p : e.properties) grid = grid || is_grid_index(e, p);
             for (std::uint64_t i = 0; i < e.count; ++i) {
                 if (!lines.next(line)) {
                     error(e, i,
                           lines.too_long() ? "a line longer than " + std::to_string(kMaxAsciiLine) + " bytes"
                                            : std::string("the file ends before it (truncated file?)"));
                 }
-                if (grid) check_ascii_grid_line(e, i, line);
+                check_ascii_line(e, i, line);
             }
         }
     }
 
-    void check_ascii_grid_line(const PlyElement& e, std::uint64_t instance, std::string_view line) const {
+    // Every value of the line is one of its property's type (is_ascii_value); every list fits the line; every
+    // range_grid index is one of the vertices.
+    void check_ascii_line(const PlyElement& e, std::uint64_t instance, std::string_view line) const {
         std::vector<std::string_view> tokens = split(line);
         for (std::string_view& t : tokens) {
             while (!t.empty() && (t.back() == '\r' || t.front() == '\r')) {
@@ -619,9 +642,18 @@ private:
             }
             return v;
         };
+        auto value = [&](const PlyProperty& p) {
+            if (at >= tokens.size()) error(e, instance, "the line ends before property '" + p.name + "'");
+            const std::string_view t = tokens[at++];
+            if (!is_ascii_value(t, p.type)) {
+                error(e, instance,
+                      "property '" + p.name + "': '" + detail::printable(t.substr(0, 32)) + "' is not a " + p.type +
+                          " value");
+            }
+        };
         for (const PlyProperty& p : e.properties) {
             if (p.count_size == 0) {
-                ++at;
+                value(p);
                 continue;
             }
             const long long items = integer("the item count of list '" + p.name + "'");
@@ -633,7 +665,7 @@ private:
                 if (is_grid_index(e, p)) {
                     check_index(e, instance, integer("a range_grid vertex index"));
                 } else {
-                    ++at;
+                    value(p);
                 }
             }
         }

@@ -188,6 +188,7 @@ Image read_png_file(const std::filesystem::path& path) {
     if (!read_header(g.png, g.info, &layout)) {
         fail(ErrorCode::format, path, std::string("corrupt PNG: ") + slot.message);
     }
+    detail::check_image_size(path, "PNG", layout.width, layout.height);
     // Deflate expands at most 1032-fold, so an image claiming more pixel data than that is lying: refuse it before
     // allocating rather than let a tiny file request gigabytes.
     const std::uint64_t stored = (layout.width * layout.stored_bits + 7) / 8 * layout.height;

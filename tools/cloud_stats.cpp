@@ -24,14 +24,6 @@ double median_depth(const std::vector<float>& points) {
     return median_of(z);
 }
 
-double median_sample(const std::vector<float>& depth) {
-    std::vector<float> valid;
-    for (const float d : depth) {
-        if (std::isfinite(d) && d > 0) valid.push_back(d);
-    }
-    return median_of(valid);
-}
-
 double detected_unit_mm(double median) {
     return median > 0 && median < kMetresBelowMedianDepth ? 1000.0 : 1.0;
 }

@@ -5,7 +5,9 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
+#include "pyrseg/depth.hpp"
 #include "pyrseg/error.hpp"
 #include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
@@ -65,10 +67,11 @@ std::string number_text(double v) {
 }
 
 // The samples' unit: --metres-per-unit, else the deprecated --depth-scale inverted, else the default of the
-// sample type. A unit that puts the median depth out of every depth sensor's range is refused rather than
-// segmented into nothing (RealSense's depth scale 0.001 given as --depth-scale is 1000 m per unit), and the
-// message names the usual unit that fits, when one does.
-double depth_metres_per_unit(const Args& args, const io::DepthImage& image, const std::filesystem::path& path) {
+// sample type; checked with the intrinsics as the library checks every depth frame (pyrseg::check_depth_camera: a
+// scale that puts the median depth out of every depth sensor's range, intrinsics in the wrong order), its message
+// saying which option gave the scale, its warnings printed.
+double depth_metres_per_unit(const Args& args, const io::DepthImage& image, const io::Intrinsics& k,
+                             const std::filesystem::path& path) {
     double metres_per_unit = image.floating ? 1.0 : 0.001;
     std::string given = image.floating ? "float samples read as metres (the default)"
                                        : "16-bit samples read as millimetres (the default)";
@@ -89,21 +92,28 @@ double depth_metres_per_unit(const Args& args, const io::DepthImage& image, cons
         given = "--depth-scale " + *args.value("depth-scale") +
                 " (depth units per metre: " + number_text(metres_per_unit) + " m per unit)";
     }
-    const double median = median_sample(image.depth);
-    if (median <= 0 || plausible_median_metres(median * metres_per_unit)) return metres_per_unit;
-    std::string message = path.string() + ": with " + given + " the median depth is " +
-                          number_text(median * metres_per_unit) + " m, outside any depth sensor's range (" +
-                          number_text(kPlausibleMedianMetresMin) + " to " + number_text(kPlausibleMedianMetresMax) +
-                          " m). Pass the depth of one sample unit in metres, as SDKs state it (RealSense's depth "
-                          "scale), as --metres-per-unit";
-    for (const double usual : {0.001, 1.0, 0.0001}) {
-        if (plausible_median_metres(median * usual)) {
-            message += ": --metres-per-unit " + number_text(usual) + " makes the median sample " + number_text(median) +
-                       " a depth of " + number_text(median * usual) + " m";
-            break;
+    DepthView camera;
+    camera.depth = image.depth.data();
+    camera.format = DepthFormat::f32;  // 16-bit samples' float copies are exact
+    camera.width = image.width;
+    camera.height = image.height;
+    camera.metres_per_unit = metres_per_unit;
+    camera.fx = k.fx;
+    camera.fy = k.fy;
+    camera.cx = k.cx;
+    camera.cy = k.cy;
+    try {
+        for (const std::string& w : check_depth_camera(camera).warnings) {
+            std::fprintf(stderr, "pyrseg: warning: %s: %s (the depth scale: %s)\n", path.string().c_str(), w.c_str(),
+                         given.c_str());
         }
+    } catch (const Error& e) {
+        std::string message = e.what();
+        constexpr std::string_view kPrefix = "pyrseg: ";  // Error's constructor adds it again
+        if (message.starts_with(kPrefix)) message.erase(0, kPrefix.size());
+        throw Error(e.code(), path.string() + ": with " + given + ", " + message);
     }
-    throw Error(ErrorCode::invalid_argument, message);
+    return metres_per_unit;
 }
 
 // A NumPy depth map (H x W uint16 or float32) as a depth image.
@@ -211,8 +221,8 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
             }
             const io::DepthImage image = depth_map_of(npy, path);
             const io::Intrinsics k = intrinsics_from(args, path);
-            const double metres_per_unit = depth_metres_per_unit(args, image, path);
-            return {io::depth_to_cloud(image, k, 1000.0 * metres_per_unit), "NumPy depth map", true,
+            const double metres_per_unit = depth_metres_per_unit(args, image, k, path);
+            return {io::depth_to_cloud(image, k, metres_per_unit), "NumPy depth map", true,
                     depth_frame(image, k, metres_per_unit)};
         }
         if (ext == ".ply") return {io::read_ply(path), "PLY", false, std::nullopt};
@@ -224,8 +234,8 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
         }
         const io::Intrinsics k = intrinsics_from(args, path);
         const io::DepthImage depth = io::read_depth_image(path);
-        const double metres_per_unit = depth_metres_per_unit(args, depth, path);
-        return {io::depth_to_cloud(depth, k, 1000.0 * metres_per_unit), "depth image", true,
+        const double metres_per_unit = depth_metres_per_unit(args, depth, k, path);
+        return {io::depth_to_cloud(depth, k, metres_per_unit), "depth image", true,
                 depth_frame(depth, k, metres_per_unit)};
     }
     throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +

@@ -1,22 +1,37 @@
 #include "backends/cpu/thread_pool.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdlib>
 #include <string>
+#include <string_view>
+
+#include "pyrseg/error.hpp"
 
 namespace pyrseg::cpu {
 namespace {
 
+constexpr unsigned kMaxThreads = 1024;
+
+// PYRSEG_THREADS, or every core when it is unset or empty. A value that is not a count is an error rather than
+// silently every core: PYRSEG_THREADS=2x or =two was meant to limit the pool.
 unsigned default_threads() {
-    if (const char* env = std::getenv("PYRSEG_THREADS")) {
-        try {
-            const long v = std::stol(env);
-            if (v >= 1 && v <= 1024) return static_cast<unsigned>(v);
-        } catch (...) {  // an unreadable value falls back to the hardware's count
+    const char* env = std::getenv("PYRSEG_THREADS");
+    if (env == nullptr || *env == '\0') return std::max(1u, std::thread::hardware_concurrency());
+    const std::string_view text(env);
+    unsigned v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || v < 1 || v > kMaxThreads) {
+        std::string shown(text.substr(0, 40));
+        for (char& c : shown) {
+            if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
         }
+        throw Error(ErrorCode::invalid_parameter, "PYRSEG_THREADS='" + shown +
+                                                      "' is not a number of threads from 1 to " +
+                                                      std::to_string(kMaxThreads) + " (unset it to use every core)");
     }
-    return std::max(1u, std::thread::hardware_concurrency());
+    return v;
 }
 
 // How long a thread spins for the next loop or for the workers to finish before it sleeps.

@@ -117,9 +117,11 @@ PYRSEG_IO_EXPORT Intrinsics parse_intrinsics(const std::string& text);
 // fx fy cx cy, or exactly one 3x3 matrix. The message of a failure names the file and the node.
 PYRSEG_IO_EXPORT Intrinsics read_intrinsics(const std::filesystem::path& path, const std::string& node = {});
 
-// An organized cloud in millimetres from a depth image: z = depth * mm_per_unit, x = (u - cx) * z / fx,
-// y = (v - cy) * z / fy (computed in double, stored as float); pixels without data are NaN.
-PYRSEG_IO_EXPORT PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double mm_per_unit);
+// An organized cloud in millimetres from a depth image: z = depth * metres_per_unit * 1000, x = (u - cx) * z / fx,
+// y = (v - cy) * z / fy (computed in double, stored as float); pixels without data are NaN. metres_per_unit is the
+// depth of one sample unit in metres, as in DepthView (0.001 for millimetres); the camera is checked as
+// pyrseg::check_depth_camera checks it (a wrong depth scale or intrinsics in the wrong order is an error).
+PYRSEG_IO_EXPORT PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double metres_per_unit);
 
 // Colour-coded segmentation: label 0 black, other labels distinct saturated colours (a fixed hash of the label so
 // the same label is the same colour in every picture; neighbouring label values clearly different).

@@ -29,6 +29,7 @@ enum class SensorKind : std::uint8_t {
 [[nodiscard]] PYRSEG_EXPORT const char* sensor_kind_summary(SensorKind kind);
 
 // The preset for a kind of sensor, for clouds in units of unit_mm millimetres. Every other field keeps its default.
+// A unit_mm that is not finite and > 0 is pyrseg::Error(invalid_parameter), as in measure_frame_noise.
 [[nodiscard]] PYRSEG_EXPORT Params sensor_preset(SensorKind kind, double unit_mm = 1.0);
 
 // How noisy a frame's depth is, measured on the frame itself (no ground truth needed): the mean absolute second

@@ -172,7 +172,7 @@ constexpr Param kLabel[] = {{"label"}};
 constexpr Param kStats[] = {{"path"}, {"segments"}, {"width"}, {"height"}, {"unit_mm", "1.0"}, {"source", "''"}};
 constexpr Param kParseIntrinsics[] = {{"text"}};
 constexpr Param kReadIntrinsics[] = {{"path"}, {"node", "''"}};
-constexpr Param kDepthToCloud[] = {{"depth"}, {"intrinsics"}, {"mm_per_unit"}};
+constexpr Param kDepthToCloud[] = {{"depth"}, {"intrinsics"}, {"metres_per_unit"}};
 
 // A reader: path -> what read(path) gives.
 template <class Read>
@@ -351,18 +351,19 @@ void bind_io(py::module_& io) {
                  return io::read_intrinsics(a.path(0), a.text(1, ""));
              });
     def_args(io, "depth_to_cloud", kDepthToCloud,
-             "An H x W x 3 float32 cloud in millimetres from a depth image (NaN where no data).",
+             "An H x W x 3 float32 cloud in millimetres from a depth image (NaN where no data); metres_per_unit is "
+             "the depth of one sample unit in metres, as in Segmenter.segment_depth (0.001 for millimetres).",
              [](const py::args& args, const py::kwargs& kwargs) {
                  const char* f = "depth_to_cloud()";
                  const Args a(f, kDepthToCloud, args, kwargs);
                  const io::Intrinsics k = intrinsics_arg(f, "intrinsics", a.object(1));
-                 const double mm_per_unit = a.number(2);
+                 const double metres_per_unit = a.number(2);
                  const auto depth = image_of<float>(f, a.object(0), "depth", 1, "float32 depth");
                  io::DepthImage d;
                  d.width = int(depth.shape(1));
                  d.height = int(depth.shape(0));
                  d.depth.assign(depth.data(), depth.data() + depth.size());
-                 const io::PointCloud c = io::depth_to_cloud(d, k, mm_per_unit);
+                 const io::PointCloud c = io::depth_to_cloud(d, k, metres_per_unit);
                  return array_of(c.points.data(), c.height, c.width, 3);
              });
 }

@@ -301,7 +301,7 @@ TEST_P(RealDepthImages, MatchesReference) {
     }
     const io::PointCloud cloud =
         io::depth_to_cloud(io::read_depth_image(data / "cape_depth_0.png"),
-                           io::read_intrinsics(data / "cape_calib_params.xml", "IR_intrinsic_params"), 1.0);
+                           io::read_intrinsics(data / "cape_calib_params.xml", "IR_intrinsic_params"), 0.001);
     Params params;
     expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params);
     params.normal_radius = 4;

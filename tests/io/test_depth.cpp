@@ -105,7 +105,7 @@ TEST(DepthImage, TruncatedAndCorruptTiffsGiveErrorsNotCrashes) {
 TEST(DepthToCloud, BackProjectsThroughThePinholeModelInMillimetres) {
     DepthImage d{3, 2, {1000, 0, 2000, std::numeric_limits<float>::quiet_NaN(), -5, 500}, false};
     const Intrinsics k{500.0, 400.0, 1.0, 0.0};
-    const PointCloud c = depth_to_cloud(d, k, 0.2);  // TUM: 5000 units per metre
+    const PointCloud c = depth_to_cloud(d, k, 0.0002);  // TUM: 5000 units per metre
     ASSERT_EQ(c.width, 3);
     ASSERT_EQ(c.height, 2);
     // (u, v) = (0, 0), 1000 units = 200 mm: x = (0 - 1) * 200 / 500, y = 0.
@@ -117,8 +117,22 @@ TEST(DepthToCloud, BackProjectsThroughThePinholeModelInMillimetres) {
     EXPECT_FLOAT_EQ(c.points[15], 0.2f);
     EXPECT_FLOAT_EQ(c.points[16], 0.25f);
     EXPECT_FLOAT_EQ(c.points[17], 100.0f);
-    EXPECT_EQ(error_of([&] { (void)depth_to_cloud(d, Intrinsics{0, 1, 0, 0}, 1.0); }), ErrorCode::invalid_argument);
-    EXPECT_EQ(error_of([&] { (void)depth_to_cloud(d, k, 0.0); }), ErrorCode::invalid_argument);
+    EXPECT_EQ(error_of([&] { (void)depth_to_cloud(d, Intrinsics{0, 1, 0, 0}, 0.001); }), ErrorCode::invalid_parameter);
+    EXPECT_EQ(error_of([&] { (void)depth_to_cloud(d, k, 0.0); }), ErrorCode::invalid_parameter);
+}
+
+TEST(DepthToCloud, ChecksTheCameraAsTheSegmenterDoes) {
+    DepthImage image{640, 480, std::vector<float>(640 * 480, 800.0f), false};
+    const Intrinsics k{612.937, 613.173, 322.549, 248.158};
+    const PointCloud cloud = depth_to_cloud(image, k, 0.001);
+    EXPECT_FLOAT_EQ(cloud.points[2], 800.0f);
+    try {
+        (void)depth_to_cloud(image, k, 1.0);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("metres_per_unit 0.001 makes it 0.8 m"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)depth_to_cloud(image, Intrinsics{322.549, 248.158, 612.937, 613.173}, 0.001), Error);
 }
 
 TEST(Intrinsics, ParsedFromFourNumbers) {

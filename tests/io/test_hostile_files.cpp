@@ -349,6 +349,21 @@ TEST(HostileFiles, PngTextChunkClaimingGigabytes) {
     expect_refused([&] { (void)read_depth_image(file); }, file);
 }
 
+// The report's 810 KB PNG claiming 20000 x 20000 16-bit pixels: deflate could hold that much (800 MB of zeros), so
+// the file's size let it through, and the reader grew to 2.7 GB before std::bad_alloc. The image size is refused from
+// the header, as TIFF's is, before anything is allocated for the pixels; the IDAT here is never decoded.
+TEST(HostileFiles, PngClaimingMorePixelsThanAnyCamera) {
+    ScratchDir dir;
+    const fs::path file = dir / "huge.png";
+    std::string png = png_ihdr(20000, 20000);
+    const std::string idat(810 * 1024, '\0');
+    chunk(png, "IDAT", idat, std::uint32_t(idat.size()));
+    chunk(png, "IEND", "", 0);
+    write_bytes(file, png);
+    expect_refused([&] { (void)read_png(file); }, file, "PNG size 20000 x 20000 is not an image size pyrseg reads");
+    expect_refused([&] { (void)read_depth_image(file); }, file, "at most 65536 on a side and 268435456 pixels");
+}
+
 // ---- Whole-file reads of sparse files
 
 constexpr std::uint64_t kSparseSize = std::uint64_t{40} << 30;

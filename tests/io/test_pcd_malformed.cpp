@@ -1,5 +1,6 @@
 // Malformed PCD files: each must load or throw pyrseg::Error naming the file, never crash, hang or read out of
 // bounds (run under -DPYRSEG_SANITIZE=ON to check the last).
+#include <chrono>
 #include <random>
 #include <sstream>
 
@@ -415,6 +416,9 @@ TEST(PcdUnsupported, AsciiGarbage) {
         {"1 2 3 4\n1 2 3 4\n1 2 3 red\n1 2 3 4\n", "'red' in field 'rgb' is not a number"},
         {"1 2 3 4\n1 2 3 4\n1 2 3 4\n1 2 3 4\x01\n", "is not a number"},
         {"1 2 3 4\n1 2 3 4\n1 2 3.5.5 4\n1 2 3 4\n", "'3.5.5'"},
+        // A number float32 cannot hold is not "not a number": it says what is wrong with it.
+        {"1 2 3 4\n1 2 3e50 4\n1 2 3 4\n1 2 3 4\n", "'3e50' in field 'z' is outside float32's range"},
+        {"1 2 3 4\n1 -1e39 3 4\n1 2 3 4\n1 2 3 4\n", "'-1e39' in field 'y' is outside float32's range"},
         {"1 2 3 4 ", "cannot fit"},
         {"", "cannot fit"},
     };
@@ -422,6 +426,26 @@ TEST(PcdUnsupported, AsciiGarbage) {
         write_bytes(dir / "g.pcd", header + body);
         expect_error_containing(dir / "g.pcd", expected);
     }
+}
+
+// A header longer than the reader reads is said to be that, not "no DATA line"; and a megabyte of FIELDS names is
+// refused in linear time (a check against every earlier name took a minute for 1.2 MB).
+TEST(PcdUnsupported, HeadersOfAMegabyte) {
+    ScratchDir dir;
+    std::string fields = "FIELDS x y z";
+    for (int i = 0; fields.size() < (std::size_t{12} << 17); ++i) fields += " f" + std::to_string(i);
+    write_bytes(dir / "long.pcd", "VERSION 0.7\n" + fields +
+                                      "\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\n"
+                                      "DATA ascii\n1 2 3\n");
+    const auto start = std::chrono::steady_clock::now();
+    expect_error_containing(dir / "long.pcd", "the header is longer than pyrseg reads");
+    std::string names = "VERSION 0.7\nFIELDS x y z";
+    for (int i = 0; names.size() < (std::size_t{1} << 20) - 4096; ++i) names += " f" + std::to_string(i);
+    write_bytes(dir / "names.pcd",
+                names + "\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    expect_error_containing(dir / "names.pcd", "SIZE has no entry for field 'f0'");
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    EXPECT_LT(took.count(), 5.0) << "a 1.5 MB and a 1 MB header took " << took.count() << " s to refuse";
 }
 
 TEST(PcdUnsupported, NotAFile) {

@@ -2,6 +2,7 @@
 // malformed files, each of which must load or throw pyrseg::Error naming the file, never crash or hang (PCL's
 // reader aborts on some headers: io/ply.cpp checks them first).
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <sstream>
 
@@ -384,6 +385,16 @@ TEST(PlyRead, UnorganizedCloudsAreRefusedWithTheReason) {
 
 // ---- malformed files
 
+// PCL writes invalid points of an ascii PLY as nan: they stay readable, as NaN.
+TEST(PlyAscii, NanAndInfinityTokensAreValues) {
+    ScratchDir dir;
+    write_bytes(dir / "nan.ply", xyz_header("ascii", 4, grid_lines(2, 2)) + "1 2 3\nnan nan nan\n+1 -2 inf\n1 2 3\n");
+    const PointCloud c = read_ply(dir / "nan.ply");
+    ASSERT_EQ(c.points.size(), 12u);
+    EXPECT_TRUE(std::isnan(c.points[3]));
+    EXPECT_EQ(c.points[6], 1.0f);
+}
+
 TEST(PlyMalformed, EachNamedCase) {
     ScratchDir dir;
     const std::string good = grid_binary(4, 3);
@@ -448,6 +459,17 @@ TEST(PlyMalformed, EachNamedCase) {
          "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
          "element range_grid 4\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n1 2 3\n1 0\n0\n0\n1 1\n",
          "not organized"},
+        // PCL's ascii parser read these as NaN, inf and 44 (300 cast to a uchar), silently.
+        {"ascii_not_a_number", xyz_header("ascii", 4, grid_lines(2, 2)) + "1 2 3\n1 abc 3\n1 2 3\n1 2 3\n",
+         "instance 1: property 'y': 'abc' is not a float value"},
+        {"ascii_beyond_float", xyz_header("ascii", 4, grid_lines(2, 2)) + "1 2 3\n1 2 3\n1 2 1e50\n1 2 3\n",
+         "property 'z': '1e50' is not a float value"},
+        {"ascii_uchar_300",
+         xyz_header("ascii", 4, grid_lines(2, 2), "property uchar red\nproperty uchar green\nproperty uchar blue\n") +
+             "1 2 3 0 0 0\n1 2 3 300 0 0\n1 2 3 0 0 0\n1 2 3 0 0 0\n",
+         "property 'red': '300' is not a uchar value"},
+        {"ascii_short_line", xyz_header("ascii", 4, grid_lines(2, 2)) + "1 2 3\n1 2\n1 2 3\n1 2 3 4 5 6\n",
+         "the line ends before property 'z'"},
         {"unknown_keyword", "ply\nformat ascii 1.0\nfrobnicate\n", "unknown keyword"},
         {"bad_format", "ply\nformat binary_middle_endian 1.0\n", "unknown format"},
         {"bad_version", "ply\nformat ascii 2.0\n", "version"},

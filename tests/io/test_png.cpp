@@ -95,28 +95,38 @@ TEST(Png, BrokenFilesFailCleanly) {
     EXPECT_EQ(code, ErrorCode::io);
 }
 
+// A tiny file claiming a huge image: refused from its header, before anything is allocated for the pixels. Beyond
+// any image size pyrseg reads (1,000,000 x 1,000,000, libpng's own limit), or within it (16000 x 16000) but more
+// than deflate could have stored in the file.
 TEST(Png, HugeDimensionsInTinyFileDoNotAllocate) {
     ScratchDir dir;
     std::vector<std::uint8_t> gray(4, 0);
     write_png_gray8(dir / "g.png", gray.data(), 2, 2);
-    std::string bytes = read_bytes(dir / "g.png");
-    // IHDR data sits at bytes 16..28; claim 1,000,000 x 1,000,000 (libpng's own limit) and fix the CRC.
-    const std::uint32_t big = 1000000;
-    for (int k = 0; k < 4; ++k) {
-        bytes[16 + k] = static_cast<char>(big >> (24 - 8 * k));
-        bytes[20 + k] = static_cast<char>(big >> (24 - 8 * k));
-    }
-    std::uint32_t crc = 0xFFFFFFFFu;
-    for (std::size_t i = 12; i < 29; ++i) {
-        crc ^= static_cast<unsigned char>(bytes[i]);
-        for (int b = 0; b < 8; ++b) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    crc = ~crc;
-    for (int k = 0; k < 4; ++k) bytes[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
-    write_bytes(dir / "huge.png", bytes);
+    const std::string small = read_bytes(dir / "g.png");
+    const auto claiming = [&](std::uint32_t side) {
+        std::string bytes = small;
+        // IHDR data sits at bytes 16..28: the width and height, then the CRC fixed.
+        for (int k = 0; k < 4; ++k) {
+            bytes[16 + k] = static_cast<char>(side >> (24 - 8 * k));
+            bytes[20 + k] = static_cast<char>(side >> (24 - 8 * k));
+        }
+        std::uint32_t crc = 0xFFFFFFFFu;
+        for (std::size_t i = 12; i < 29; ++i) {
+            crc ^= static_cast<unsigned char>(bytes[i]);
+            for (int b = 0; b < 8; ++b) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+        }
+        crc = ~crc;
+        for (int k = 0; k < 4; ++k) bytes[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
+        return bytes;
+    };
+    write_bytes(dir / "huge.png", claiming(1000000));
     std::string message;
     EXPECT_EQ(outcome([&] { read_png(dir / "huge.png"); }, &message), "error");
-    EXPECT_NE(message.find("1000000 x 1000000 image cannot be stored in a file of"), std::string::npos) << message;
+    EXPECT_NE(message.find("PNG size 1000000 x 1000000 is not an image size pyrseg reads"), std::string::npos)
+        << message;
+    write_bytes(dir / "large.png", claiming(16000));
+    EXPECT_EQ(outcome([&] { read_png(dir / "large.png"); }, &message), "error");
+    EXPECT_NE(message.find("16000 x 16000 image cannot be stored in a file of"), std::string::npos) << message;
 }
 
 TEST(Png, WriteRejectsBadArguments) {

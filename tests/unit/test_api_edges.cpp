@@ -12,8 +12,10 @@
 #include <vector>
 
 #include "pyrseg/error.hpp"
+#include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "tests/support/cpu_targets.hpp"
 
 namespace pyrseg {
 namespace {
@@ -146,6 +148,40 @@ TEST_F(GivenNormals, NearUnitNormalsAndNoNormalMarkersAreAccepted) {
         const Result r = segment(n);
         EXPECT_EQ(r.labels[7 * kWidth + 5], 0u);
         EXPECT_GT(r.segment_count, 0u);
+    }
+}
+
+// A unit that is not a length was once a preset in that unit, or a noise measurement of "the frame is too small".
+TEST(ApiEdges, PresetsAndTheNoiseMeasureRefuseAUnitThatIsNotALength) {
+    const synthetic::Scene scene = synthetic::generate(synthetic::SceneOptions{});
+    CloudView view;
+    view.points = scene.points.data();
+    view.width = scene.width;
+    view.height = scene.height;
+    for (const double unit : {-1.0, 0.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+        SCOPED_TRACE(unit);
+        EXPECT_NE(error_message(ErrorCode::invalid_parameter, [&] { (void)sensor_preset(SensorKind::kinect_v1, unit); })
+                      .find("unit_mm must be a finite number of millimetres > 0"),
+                  std::string::npos);
+        EXPECT_NE(
+            error_message(ErrorCode::invalid_parameter, [&] { (void)measure_frame_noise(view, unit); }).find("unit_mm"),
+            std::string::npos);
+    }
+    EXPECT_NO_THROW((void)measure_frame_noise(view, 1.0));
+}
+
+// PYRSEG_THREADS=two or 2x once gave a pool of every core without a word.
+TEST(ApiEdges, AThreadCountThatIsNotOneIsAnError) {
+    for (const char* bad : {"two", "2x", "0", "-3", "100000", " 2"}) {
+        SCOPED_TRACE(bad);
+        const test::ScopedEnv env("PYRSEG_THREADS", bad);
+        EXPECT_NE(error_message(ErrorCode::invalid_parameter, [] { Segmenter s(32, 24, Params{}, "cpu"); })
+                      .find("PYRSEG_THREADS='"),
+                  std::string::npos);
+    }
+    for (const char* good : {"1", "3", ""}) {
+        const test::ScopedEnv env("PYRSEG_THREADS", good);
+        EXPECT_NO_THROW(Segmenter(32, 24, Params{}, "cpu")) << good;
     }
 }
 
