@@ -69,30 +69,33 @@ install(FILES ${PROJECT_BINARY_DIR}/pyrsegConfig.cmake ${PROJECT_BINARY_DIR}/pyr
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pyrseg)
 
 # pkg-config files, relocatable (${pcfiledir}): the same files serve a temporary prefix and an unpacked .deb.
-# Libs.private and Requires.private are what `pkg-config --static` adds for the static libraries.
+# A static library's dependencies are in Requires and Libs themselves, not in the .private fields: the default
+# install is static, and `pkg-config --libs pyrseg` without --static must then link (it once left about 550
+# undefined references). A shared library records its own (DT_NEEDED) and lists none.
 if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}" OR IS_ABSOLUTE "${CMAKE_INSTALL_INCLUDEDIR}")
   message(FATAL_ERROR "pyrseg: the pkg-config files need CMAKE_INSTALL_LIBDIR and CMAKE_INSTALL_INCLUDEDIR relative")
 endif()
 file(RELATIVE_PATH _pc_to_prefix /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
 string(REGEX REPLACE "/$" "" _pc_to_prefix "${_pc_to_prefix}")
 set(PYRSEG_PC_PREFIX "\${pcfiledir}/${_pc_to_prefix}")
-# _pyrseg_pc(NAME DESCRIPTION LIBRARY REQUIRES REQUIRES_PRIVATE LIBS_PRIVATE)
-function(_pyrseg_pc name description library requires requires_private libs_private)
+# _pyrseg_pc(NAME DESCRIPTION LIBRARY REQUIRES STATIC_REQUIRES STATIC_LIBS): STATIC_* only for static libraries.
+function(_pyrseg_pc name description library requires static_requires static_libs)
   set(PC_NAME ${name})
   set(PC_DESCRIPTION "${description}")
   set(PC_LIBRARY ${library})
   set(PC_REQUIRES "${requires}")
-  # A shared library records its own dependencies (DT_NEEDED): consumers need neither list, nor the -dev packages
-  # that provide the .pc files named in Requires.private (which pkg-config looks for even without --static).
-  set(PC_REQUIRES_PRIVATE "")
-  set(PC_LIBS_PRIVATE "")
+  set(PC_LIBS "")
   if(NOT BUILD_SHARED_LIBS)
-    set(PC_REQUIRES_PRIVATE "${requires_private}")
-    set(PC_LIBS_PRIVATE "${libs_private}")
+    string(STRIP "${requires} ${static_requires}" PC_REQUIRES)
+    set(PC_LIBS "${static_libs}")
     # Instrumented static libraries need the sanitizers' runtimes wherever they are linked (the CMake package has
     # them through pyrseg_build_flags' link options).
     if(PYRSEG_SANITIZE)
-      string(STRIP "${PC_LIBS_PRIVATE} -fsanitize=address,undefined" PC_LIBS_PRIVATE)
+      string(APPEND PC_LIBS " -fsanitize=address,undefined")
+    endif()
+    string(STRIP "${PC_LIBS}" PC_LIBS)
+    if(PC_LIBS)
+      set(PC_LIBS " ${PC_LIBS}")
     endif()
   endif()
   # A static library's export macros are empty (cmake/PyrsegLibraries.cmake), as they are in its own build.

@@ -40,16 +40,16 @@ consume() {
         -DCMAKE_BUILD_TYPE=Release -DEXAMPLE_SOURCE="$source/examples/segment_frames.cpp" >/dev/null
   cmake --build "$consumer" >/dev/null
   mkdir -p "$work/scratch"
-  # pkg-config: the same two programs from the compiler's command line; a static install links with --static.
-  local pkg_static=() binaries=("$consumer/consumer" "$consumer/io_consumer")
-  ((shared)) || pkg_static=(--static)
+  # pkg-config: the same two programs from the compiler's command line, with the command the README gives (no
+  # --static, also for the static install: its dependencies are in Libs and Requires).
+  local binaries=("$consumer/consumer" "$consumer/io_consumer")
   export PKG_CONFIG_PATH="$libdir/pkgconfig"
   local flags
-  flags="$(pkg-config --cflags --libs "${pkg_static[@]}" pyrseg-synthetic pyrseg)"
+  flags="$(pkg-config --cflags --libs pyrseg-synthetic pyrseg)"
   # shellcheck disable=SC2086  # pkg-config's output is a list of words
   mkdir -p "$work/$name-pkg-config"
   c++ -std=c++20 -O2 "$source/examples/segment_frames.cpp" -o "$work/$name-pkg-config/consumer" $flags
-  flags="$(pkg-config --cflags --libs "${pkg_static[@]}" pyrseg-io pyrseg-synthetic)"
+  flags="$(pkg-config --cflags --libs pyrseg-io pyrseg-synthetic)"
   # shellcheck disable=SC2086
   c++ -std=c++20 -O2 "$source/tests/package/io_consumer.cpp" -o "$work/$name-pkg-config/io_consumer" $flags
   binaries+=("$work/$name-pkg-config/consumer" "$work/$name-pkg-config/io_consumer")
