@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Segment depth images read with OpenCV, as a depth camera's frames, and save the segments as a picture.
 
-    python3 opencv_depth.py [depth.png --intrinsics fx,fy,cx,cy --depth-scale 0.001] [--out segments.png]
+    python3 opencv_depth.py [depth.png --intrinsics fx,fy,cx,cy --metres-per-unit 0.001] [--out segments.png]
 
-A 16-bit PNG holds the camera's units (0.001 m for most cameras: pass the SDK's depth scale). Without a file it
+A 16-bit PNG holds the camera's units (0.001 m for most cameras: pass the SDK's depth scale, as pyrseg segment's
+--metres-per-unit). Without a file it
 writes a few synthetic depth frames as 16-bit PNGs with OpenCV and segments them back, as a camera loop would: one
 Segmenter, one labels array, reused every frame.
 """
@@ -34,7 +35,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("depth", nargs="*", help="16-bit depth PNGs (default: synthetic frames)")
     ap.add_argument("--intrinsics", help="fx,fy,cx,cy in pixels")
-    ap.add_argument("--depth-scale", type=float, default=0.001, help="metres per depth unit (the SDK's depth scale)")
+    ap.add_argument("--metres-per-unit", type=float, default=0.001,
+                    help="the depth of one sample unit in metres, the SDK's depth scale (default 0.001)")
     ap.add_argument("--preset", default="kinect-v1", help=f"one of {', '.join(pyrseg.presets())}")
     ap.add_argument("--out", default="segments.png", help="the last frame's segments, coloured")
     ap.add_argument("--backend", default=None, help="cpu, cuda, vulkan, opencl or auto")
@@ -60,7 +62,7 @@ def main():
                 seg = pyrseg.Segmenter(w, h, args.backend, preset=args.preset)
                 labels = np.empty((h, w), np.uint32)
             start = time.perf_counter()
-            result = seg.segment_depth(depth, fx, fy, cx, cy, metres_per_unit=args.depth_scale, out=labels)
+            result = seg.segment_depth(depth, fx, fy, cx, cy, metres_per_unit=args.metres_per_unit, out=labels)
             ms = (time.perf_counter() - start) * 1000
             print(f"{os.path.basename(path)}: {result.segment_count} segments in {ms:.1f} ms on {seg.backend}")
 

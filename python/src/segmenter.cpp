@@ -1,4 +1,5 @@
 // pyrseg.Segmenter, its parameters and results, pyrseg.Error, the backends and presets.
+#include <array>
 #include <atomic>
 #include <climits>
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "bindings.hpp"
 #include "device.hpp"
 #include "pyrseg/backend.hpp"
+#include "pyrseg/depth.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -225,6 +227,7 @@ public:
         }
         no_count(count);
         const DepthInput input(depth);
+        warn_about_camera(input, camera);
         return run(input, out, true, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
             DepthView v = input.view(s);
             v.fx = camera.fx;
@@ -283,6 +286,31 @@ private:
                       "torch: .cpu().numpy())");
         }
         return *device_;
+    }
+
+    // The warnings of pyrseg::check_depth_camera (a depth scale or intrinsics that are legal but unusual) as Python
+    // warnings, once per camera; its errors are raised as the Segmenter would raise them. A stream's warm frames
+    // with the same camera skip it (and allocate nothing).
+    void warn_about_camera(const DepthInput& input, const DepthView& camera) {
+        const std::array<double, 5> now = {camera.fx, camera.fy, camera.cx, camera.cy, camera.metres_per_unit};
+        if (camera_checked_ && now == checked_camera_) return;
+        Scratch scratch;  // the Segmenter's own may be in use by another thread's frame
+        DepthView v = input.view(scratch);
+        v.fx = camera.fx;
+        v.fy = camera.fy;
+        v.cx = camera.cx;
+        v.cy = camera.cy;
+        v.metres_per_unit = camera.metres_per_unit;
+        const DepthCameraCheck check = check_depth_camera(v);
+        for (const std::string& w : check.warnings) {
+            if (PyErr_WarnEx(PyExc_UserWarning, ("pyrseg: segment_depth(): " + w).c_str(), 2) != 0) {
+                throw py::error_already_set();
+            }
+        }
+        if (check.median_depth_m > 0) {  // as the Segmenter: a frame without data says nothing about the scale
+            camera_checked_ = true;
+            checked_camera_ = now;
+        }
     }
 
     static void no_count(const py::object& count) {
@@ -360,6 +388,8 @@ private:
     std::optional<Segmenter> segmenter_;
     Result result_;
     Scratch scratch_;
+    bool camera_checked_ = false;  // warn_about_camera: the camera its warnings were last given for
+    std::array<double, 5> checked_camera_{};
     std::atomic<bool> last_copied_{false};
     std::mutex mutex_;  // one frame at a time: Python threads may share a Segmenter, and run without the GIL
 };
