@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <new>
 #include <string>
 #include <utility>
 
@@ -110,30 +111,50 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The host memory a backend's buffers, staging or a frame's results need but cannot get is ErrorCode::out_of_memory
+// on every backend (the GPU backends' host vectors let std::bad_alloc through, Python saw a MemoryError), here once
+// for all of them.
+template <class Work>
+void with_host_memory(const Segmenter::Impl& impl, const Work& work) {
+    try {
+        work();
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::out_of_memory, "segmenting a " + std::to_string(impl.plan.width) + " x " +
+                                                  std::to_string(impl.plan.height) + " frame on the " + impl.backend +
+                                                  " backend: the host's memory ran out");
+    }
+}
+
 // One frame: the input to the backend, the passes, the results back; all timed ("upload" and "download" after
 // the passes).
 template <class Bind>
 void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out) {
-    const auto upload_start = std::chrono::steady_clock::now();
-    bind();
-    const double upload_ms = milliseconds_since(upload_start);
-    core::run_pipeline(impl.plan, input, *impl.executor, impl.timings);
-    const auto download_start = std::chrono::steady_clock::now();
-    impl.executor->read_back(out, impl.outputs);
-    impl.timings.push_back(PassTiming{"upload", upload_ms});
-    impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
-    impl.executor->device_timings(impl.timings);
+    with_host_memory(impl, [&] {
+        const auto upload_start = std::chrono::steady_clock::now();
+        bind();
+        const double upload_ms = milliseconds_since(upload_start);
+        core::run_pipeline(impl.plan, input, *impl.executor, impl.timings);
+        const auto download_start = std::chrono::steady_clock::now();
+        impl.executor->read_back(out, impl.outputs);
+        impl.timings.push_back(PassTiming{"upload", upload_ms});
+        impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
+        impl.executor->device_timings(impl.timings);
+    });
 }
 
 }  // namespace
 
-Segmenter::Segmenter(int width, int height, const Params& params, std::string_view backend, const Outputs& outputs)
+// A function try block: the host's memory can run out from the first member on.
+Segmenter::Segmenter(int width, int height, const Params& params, std::string_view backend, const Outputs& outputs) try
     : impl_(std::make_unique<Impl>()) {
     impl_->plan = core::make_plan(width, height, params, outputs);
     impl_->backend = resolve_backend_name(backend);
     impl_->outputs = outputs;
     impl_->executor = core::make_executor(impl_->backend, impl_->plan);
     impl_->timings.reserve(16);
+} catch (const std::bad_alloc&) {
+    throw Error(ErrorCode::out_of_memory, "making a " + std::to_string(width) + " x " + std::to_string(height) +
+                                              " Segmenter: the host's memory ran out");
 }
 
 Segmenter::Segmenter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

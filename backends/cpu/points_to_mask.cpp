@@ -99,9 +99,13 @@ void PointsToMask::release(size_t slot) {
 void PointsToMask::run(ThreadPool& pool, const simd::RowKernels& kernels, const PointsToMaskFrame& frame) {
     const size_t threads = pool.size();
     if (scratch_.size() != threads) {  // the first frame
-        scratch_.resize(threads);
-        for (Scratch& s : scratch_) allocate(s, frame.width, frame.normal_radius);
-        busy_.assign(threads, false);
+        // Made whole before it is kept: an allocation failing half-way (out_of_memory) must not leave scratch_ sized
+        // and busy_ empty for the next frame to index.
+        std::vector<Scratch> scratch(threads);
+        for (Scratch& s : scratch) allocate(s, frame.width, frame.normal_radius);
+        std::vector<bool> busy(threads, false);
+        scratch_ = std::move(scratch);
+        busy_ = std::move(busy);
     }
     const size_t rows = frame.height;
     const size_t grain = std::max<size_t>(1, (rows + threads * kChunksPerThread - 1) / (threads * kChunksPerThread));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pyrseg/backend.hpp"
+#include "pyrseg/error.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
@@ -18,6 +19,10 @@
 namespace {
 std::atomic<bool> counting{false};
 std::atomic<long> allocations{0};
+// While counting, on the thread that set it: the allocation with this number (1 = the first) fails with
+// std::bad_alloc, as a large one does when memory runs out (the smaller ones after it, such as the error's message,
+// succeed); 0: none fails. Other threads (a driver's compiler threads) are never failed.
+thread_local long failing_allocation = 0;
 }  // namespace
 
 // The replacements are a matched pair over malloc/free; GCC, seeing them inlined, would warn that free() gets a
@@ -27,7 +32,10 @@ std::atomic<long> allocations{0};
 #endif
 
 void* operator new(std::size_t size) {
-    if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
+    if (counting.load(std::memory_order_relaxed)) {
+        const long n = allocations.fetch_add(1, std::memory_order_relaxed) + 1;
+        if (failing_allocation > 0 && n == failing_allocation) throw std::bad_alloc();
+    }
     if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
     throw std::bad_alloc();
 }
@@ -58,6 +66,51 @@ std::vector<std::string> available() {
 }
 
 class NoAllocation : public ::testing::TestWithParam<std::string> {};
+
+// What `f` throws when the host's memory runs out at its n-th allocation: "" for nothing, else the pyrseg::Error's
+// code name or "bad_alloc".
+std::string when_memory_runs_out_at(long n, const std::function<void()>& f) {
+    allocations = 0;
+    failing_allocation = n;
+    counting = true;
+    std::string outcome;
+    try {
+        f();
+    } catch (const Error& e) {
+        outcome = to_string(e.code());
+    } catch (const std::bad_alloc&) {
+        outcome = "bad_alloc";
+    }
+    counting = false;
+    failing_allocation = 0;
+    return outcome;
+}
+
+// The host's memory running out, anywhere in making a Segmenter or in a frame, is pyrseg::Error(out_of_memory) on
+// every backend (OpenCL's let std::bad_alloc through: Python saw a bare MemoryError).
+TEST_P(NoAllocation, HostMemoryRunningOutIsOutOfMemory) {
+    synthetic::SceneOptions o;
+    o.width = 64;
+    o.height = 48;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const CloudView cv{scene.points.data(), nullptr, o.width, o.height};
+    Outputs outputs;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    for (long n = 1; n <= 120; ++n) {  // every allocation of a small frame's setup, one at a time
+        SCOPED_TRACE("allocation " + std::to_string(n));
+        const std::string made =
+            when_memory_runs_out_at(n, [&] { Segmenter s(o.width, o.height, Params{}, GetParam(), outputs); });
+        EXPECT_TRUE(made.empty() || made == to_string(ErrorCode::out_of_memory)) << "making the Segmenter: " << made;
+        Segmenter segmenter(o.width, o.height, Params{}, GetParam(), outputs);
+        const std::string framed = when_memory_runs_out_at(n, [&] {
+            Result fresh;  // sized by the frame: its vectors are what the frame allocates
+            segmenter.segment(cv, fresh);
+        });
+        EXPECT_TRUE(framed.empty() || framed == to_string(ErrorCode::out_of_memory)) << "a frame: " << framed;
+        Result after;
+        EXPECT_NO_THROW(segmenter.segment(cv, after)) << "the Segmenter must work once memory is back";
+    }
+}
 
 TEST_P(NoAllocation, WarmFramesAllocateNothing) {
     if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
