@@ -186,6 +186,20 @@ void write_tiff_float(const std::filesystem::path& path, const float* depth, int
     });
 }
 
+DepthView depth_view(const DepthImage& image, const Intrinsics& k, double metres_per_unit) {
+    DepthView v;
+    v.depth = image.depth.data();
+    v.format = DepthFormat::f32;
+    v.width = image.width;
+    v.height = image.height;
+    v.metres_per_unit = metres_per_unit;
+    v.fx = k.fx;
+    v.fy = k.fy;
+    v.cx = k.cx;
+    v.cy = k.cy;
+    return v;
+}
+
 PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double metres_per_unit) {
     if (image.width < 1 || image.height < 1 ||
         image.depth.size() != std::size_t(image.width) * std::size_t(image.height)) {
@@ -193,16 +207,7 @@ PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double m
                                                      " x " + std::to_string(image.height) + " with " +
                                                      std::to_string(image.depth.size()) + " samples");
     }
-    DepthView camera;
-    camera.depth = image.depth.data();
-    camera.format = DepthFormat::f32;
-    camera.width = image.width;
-    camera.height = image.height;
-    camera.metres_per_unit = metres_per_unit;
-    camera.fx = k.fx;
-    camera.fy = k.fy;
-    camera.cx = k.cx;
-    camera.cy = k.cy;
+    const DepthView camera = depth_view(image, k, metres_per_unit);
     (void)check_depth_camera(camera);
     const double mm_per_unit = metres_per_unit * 1000.0;
     PointCloud cloud;

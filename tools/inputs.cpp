@@ -92,16 +92,7 @@ double depth_metres_per_unit(const Args& args, const io::DepthImage& image, cons
         given = "--depth-scale " + *args.value("depth-scale") +
                 " (depth units per metre: " + number_text(metres_per_unit) + " m per unit)";
     }
-    DepthView camera;
-    camera.depth = image.depth.data();
-    camera.format = DepthFormat::f32;  // 16-bit samples' float copies are exact
-    camera.width = image.width;
-    camera.height = image.height;
-    camera.metres_per_unit = metres_per_unit;
-    camera.fx = k.fx;
-    camera.fy = k.fy;
-    camera.cx = k.cx;
-    camera.cy = k.cy;
+    const DepthView camera = io::depth_view(image, k, metres_per_unit);
     try {
         for (const std::string& w : check_depth_camera(camera).warnings) {
             std::fprintf(stderr, "pyrseg: warning: %s: %s (the depth scale: %s)\n", path.string().c_str(), w.c_str(),

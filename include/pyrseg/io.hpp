@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "pyrseg/depth.hpp"
 #include "pyrseg/io_export.hpp"
 #include "pyrseg/result.hpp"
 
@@ -122,6 +123,12 @@ PYRSEG_IO_EXPORT Intrinsics read_intrinsics(const std::filesystem::path& path, c
 // depth of one sample unit in metres, as in DepthView (0.001 for millimetres); the camera is checked as
 // pyrseg::check_depth_camera checks it (a wrong depth scale or intrinsics in the wrong order is an error).
 PYRSEG_IO_EXPORT PointCloud depth_to_cloud(const DepthImage& image, const Intrinsics& k, double metres_per_unit);
+
+// A DepthView of the image's samples (float32, as DepthImage holds them: a 16-bit image's integers are exact, and
+// segment into the very labels their uint16 samples do), for Segmenter::segment; `image` must outlive the view.
+// pyrseg.io.read_depth_image in Python gives the uint16 samples themselves.
+[[nodiscard]] PYRSEG_IO_EXPORT DepthView depth_view(const DepthImage& image, const Intrinsics& k,
+                                                    double metres_per_unit);
 
 // Colour-coded segmentation: label 0 black, other labels distinct saturated colours (a fixed hash of the label so
 // the same label is the same colour in every picture; neighbouring label values clearly different).

@@ -9,3 +9,7 @@
 #include "pyrseg/result.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/version.hpp"
+// The file formats (pyrseg::io; link pyrseg::io, or pkg-config pyrseg-io), where this install has them.
+#if __has_include("pyrseg/io_export.hpp")
+#include "pyrseg/io.hpp"
+#endif

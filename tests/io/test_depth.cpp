@@ -13,6 +13,7 @@
 #include "io_test_util.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
+#include "pyrseg/segmenter.hpp"
 
 namespace pyrseg::io::test {
 namespace {
@@ -133,6 +134,26 @@ TEST(DepthToCloud, ChecksTheCameraAsTheSegmenterDoes) {
         EXPECT_NE(std::string(e.what()).find("metres_per_unit 0.001 makes it 0.8 m"), std::string::npos) << e.what();
     }
     EXPECT_THROW((void)depth_to_cloud(image, Intrinsics{322.549, 248.158, 612.937, 613.173}, 0.001), Error);
+}
+
+// C++ reads a 16-bit depth PNG as floats, Python as uint16: depth_view's float samples segment into the very labels
+// the uint16 samples do, so both routes agree byte for byte.
+TEST(DepthView, AReadImageSegmentsAsItsSixteenBitSamples) {
+    ScratchDir dir;
+    const int w = 64, h = 48;
+    std::vector<std::uint16_t> mm(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) mm[std::size_t(y * w + x)] = std::uint16_t(x < w / 2 ? 800 + y : 1200 - x);
+    }
+    write_png_gray16(dir / "d.png", mm.data(), w, h);
+    const DepthImage image = read_depth_image(dir / "d.png");
+    const Intrinsics k{60.0, 60.0, 32.0, 24.0};
+    Segmenter segmenter(w, h, Params{}, "cpu");
+    const Result from_floats = segmenter.segment(depth_view(image, k, 0.001));
+    const Result from_u16 =
+        segmenter.segment(DepthView{mm.data(), DepthFormat::u16, w, h, 0, 0.001, k.fx, k.fy, k.cx, k.cy});
+    EXPECT_GT(from_u16.segment_count, 1u);
+    EXPECT_EQ(from_floats.labels, from_u16.labels);
 }
 
 TEST(Intrinsics, ParsedFromFourNumbers) {
