@@ -329,7 +329,7 @@ def test_out_aliasing_the_input_is_refused(scene):
         seg.segment(points, out=points.view(np.uint32)[..., 0])
     buf = np.zeros((h, w), np.uint32)
     with pytest.raises(ValueError, match="out="):
-        seg.segment_depth(buf.view(np.uint16)[:, :w], 1, 1, 1, 1, 0.001, out=buf)
+        seg.segment_depth(buf.view(np.uint16)[:, :w], w, w, w / 2, h / 2, 0.001, out=buf)
     mask = np.zeros((h, w, 4), np.uint8)
     with pytest.raises(ValueError, match="out="):
         seg.segment_mask(mask[..., 0], out=mask.view(np.uint32)[..., 0])
