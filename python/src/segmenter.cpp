@@ -165,6 +165,16 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
     return p;
 }
 
+// The samples of `samples` (format, size, pointer, row step) with the scale and intrinsics of `camera`.
+DepthView with_camera(DepthView samples, const DepthView& camera) {
+    samples.metres_per_unit = camera.metres_per_unit;
+    samples.fx = camera.fx;
+    samples.fy = camera.fy;
+    samples.cx = camera.cx;
+    samples.cy = camera.cy;
+    return samples;
+}
+
 // --- the Segmenter ----------------------------------------------------------------------------------------------
 
 // The frame methods' parameters (Args binds them; their docstrings show them).
@@ -229,13 +239,7 @@ public:
         const DepthInput input(depth);
         warn_about_camera(input, camera);
         return run(input, out, true, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
-            DepthView v = input.view(s);
-            v.fx = camera.fx;
-            v.fy = camera.fy;
-            v.cx = camera.cx;
-            v.cy = camera.cy;
-            v.metres_per_unit = camera.metres_per_unit;
-            seg.segment(v, r);
+            seg.segment(with_camera(input.view(s), camera), r);
         });
     }
 
@@ -295,13 +299,7 @@ private:
         const std::array<double, 5> now = {camera.fx, camera.fy, camera.cx, camera.cy, camera.metres_per_unit};
         if (camera_checked_ && now == checked_camera_) return;
         Scratch scratch;  // the Segmenter's own may be in use by another thread's frame
-        DepthView v = input.view(scratch);
-        v.fx = camera.fx;
-        v.fy = camera.fy;
-        v.cx = camera.cx;
-        v.cy = camera.cy;
-        v.metres_per_unit = camera.metres_per_unit;
-        const DepthCameraCheck check = check_depth_camera(v);
+        const DepthCameraCheck check = check_depth_camera(with_camera(input.view(scratch), camera));
         for (const std::string& w : check.warnings) {
             if (PyErr_WarnEx(PyExc_UserWarning, ("pyrseg: segment_depth(): " + w).c_str(), 2) != 0) {
                 throw py::error_already_set();
