@@ -1,5 +1,7 @@
 #include "file_util.hpp"
 
+#include <fcntl.h>
+#include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -7,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <climits>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -163,13 +166,124 @@ std::vector<unsigned char> read_file(const std::filesystem::path& path, std::uin
     });
 }
 
+namespace {
+
+// Closes the descriptor unless released; write_in_place's own close is checked.
+struct Descriptor {
+    int fd = -1;
+    Descriptor(const Descriptor&) = delete;
+    Descriptor& operator=(const Descriptor&) = delete;
+    explicit Descriptor(int f) : fd(f) {}
+    ~Descriptor() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+// A hidden name for a temporary copy of `target` in `folder`; pid and a counter keep concurrent writers (threads,
+// processes) of the same target apart.
+std::filesystem::path temporary_name(const std::filesystem::path& folder, const std::filesystem::path& target) {
+    static std::atomic<unsigned> counter{0};
+    std::string name = ".";
+    name += target.filename().string();
+    name += ".pyrseg-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1)) + ".tmp";
+    return folder / name;
+}
+
+// The bytes a writer left in `temporary` (removed then), for a target that is written in place.
+std::vector<unsigned char> take_temporary(const std::filesystem::path& temporary, const std::filesystem::path& path) {
+    std::vector<unsigned char> bytes;
+    {
+        const File file(std::fopen(temporary.c_str(), "rb"));
+        if (!file) fail(ErrorCode::io, path, "cannot read back the temporary file: " + errno_text(errno));
+        unsigned char chunk[1 << 16];
+        std::size_t n = 0;
+        while ((n = std::fread(chunk, 1, sizeof chunk, file.get())) > 0) bytes.insert(bytes.end(), chunk, chunk + n);
+        if (std::ferror(file.get())) fail(ErrorCode::io, path, "cannot read back the temporary file");
+    }
+    std::error_code ec;
+    std::filesystem::remove(temporary, ec);
+    return bytes;
+}
+
+// SIGPIPE blocked on this thread while it lives, and one it caused discarded: a reader that closes its end of the
+// FIFO early costs the writer EPIPE (an error naming the file), not the whole process.
+class SigpipeBlocked {
+public:
+    SigpipeBlocked() {
+        sigemptyset(&pipe_);
+        sigaddset(&pipe_, SIGPIPE);
+        sigset_t pending;
+        sigpending(&pending);
+        was_pending_ = sigismember(&pending, SIGPIPE) == 1;
+        pthread_sigmask(SIG_BLOCK, &pipe_, &old_);
+    }
+    SigpipeBlocked(const SigpipeBlocked&) = delete;
+    SigpipeBlocked& operator=(const SigpipeBlocked&) = delete;
+    ~SigpipeBlocked() {
+        sigset_t pending;
+        sigpending(&pending);
+        if (!was_pending_ && sigismember(&pending, SIGPIPE) == 1) {
+            const timespec now{};
+            sigtimedwait(&pipe_, nullptr, &now);
+        }
+        pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+    }
+
+private:
+    sigset_t pipe_{};
+    sigset_t old_{};
+    bool was_pending_ = false;
+};
+
+}  // namespace
+
+void write_in_place(const std::filesystem::path& path, const void* data, std::size_t size) {
+    struct stat st {};
+    const bool fifo = ::stat(path.c_str(), &st) == 0 && S_ISFIFO(st.st_mode);
+    // A FIFO's open blocks until a reader comes, which may be never: O_NONBLOCK makes that ENXIO instead.
+    Descriptor out(::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0)));
+    if (out.fd < 0) {
+        if (fifo && errno == ENXIO) fail(ErrorCode::io, path, "is a FIFO with no reader");
+        fail(ErrorCode::io, path, "cannot open for writing: " + errno_text(errno));
+    }
+    // With a reader, the writes may wait for it like any pipe's: blocking again, so that they never fail EAGAIN.
+    if (fifo) {
+        const int flags = ::fcntl(out.fd, F_GETFL);
+        if (flags < 0 || ::fcntl(out.fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+            fail(ErrorCode::io, path, "cannot write: " + errno_text(errno));
+        }
+    }
+    const SigpipeBlocked sigpipe_blocked;
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t done = 0; done < size;) {
+        const ssize_t n = ::write(out.fd, bytes + done, size - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) fail(ErrorCode::io, path, "write error: " + errno_text(n < 0 ? errno : EIO));
+        done += static_cast<std::size_t>(n);
+    }
+    const int fd = out.fd;
+    out.fd = -1;
+    if (::close(fd) != 0) fail(ErrorCode::io, path, "write error: " + errno_text(errno));
+}
+
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& temporary)>& write_to) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
     if (std::filesystem::is_directory(status)) fail(ErrorCode::io, path, "cannot open for writing: is a directory");
     if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-        write_to(path);
+        // Not the target itself: a writer opening a FIFO would block, and one that seeks (TIFF) would fail.
+        std::filesystem::path folder = std::filesystem::temp_directory_path(ec);
+        if (ec) folder = "/tmp";
+        const std::filesystem::path temporary = temporary_name(folder, path);
+        try {
+            write_to(temporary);
+        } catch (...) {
+            std::filesystem::remove(temporary, ec);
+            throw;
+        }
+        const std::vector<unsigned char> bytes = take_temporary(temporary, path);
+        write_in_place(path, bytes.data(), bytes.size());
         return;
     }
     // Through a symbolic link the file it names is replaced, not the link.
@@ -178,14 +292,14 @@ void write_atomically(const std::filesystem::path& path,
         const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, ec);
         if (!ec) target = resolved;
     }
-    // Beside the target, so that the rename stays within one file system; pid and a counter keep concurrent
-    // writers (threads, processes) of the same target apart.
-    static std::atomic<unsigned> counter{0};
-    std::filesystem::path temporary = target;
-    std::string name = ".";
-    name += target.filename().string();
-    name += ".pyrseg-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1)) + ".tmp";
-    temporary.replace_filename(name);
+    // Beside the target, so that the rename stays within one file system.
+    const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
+    if (!std::filesystem::is_directory(parent, ec)) {
+        fail(ErrorCode::io, path,
+             std::filesystem::exists(parent, ec) ? parent.string() + " is not a folder"
+                                                 : "the folder " + parent.string() + " does not exist");
+    }
+    const std::filesystem::path temporary = temporary_name(parent, target);
     try {
         write_to(temporary);
     } catch (...) {

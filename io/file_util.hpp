@@ -122,9 +122,16 @@ void write_file(const std::filesystem::path& path, const void* data, std::size_t
 
 // The same for writers that open the file themselves (PCL's): `write_to` writes the temporary file it is given and
 // throws on failure; the temporary file is removed then, and renamed over `path` otherwise. Existing targets that
-// are not regular files (/dev/null, a FIFO) are written in place: they cannot be replaced.
+// are not regular files (/dev/null, a FIFO) cannot be replaced: the temporary file is then written in the temporary
+// folder and its bytes copied into the target (write_in_place).
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& temporary)>& write_to);
+
+// Writes `size` bytes into an existing file that cannot be replaced (a device such as /dev/null, a FIFO), every
+// step checked. A FIFO is opened without blocking: with no reader that is ErrorCode::io "<path>: is a FIFO with no
+// reader" at once, never a hang; with one, the bytes are written as to any pipe. The one home of this rule: the
+// library's writers and the CLI's outputs both write non-regular files through it.
+void write_in_place(const std::filesystem::path& path, const void* data, std::size_t size);
 
 // What a cloud writer needs of its cloud: a positive size that fits int, 3 point values per pixel, and 0 or 3
 // normal values per pixel. ErrorCode::invalid_argument naming the file otherwise.
