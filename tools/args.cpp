@@ -6,9 +6,13 @@
 namespace pyrseg::cli {
 
 Args::Args(const std::vector<std::string>& argv, const std::set<std::string>& value_options,
-           const std::set<std::string>& flag_options) {
+           const std::set<std::string>& flag_options, const std::map<std::string, std::string>& short_flags) {
     for (std::size_t i = 0; i < argv.size(); ++i) {
         const std::string& a = argv[i];
+        if (const auto alias = short_flags.find(a); alias != short_flags.end()) {
+            flags_.insert(alias->second);
+            continue;
+        }
         if (a.size() < 2 || a.rfind("--", 0) != 0) {
             positional_.push_back(a);
             continue;

@@ -10,9 +10,10 @@ namespace pyrseg::cli {
 
 class Args {
 public:
-    // value_options take a value (--dt 5 or --dt=5); flag_options take none. Anything else is an error.
+    // value_options take a value (--dt 5 or --dt=5); flag_options take none; short_flags name some of them by one
+    // dash and a letter (-v for --verbose). Anything else is an error.
     Args(const std::vector<std::string>& argv, const std::set<std::string>& value_options,
-         const std::set<std::string>& flag_options);
+         const std::set<std::string>& flag_options, const std::map<std::string, std::string>& short_flags = {});
 
     [[nodiscard]] const std::vector<std::string>& positional() const { return positional_; }
     [[nodiscard]] bool flag(const std::string& name) const { return flags_.count(name) != 0; }

@@ -18,11 +18,14 @@
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "tools/batch_plan.hpp"
 #include "tools/cloud_stats.hpp"
 #include "tools/commands.hpp"
 #include "tools/figures.hpp"
+#include "tools/output_checks.hpp"
 #include "tools/output_files.hpp"
 #include "tools/pcl_peer.hpp"
+#include "tools/printable.hpp"
 #include "tools/progress.hpp"
 
 namespace pyrseg::cli {
@@ -36,9 +39,11 @@ constexpr const char* kSegmentUsage =
     "                      [--progress auto|bar|lines|none] [--backend NAME] [input options] [parameters]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
-    "and the time. With no output option it writes nothing and also prints the segment sizes. Outputs (each name\n"
-    "must end in the extension shown, else nothing is done; a frame's files are written all or none: when one\n"
-    "cannot be written whole (a full disk), none of them is left and the exit status is 1):\n"
+    "and the time (the first frame's includes the warm-up: kernel builds, first-touch allocation).\n"
+    "With no output option it writes nothing and also prints the segment sizes. Outputs (each name must end in the\n"
+    "extension shown, and no two may name the same file, else nothing is done; a frame's files are written all or\n"
+    "none: when one cannot be written whole (a full disk), none of them is left and the exit status is 1; a FIFO\n"
+    "needs a reader, else it is an error, not a wait):\n"
     "  --labels OUT.npy      labels as a NumPy uint32 array, H x W (0 = no segment, 1..K segments);\n"
     "  --labels OUT.png      or as a 16-bit grayscale PNG, when every label fits in 16 bits\n"
     "  --png OUT.png         the segments in colour\n"
@@ -55,6 +60,10 @@ constexpr const char* kSegmentUsage =
     "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
     "                        PCL's defaults\n"
     "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
+    "  --quiet, -q           nothing on stderr but warnings and errors (no backend line, notes, hints or progress\n"
+    "                        unless --progress is given); stdout still has the results: the frame's line, a batch's\n"
+    "                        summary (redirect it to drop them)\n"
+    "  --verbose, -v         the full reason for the backend auto chose (by default one short line)\n"
     "\n"
     "Units: cloud files do not say theirs. Without --unit-mm, a cloud whose median depth is under 20 units is read\n"
     "as metres (pyrseg says so), any other as millimetres; --unit-mm always wins. Depth images and depth maps take\n"
@@ -62,10 +71,13 @@ constexpr const char* kSegmentUsage =
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply, NAME.labels.pcd, NAME.stats.json as --write asks (default labels,png). A frame that fails is reported\n"
-    "and skipped (none of its outputs is left); the exit status is 1 if any failed. No output may overwrite its\n"
-    "input.\n"
-    "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch.\n"
+    "NAME.ply, NAME.labels.pcd, NAME.stats.json as --write asks (default labels,png); NAME_2, NAME_3 ... when\n"
+    "another frame's output has that name already. An output that would be one of the batch's inputs is refused\n"
+    "before anything is read. A frame that fails (also one an input option does not apply to: --intrinsics on a\n"
+    "cloud, --unit-mm on a depth image) is reported and skipped (none of its outputs is left); the exit status is 1\n"
+    "if any failed.\n"
+    "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch, with the\n"
+    "first frame's time (its warm-up) apart from the others'.\n"
     "\n";
 
 struct OutputPaths {
@@ -124,14 +136,26 @@ OutputPaths output_paths(const Args& args) {
     return out;
 }
 
+// The outputs as check_outputs sees them: each with its option's name.
+std::vector<NamedOutput> named_outputs(const OutputPaths& out) {
+    std::vector<NamedOutput> named;
+    for (const OutputOption& o : output_options()) {
+        if (const std::optional<fs::path>& path = out.*o.path) named.push_back({"--" + std::string(o.name), *path});
+    }
+    return named;
+}
+
 struct FrameReport {
     std::string line;
     std::uint32_t segments = 0;
     double milliseconds = 0;
+    bool warm_up = false;  // the frame ran on a new Segmenter: its time includes building it for the backend
 };
 
-// Said once per run: a batch of clouds in metres needs one note, not one per frame.
+// What the run says: --quiet leaves stderr to warnings and errors, and a batch of clouds in metres needs one note,
+// not one per frame.
 struct RunNotes {
+    bool quiet = false;
     bool metres_read = false;
 };
 
@@ -173,17 +197,17 @@ double cloud_unit_mm(const fs::path& input, const io::PointCloud& cloud, const A
             std::fprintf(stderr,
                          "pyrseg: warning: %s: with --unit-mm %s the median depth is %.4g m, outside any depth "
                          "sensor's range (%g to %g m): is --unit-mm right? (1 for millimetres, 1000 for metres)\n",
-                         input.string().c_str(), args.value("unit-mm")->c_str(), metres, kPlausibleMedianMetresMin,
+                         printable(input).c_str(), args.value("unit-mm")->c_str(), metres, kPlausibleMedianMetresMin,
                          kPlausibleMedianMetresMax);
         }
         return given_unit_mm;
     }
     const double unit_mm = detected_unit_mm(median);
-    if (unit_mm == 1000.0 && !notes.metres_read) {
+    if (unit_mm == 1000.0 && !notes.metres_read && !notes.quiet) {
         std::fprintf(stderr,
                      "pyrseg: note: %s: median depth %.3g units, so the cloud is read as metres (--unit-mm 1000); "
                      "pass --unit-mm 1 if it is in millimetres\n",
-                     input.string().c_str(), median);
+                     printable(input).c_str(), median);
         notes.metres_read = true;
     }
     return unit_mm;
@@ -236,7 +260,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         const std::optional<fs::path>& path = out.*o.path;
         std::error_code ec;
         if (path.has_value() && fs::equivalent(*path, input, ec)) {
-            throw Error(ErrorCode::io, path->string() + ": is the input; refusing to overwrite it");
+            throw Error(ErrorCode::io, printable(*path) + ": is the input; refusing to overwrite it");
         }
     }
     const LoadedInput loaded = load_input(input, args);
@@ -260,15 +284,16 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
             params = parse_params(args, noise.suggested);
             params.unit_mm = frame_params.unit_mm;
             sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
-        } else if (noise.suggested != SensorKind::structured_light) {
+        } else if (noise.suggested != SensorKind::structured_light && !notes.quiet) {
             std::fprintf(stderr,
                          "pyrseg: hint: %s: %s; the default parameters suit low-noise scanners. Try --sensor %s (or "
                          "--sensor auto, or the preset of your camera: --help lists them)\n",
-                         input.string().c_str(), noise.reason.c_str(), sensor_kind_name(noise.suggested));
+                         printable(input).c_str(), noise.reason.c_str(), sensor_kind_name(noise.suggested));
         }
     }
-    if (!segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height ||
-        !same_params(segmenter->params(), params)) {
+    const bool warm_up = !segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height ||
+                         !same_params(segmenter->params(), params);
+    if (warm_up) {
         Outputs outputs;
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
         outputs.segment_stats = out.stats.has_value();
@@ -322,16 +347,16 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     const std::string unit_note =
         !loaded.millimetres && !args.value("unit-mm") && params.unit_mm == 1000.0 ? " in metres" : "";
     char line[512];
-    std::snprintf(line, sizeof line, "%s: %s%s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s",
-                  input.string().c_str(), loaded.kind.c_str(), unit_note.c_str(), result.width, result.height,
-                  cloud.normals.empty() ? "estimated" : "from file", result.segment_count, elapsed.count(),
-                  segmenter->backend_name().c_str(), sensor_note.c_str(), pcl_note.c_str());
-    std::string report = line;
+    std::snprintf(line, sizeof line, "%s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s%s", unit_note.c_str(),
+                  result.width, result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count,
+                  elapsed.count(), segmenter->backend_name().c_str(), warm_up ? ", including warm-up" : "",
+                  sensor_note.c_str(), pcl_note.c_str());
+    std::string report = printable(input) + ": " + loaded.kind + line;
     if (!out.any()) {
         report += '\n';
         report += size_summary(result, cloud);
     }
-    return {report, result.segment_count, elapsed.count()};
+    return {report, result.segment_count, elapsed.count(), warm_up};
 }
 
 // Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
@@ -345,15 +370,18 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
                 if (e.is_regular_file(ec) && is_supported_input(e.path())) found.push_back(e.path());
             }
             std::sort(found.begin(), found.end());
-            if (found.empty())
-                std::fprintf(stderr, "pyrseg: note: %s holds no .pcd/.ply/.npy/.png/.tif/.tiff file\n", name.c_str());
+            // A warning, not a note: a name that brings no frame is likely a mistake, and --quiet keeps warnings.
+            if (found.empty()) {
+                std::fprintf(stderr, "pyrseg: warning: %s holds no .pcd/.ply/.npy/.png/.tif/.tiff file\n",
+                             printable(name).c_str());
+            }
             inputs.insert(inputs.end(), found.begin(), found.end());
         } else if (name.find_first_of("*?[") != std::string::npos && !fs::exists(name, ec)) {
             glob_t matches{};
             if (::glob(name.c_str(), 0, nullptr, &matches) == 0) {
                 for (std::size_t i = 0; i < matches.gl_pathc; ++i) inputs.emplace_back(matches.gl_pathv[i]);
             } else {
-                std::fprintf(stderr, "pyrseg: note: pattern '%s' matches nothing\n", name.c_str());
+                std::fprintf(stderr, "pyrseg: warning: pattern '%s' matches nothing\n", printable(name).c_str());
             }
             globfree(&matches);
         } else {
@@ -379,53 +407,101 @@ std::set<std::string> parse_write_list(const std::string& text) {
     return kinds;
 }
 
-int run_batch(const Args& args, const Params& params) {
-    const fs::path out_dir = *args.value("out-dir");
+// What a batch's summary says of the segmentation times: the first frame's apart, since it includes the warm-up
+// (kernel builds, first-touch allocation) and is several times a typical frame's.
+struct BatchTimes {
+    std::size_t frames = 0;
+    double first_ms = 0;
+    double others_ms = 0;         // the sum over the frames after the first
+    std::size_t others_warm = 0;  // of those, frames on a new Segmenter (a new size or parameters)
+
+    void add(const FrameReport& r) {
+        if (frames++ == 0) {
+            first_ms = r.milliseconds;
+            return;
+        }
+        others_ms += r.milliseconds;
+        if (r.warm_up) ++others_warm;
+    }
+    [[nodiscard]] std::string summary() const {
+        char text[256];
+        if (frames == 0) return "segmentation: no frame";
+        if (frames == 1) {
+            std::snprintf(text, sizeof text, "segmentation: %.1f ms (one frame, including warm-up)", first_ms);
+            return text;
+        }
+        std::snprintf(text, sizeof text,
+                      "segmentation: the first frame %.1f ms (warm-up), the others %.1f ms per frame", first_ms,
+                      others_ms / double(frames - 1));
+        std::string said = text;
+        if (others_warm > 0) {
+            said +=
+                " (" + std::to_string(others_warm) + " of them on a new frame size or parameters, with its warm-up)";
+        }
+        return said;
+    }
+};
+
+int run_batch(const Args& args, const Params& params, RunNotes& notes) {
+    const std::string out_dir_name = *args.value("out-dir");
+    const fs::path out_dir = out_dir_name;
     const std::set<std::string> kinds = parse_write_list(args.value("write").value_or("labels,png"));
     const std::vector<fs::path> inputs = expand_inputs(args.positional());
     if (inputs.empty()) throw Error(ErrorCode::io, "the batch has no input file");
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (!fs::is_directory(out_dir)) throw Error(ErrorCode::io, out_dir.string() + ": cannot create the output folder");
+    make_output_folder(out_dir_name);
+    // Every frame's names before the first is read: none may replace an input or another frame's output.
+    const std::vector<PlannedFrame> plan = plan_batch(inputs, out_dir, kinds);
 
-    Progress progress(inputs.size(), Progress::style_for(args.value("progress").value_or("auto"), stderr), stderr);
+    const std::optional<std::string> progress_option = args.value("progress");
+    const Progress::Style style = notes.quiet && !progress_option
+                                      ? Progress::Style::none
+                                      : Progress::style_for(progress_option.value_or("auto"), stderr);
+    Progress progress(inputs.size(), style, stderr);
     std::unique_ptr<Segmenter> segmenter;
-    RunNotes notes;
-    std::set<std::string> stems;
     std::vector<std::string> failures;
-    double total_ms = 0;
+    BatchTimes times;
     std::uint64_t total_segments = 0;
-    for (const fs::path& input : inputs) {
-        // Distinct output names even when two inputs share a name in different folders.
-        std::string stem = input.stem().string();
-        for (int n = 2; !stems.insert(stem).second; ++n) stem = input.stem().string() + "_" + std::to_string(n);
+    for (const PlannedFrame& frame : plan) {
         OutputPaths out;
-        if (kinds.count("labels") != 0) out.labels = out_dir / (stem + ".labels.npy");
-        if (kinds.count("png") != 0) out.png = out_dir / (stem + ".png");
-        if (kinds.count("mask") != 0) out.mask = out_dir / (stem + ".mask.png");
-        if (kinds.count("figure") != 0) out.figure = out_dir / (stem + ".figure.png");
-        if (kinds.count("ply") != 0) out.ply = out_dir / (stem + ".ply");
-        if (kinds.count("pcd") != 0) out.pcd = out_dir / (stem + ".labels.pcd");
-        if (kinds.count("stats") != 0) out.stats = out_dir / (stem + ".stats.json");
+        const auto planned = [&](const char* kind) -> std::optional<fs::path> {
+            const auto at = frame.outputs.find(kind);
+            if (at == frame.outputs.end()) return std::nullopt;
+            return at->second;
+        };
+        out.labels = planned("labels");
+        out.png = planned("png");
+        out.mask = planned("mask");
+        out.figure = planned("figure");
+        out.ply = planned("ply");
+        out.pcd = planned("pcd");
+        out.stats = planned("stats");
+        std::string failure;
         try {
-            const FrameReport r = segment_frame(input, args, params, out, segmenter, notes);
-            total_ms += r.milliseconds;
+            const FrameReport r = segment_frame(frame.input, args, params, out, segmenter, notes);
+            times.add(r);
             total_segments += r.segments;
             progress.frame_done(r.line, false);
+            continue;
+        } catch (const UsageError& e) {
+            // An input option that does not apply to this kind of input (--intrinsics on a cloud in a batch of
+            // depth images): this frame's failure, not the batch's end.
+            failure = "pyrseg: " + printable(frame.input) + ": " + e.message +
+                      " (this batch's input options fit only some of its frames: segment clouds and depth images in "
+                      "separate batches)";
         } catch (const std::exception& e) {  // pyrseg::Error, or what a library still throws: the batch goes on
-            failures.push_back(e.what());
-            progress.frame_done(std::string("failed: ") + e.what(), true);
+            failure = printable(e.what());
         }
+        failures.push_back(failure);
+        progress.frame_done("failed: " + failure, true);
     }
     progress.finish();
     const std::size_t ok = inputs.size() - failures.size();
     const double seconds = progress.elapsed_seconds();
     std::printf(
-        "batch: %zu frames, %zu segmented, %zu failed, %.1f s (%.1f frames/s); segmentation %.1f ms per frame, "
-        "%.1f segments per frame; outputs in %s\n",
+        "batch: %zu frames, %zu segmented, %zu failed, %.1f s (%.1f frames/s); %s, %.1f segments per frame; "
+        "outputs in %s\n",
         inputs.size(), ok, failures.size(), seconds, seconds > 0 ? double(inputs.size()) / seconds : 0.0,
-        ok > 0 ? total_ms / double(ok) : 0.0, ok > 0 ? double(total_segments) / double(ok) : 0.0,
-        out_dir.string().c_str());
+        times.summary().c_str(), ok > 0 ? double(total_segments) / double(ok) : 0.0, printable(out_dir).c_str());
     for (const std::string& f : failures) std::printf("  failed: %s\n", f.c_str());
     return failures.empty() ? 0 : 1;
 }
@@ -433,11 +509,19 @@ int run_batch(const Args& args, const Params& params) {
 }  // namespace
 
 // Which backend the frames will run on, and why, once (the per-frame lines name it too): an explicit --backend needs
-// no reason.
-void say_backend_choice(const Args& args) {
-    if (args.value("backend") && *args.value("backend") != "auto") return;
+// no reason. The reason auto gives names every emulated device it passed by (hundreds of characters): one short
+// line says the gist, -v the whole.
+void say_backend_choice(const Args& args, const RunNotes& notes) {
+    if (notes.quiet || (args.value("backend") && *args.value("backend") != "auto")) return;
     const BackendChoice choice = choose_backend(args.value("backend").value_or(""));
-    std::fprintf(stderr, "pyrseg: backend %s (%s)\n", choice.name.c_str(), choice.reason.c_str());
+    std::string reason = choice.reason;
+    if (!args.flag("verbose")) {
+        if (reason.starts_with("auto: ")) reason.erase(0, 6);
+        if (const std::size_t detail = reason.find(" ("); detail != std::string::npos) {
+            reason = reason.substr(0, detail) + "; -v says why";
+        }
+    }
+    std::fprintf(stderr, "pyrseg: backend %s (%s)\n", choice.name.c_str(), printable(reason).c_str());
 }
 
 int cmd_segment(const std::vector<std::string>& argv) {
@@ -446,29 +530,33 @@ int cmd_segment(const std::vector<std::string>& argv) {
     for (const OutputOption& o : output_options()) values.insert(o.name);
     values.insert({"backend", "out-dir", "write", "progress"});
     std::set<std::string> flags = kParameterFlagOptions;
-    flags.insert("help");
-    const Args args(argv, values, flags);
+    flags.insert({"help", "quiet", "verbose"});
+    const Args args(argv, values, flags, {{"-q", "quiet"}, {"-v", "verbose"}});
     if (args.flag("help")) {
         std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
         return 0;
     }
     // Every option is checked before the first input is read: a mistake costs a message, not a partial run.
     const OutputPaths out = output_paths(args);
+    if (args.flag("quiet") && args.flag("verbose")) throw UsageError{"give --quiet or --verbose, not both"};
+    RunNotes notes;
+    notes.quiet = args.flag("quiet");
     check_input_options(args);
     const Params params = parse_params(args);
     if (args.value("out-dir")) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
         if (out.any()) throw UsageError{"in a batch (--out-dir), choose the outputs with --write, not file names"};
-        say_backend_choice(args);
-        return run_batch(args, params);
+        if (args.value("out-dir")->empty()) throw UsageError{"--out-dir needs a folder name (\".\" for this one)"};
+        say_backend_choice(args, notes);
+        return run_batch(args, params, notes);
     }
     if (args.value("write") || args.value("progress")) throw UsageError{"--write and --progress need --out-dir"};
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
     }
-    say_backend_choice(args);
+    check_outputs(named_outputs(out));
+    say_backend_choice(args, notes);
     std::unique_ptr<Segmenter> segmenter;
-    RunNotes notes;
     std::printf("%s\n", segment_frame(args.positional()[0], args, params, out, segmenter, notes).line.c_str());
     return 0;
 }

@@ -1,4 +1,5 @@
 // pyrseg: the command-line tool.
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -9,6 +10,7 @@
 #include "pyrseg/version.hpp"
 #include "tools/args.hpp"
 #include "tools/commands.hpp"
+#include "tools/printable.hpp"
 
 namespace {
 
@@ -34,10 +36,18 @@ constexpr const char* kUsage =
     "backend's thread count; PYRSEG_OPENCL_DEVICE and PYRSEG_VULKAN_DEVICE pick a device (an index or part of\n"
     "its name, as `pyrseg backends` lists them); PYRSEG_VULKAN_VALIDATION=1 turns the Vulkan validation layer on.\n";
 
-}  // namespace
+// What is printed on stdout is the command's result: when it cannot all be written (a full disk, /dev/full), the
+// run failed, whatever the command returned. Buffered output shows its error only at the flush.
+int with_stdout_checked(int status) {
+    errno = 0;
+    if (std::fflush(stdout) == 0 && std::ferror(stdout) == 0) return status;
+    const int err = errno;
+    std::fprintf(stderr, "pyrseg: cannot write to standard output: %s\n",
+                 err != 0 ? std::strerror(err) : "write error");
+    return status == 0 ? 1 : status;
+}
 
-int main(int argc, char** argv) {
-    const std::vector<std::string> all(argv + 1, argv + argc);
+int run_command(const std::vector<std::string>& all) {
     if (all.empty() || all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
         std::fputs(kUsage, stdout);
         return all.empty() ? 2 : 0;
@@ -53,17 +63,25 @@ int main(int argc, char** argv) {
         if (all[0] == "backends") return pyrseg::cli::cmd_backends(rest);
         if (all[0] == "eval") return pyrseg::cli::cmd_eval(rest);
         if (all[0] == "bench-report") return pyrseg::cli::cmd_bench_report(rest);
-        std::fprintf(stderr, "pyrseg: unknown command '%s'\n\n%s", all[0].c_str(), kUsage);
+        std::fprintf(stderr, "pyrseg: unknown command '%s'\n\n%s", pyrseg::cli::printable(all[0]).c_str(), kUsage);
         return 2;
     } catch (const pyrseg::cli::UsageError& e) {
-        std::fprintf(stderr, "pyrseg %s: %s (see pyrseg %s --help)\n", all[0].c_str(), e.message.c_str(),
-                     all[0].c_str());
+        const std::string command = pyrseg::cli::printable(all[0]);
+        std::fprintf(stderr, "pyrseg %s: %s (see pyrseg %s --help)\n", command.c_str(),
+                     pyrseg::cli::printable(e.message).c_str(), command.c_str());
         return 2;
     } catch (const pyrseg::Error& e) {
-        std::fprintf(stderr, "%s\n", e.what());
+        // A library's message names files as given: a newline in a name must not split the line.
+        std::fprintf(stderr, "%s\n", pyrseg::cli::printable(e.what()).c_str());
         return 1;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "pyrseg: %s\n", e.what());
+        std::fprintf(stderr, "pyrseg: %s\n", pyrseg::cli::printable(e.what()).c_str());
         return 1;
     }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    return with_stdout_checked(run_command(std::vector<std::string>(argv + 1, argv + argc)));
 }

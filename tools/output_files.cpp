@@ -12,7 +12,9 @@
 #include <system_error>
 #include <vector>
 
+#include "io/file_util.hpp"
 #include "pyrseg/error.hpp"
+#include "tools/printable.hpp"
 
 namespace pyrseg::cli {
 namespace {
@@ -25,7 +27,7 @@ struct FileCloser {
 using File = std::unique_ptr<std::FILE, FileCloser>;
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
-    throw Error(ErrorCode::io, path.string() + ": " + what);
+    throw Error(ErrorCode::io, printable(path) + ": " + what);
 }
 
 std::string errno_text(int err) {
@@ -77,7 +79,7 @@ OutputFiles::~OutputFiles() {
 void OutputFiles::stage(const fs::path& target, const std::function<void(const fs::path&)>& write) {
     std::error_code ec;
     const fs::file_status status = fs::status(target, ec);
-    if (fs::is_directory(status)) fail(target, "cannot open for writing: is a directory");
+    if (fs::is_directory(status)) fail(target, "is a folder, not a file");
     Staged s;
     s.in_place = fs::exists(status) && !fs::is_regular_file(status);
     // Through a symbolic link the file it names is replaced, not the link (as io::write_* do).
@@ -87,6 +89,10 @@ void OutputFiles::stage(const fs::path& target, const std::function<void(const f
         if (!ec) s.target = resolved;
     }
     const fs::path folder = s.in_place ? fs::temp_directory_path() : s.target.parent_path();
+    if (!s.in_place && !folder.empty() && !fs::is_directory(folder, ec)) {
+        fail(target, fs::exists(folder, ec) ? printable(folder) + " is a file, not a folder"
+                                            : "the folder " + printable(folder) + " does not exist");
+    }
     s.temporary = temporary_name(folder.empty() ? fs::path(".") : folder, s.target);
     staged_.push_back(s);  // before writing: a failed write's leftovers are removed with the rest
     try {
@@ -96,10 +102,12 @@ void OutputFiles::stage(const fs::path& target, const std::function<void(const f
         std::string message = e.what();
         constexpr std::string_view kPrefix = "pyrseg: ";  // Error's constructor adds it again
         if (message.starts_with(kPrefix)) message.erase(0, kPrefix.size());
-        const std::string temporary = s.temporary.string();
-        for (std::size_t at = message.find(temporary); at != std::string::npos; at = message.find(temporary, at)) {
-            message.replace(at, temporary.size(), target.string());
-            at += target.string().size();
+        const std::string named = printable(target);
+        for (const std::string& temporary : {s.temporary.string(), printable(s.temporary)}) {
+            for (std::size_t at = message.find(temporary); at != std::string::npos; at = message.find(temporary, at)) {
+                message.replace(at, temporary.size(), named);
+                at += named.size();
+            }
         }
         throw Error(e.code(), message);
     }
@@ -112,7 +120,10 @@ void OutputFiles::commit() {
         for (const Staged& s : staged_) {
             if (!s.in_place) continue;
             const std::vector<char> bytes = read_all(s.temporary, s.target);
-            write_checked(s.target, bytes.data(), bytes.size(), s.target);
+            // Gone before the write, which may wait for a FIFO's reader: a run killed meanwhile leaves nothing.
+            std::error_code ec;
+            fs::remove(s.temporary, ec);
+            io::detail::write_in_place(s.target, bytes.data(), bytes.size());
         }
         for (const Staged& s : staged_) {
             if (s.in_place) continue;

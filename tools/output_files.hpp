@@ -20,8 +20,9 @@ public:
     // for a target that is a device or a FIFO, which cannot be replaced). `write` throws pyrseg::Error on failure.
     void stage(const std::filesystem::path& target, const std::function<void(const std::filesystem::path&)>& write);
 
-    // Moves every staged file to its target (devices and FIFOs are written first: they cannot be taken back). On
-    // failure, pyrseg::Error, and the targets this frame had already replaced are removed.
+    // Moves every staged file to its target (devices and FIFOs are written first: they cannot be taken back; a FIFO
+    // with no reader is an error at once, io::detail::write_in_place). On failure, pyrseg::Error, and the targets
+    // this frame had already replaced are removed.
     void commit();
 
 private:

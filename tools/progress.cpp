@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "tools/args.hpp"
+#include "tools/printable.hpp"
 
 namespace pyrseg::cli {
 
@@ -26,10 +27,11 @@ double Progress::elapsed_seconds() const {
 
 void Progress::frame_done(const std::string& line, bool failed) {
     ++done_;
+    const std::string shown = printable(line);
     if (style_ == Style::lines) {
-        std::fprintf(out_, "[%zu/%zu] %s\n", done_, total_, line.c_str());
+        std::fprintf(out_, "[%zu/%zu] %s\n", done_, total_, shown.c_str());
     } else if (style_ == Style::bar) {
-        if (failed) std::fprintf(out_, "\r\033[K%s\n", line.c_str());  // failures stay visible above the bar
+        if (failed) std::fprintf(out_, "\r\033[K%s\n", shown.c_str());  // failures stay visible above the bar
         draw_bar();
     }
     std::fflush(out_);
