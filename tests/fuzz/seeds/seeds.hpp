@@ -12,7 +12,7 @@ inline void write_seed(const std::filesystem::path& dir, const std::string& name
     write_seed(dir, name, text.data(), text.size());
 }
 
-void write_text_seeds(const std::filesystem::path& root);  // calib, intrinsics, args
+void write_text_seeds(const std::filesystem::path& root);  // calib, intrinsics, args, py_arrays
 void write_tiff_seeds(const std::filesystem::path& root);  // tiff and depth: the sample layouts pyrseg cannot write
 
 }  // namespace pyrseg::fuzz

@@ -1,4 +1,5 @@
-// Text seeds: calibration files in OpenCV FileStorage's three syntaxes, --intrinsics strings, and command lines.
+// Text seeds: calibration files in OpenCV FileStorage's three syntaxes, --intrinsics strings, command lines, and
+// fuzz_py_arrays's byte choices.
 #include <filesystem>
 
 #include "tests/fuzz/seeds/seeds.hpp"
@@ -55,12 +56,34 @@ void args_seeds(const fs::path& dir) {
     write_seed(dir, "help.args", "--help\n");
 }
 
+// fuzz_py_arrays's inputs are FuzzedDataProvider's: the choices are read from the end (one byte each here: the
+// operation last, then the array's kind, dtype, dimensions, strides, ...), buffer noise from the front. One seed per
+// operation, for each of a few layouts: every choice 0 (a C-ordered array) or the byte given.
+void py_arrays_seeds(const fs::path& dir) {
+    // Choices in the order the harness reads them, written backwards (the last byte is read first).
+    const auto seed = [&](const std::string& name, std::string choices) {
+        const std::string noise = "\x00\x00\xc0\x7f\x00\x00\x80\x3f";
+        std::string bytes(choices.rbegin(), choices.rend());
+        write_seed(dir, name, noise + bytes);
+    };
+    for (int op = 0; op < 8; ++op) {
+        const std::string o(1, char(op));
+        // kind 0 (an array), dtype 0 (<f4), 3 dimensions of 4 x 5 x 3, natural strides.
+        seed("op" + std::to_string(op) + "_f4_4x5x3", o + std::string("\x00\x00\x03\x04\x05\x03", 6));
+        // dtype 4 (<u2), 2 dimensions of 6 x 7, the rows reversed.
+        seed("op" + std::to_string(op) + "_u2_6x7", o + std::string("\x00\x04\x02\x06\x07\x03\x00", 7));
+        // dtype 11 (|b1), 2 dimensions of 3 x 3, a zero stride.
+        seed("op" + std::to_string(op) + "_b1_3x3", o + std::string("\x00\x0b\x02\x03\x03\x04\x00", 7));
+    }
+}
+
 }  // namespace
 
 void write_text_seeds(const fs::path& root) {
     calib_seeds(root / "fuzz_calib");
     intrinsics_seeds(root / "fuzz_intrinsics");
     args_seeds(root / "fuzz_args");
+    py_arrays_seeds(root / "fuzz_py_arrays");
 }
 
 }  // namespace pyrseg::fuzz
