@@ -9,20 +9,25 @@
 namespace pyrseg {
 
 // In the registry's order (core/backend_registry.hpp): GPUs first, the CPU always last and always there.
+namespace {
+
+BackendInfo describe(const core::KnownBackend& k) {
+    BackendInfo info;
+    info.name = k.name;
+    if (k.entry == nullptr) {
+        info.reason = k.why_not_built;
+    } else {
+        info.devices = k.entry->describe(&info.reason, &info.available);
+        if (info.available && k.entry->emulated != nullptr) info.emulated = k.entry->emulated(&info.emulated_device);
+    }
+    return info;
+}
+
+}  // namespace
+
 std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;
-    for (const core::KnownBackend& k : core::known_backends()) {
-        BackendInfo info;
-        info.name = k.name;
-        if (k.entry == nullptr) {
-            info.reason = k.why_not_built;
-        } else {
-            info.devices = k.entry->describe(&info.reason, &info.available);
-            if (info.available && k.entry->emulated != nullptr)
-                info.emulated = k.entry->emulated(&info.emulated_device);
-        }
-        all.push_back(std::move(info));
-    }
+    for (const core::KnownBackend& k : core::known_backends()) all.push_back(describe(k));
     return all;
 }
 
@@ -37,8 +42,8 @@ BackendChoice choose_backend(std::string_view requested) {
             name = "auto";
         }
     }
-    const std::vector<BackendInfo> all = list_backends();
     if (name == "auto") {
+        const std::vector<BackendInfo> all = list_backends();
         // GPUs first; a GPU API running in software on the CPU is slower than the native CPU backend.
         std::string passed;
         for (const BackendInfo& b : all) {
@@ -55,9 +60,12 @@ BackendChoice choose_backend(std::string_view requested) {
         }
         throw Error(ErrorCode::internal, "no backend is available, not even the CPU");
     }
+    // A named backend asks only its own API: a CPU Segmenter never loads a GPU driver (nor waits on one, nor fails in
+    // one).
     std::string known;
-    for (const BackendInfo& b : all) {
-        if (b.name == name) {
+    for (const core::KnownBackend& k : core::known_backends()) {
+        if (k.name == name) {
+            const BackendInfo b = describe(k);
             if (!b.available) {
                 std::string message = "backend '" + name;
                 message += "' (" + origin + ") is unavailable: ";
@@ -66,7 +74,7 @@ BackendChoice choose_backend(std::string_view requested) {
             }
             return {b.name, origin == "requested" ? std::string("requested") : "PYRSEG_BACKEND=" + name};
         }
-        known += (known.empty() ? "" : ", ") + b.name;
+        known += (known.empty() ? "" : ", ") + std::string(k.name);
     }
     throw Error(ErrorCode::backend_unavailable,
                 "unknown backend '" + name + "' (" + origin + "); known backends: " + known + ", auto");

@@ -19,10 +19,24 @@
 namespace {
 std::atomic<bool> counting{false};
 std::atomic<long> allocations{0};
-// While counting, on the thread that set it: the allocation with this number (1 = the first) fails with
+// While counting, on the thread that set it: pyrseg's allocation with this number (1 = the first) fails with
 // std::bad_alloc, as a large one does when memory runs out (the smaller ones after it, such as the error's message,
-// succeed); 0: none fails. Other threads (a driver's compiler threads) are never failed.
+// succeed); 0: none fails. Other threads (a driver's compiler threads) are never failed, nor are a driver's own
+// allocations: an exception thrown in a Vulkan layer unwinds through the C loader and leaves its lock held (the next
+// vkEnumeratePhysicalDevices waits for ever), which is the driver's to handle, not pyrseg's.
 thread_local long failing_allocation = 0;
+thread_local long pyrseg_allocations = 0;
+}  // namespace
+
+// The test binary's own code (pyrseg is linked in statically), from GNU ld's symbols.
+extern "C" const char __executable_start;  // NOLINT(bugprone-reserved-identifier)
+extern "C" const char etext;
+
+namespace {
+bool called_from_this_binary(const void* return_address) {
+    const auto* at = static_cast<const char*>(return_address);
+    return at >= &__executable_start && at < &etext;
+}
 }  // namespace
 
 // The replacements are a matched pair over malloc/free; GCC, seeing them inlined, would warn that free() gets a
@@ -33,8 +47,10 @@ thread_local long failing_allocation = 0;
 
 void* operator new(std::size_t size) {
     if (counting.load(std::memory_order_relaxed)) {
-        const long n = allocations.fetch_add(1, std::memory_order_relaxed) + 1;
-        if (failing_allocation > 0 && n == failing_allocation) throw std::bad_alloc();
+        allocations.fetch_add(1, std::memory_order_relaxed);
+        if (failing_allocation > 0 && called_from_this_binary(__builtin_return_address(0)) &&
+            ++pyrseg_allocations == failing_allocation)
+            throw std::bad_alloc();
     }
     if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
     throw std::bad_alloc();
@@ -71,6 +87,7 @@ class NoAllocation : public ::testing::TestWithParam<std::string> {};
 // code name or "bad_alloc".
 std::string when_memory_runs_out_at(long n, const std::function<void()>& f) {
     allocations = 0;
+    pyrseg_allocations = 0;
     failing_allocation = n;
     counting = true;
     std::string outcome;
@@ -96,20 +113,27 @@ TEST_P(NoAllocation, HostMemoryRunningOutIsOutOfMemory) {
     const CloudView cv{scene.points.data(), nullptr, o.width, o.height};
     Outputs outputs;
     outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    int failed_makes = 0;
+    int failed_frames = 0;
     for (long n = 1; n <= 120; ++n) {  // every allocation of a small frame's setup, one at a time
         SCOPED_TRACE("allocation " + std::to_string(n));
         const std::string made =
             when_memory_runs_out_at(n, [&] { Segmenter s(o.width, o.height, Params{}, GetParam(), outputs); });
         EXPECT_TRUE(made.empty() || made == to_string(ErrorCode::out_of_memory)) << "making the Segmenter: " << made;
+        failed_makes += made.empty() ? 0 : 1;
         Segmenter segmenter(o.width, o.height, Params{}, GetParam(), outputs);
         const std::string framed = when_memory_runs_out_at(n, [&] {
             Result fresh;  // sized by the frame: its vectors are what the frame allocates
             segmenter.segment(cv, fresh);
         });
         EXPECT_TRUE(framed.empty() || framed == to_string(ErrorCode::out_of_memory)) << "a frame: " << framed;
+        failed_frames += framed.empty() ? 0 : 1;
         Result after;
         EXPECT_NO_THROW(segmenter.segment(cv, after)) << "the Segmenter must work once memory is back";
     }
+    // The injection reached pyrseg's allocations: the first ones of making a Segmenter and of a fresh frame fail.
+    EXPECT_GE(failed_makes, 1);
+    EXPECT_GE(failed_frames, 1);
 }
 
 TEST_P(NoAllocation, WarmFramesAllocateNothing) {
