@@ -22,6 +22,7 @@ namespace pyrseg::io::detail {
 [[noreturn]] void fail(ErrorCode code, const std::filesystem::path& path, std::string_view what);
 
 // A file's bytes quoted in a message: control and non-ASCII bytes as '?', so that a message stays one line of text.
+// (File names are the CLI's to print, tools/printable.hpp: they keep UTF-8 and escape control characters.)
 std::string printable(std::string_view bytes);
 
 // The largest image any reader decodes: 65536 on a side and 2^28 pixels in all (16384 x 16384, 1 GiB of float depth),

@@ -30,16 +30,13 @@ std::vector<std::string_view> split(std::string_view line) {
     return tokens;
 }
 
-// Header text quoted in messages: short, and with control bytes shown as '?' so a binary file cannot garble them.
+// Header text quoted in messages: short, and printable (detail::printable) so a binary file cannot garble them.
 std::string quote(std::string_view text) {
     constexpr std::size_t kMaxLen = 40;
     std::string out = "'";
-    for (std::size_t i = 0; i < text.size() && i < kMaxLen; ++i) {
-        const auto c = static_cast<unsigned char>(text[i]);
-        out += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
-    }
-    if (text.size() > kMaxLen) out += "...";
-    return out + "'";
+    out += detail::printable(text.substr(0, kMaxLen));
+    out += text.size() > kMaxLen ? "...'" : "'";
+    return out;
 }
 
 std::optional<std::uint64_t> parse_uint(std::string_view s) {
