@@ -31,10 +31,6 @@ targets=(
   "fuzz_args args 80000"
   "fuzz_py_arrays py_arrays 1200"
 )
-# fuzz_py_arrays leaves out the ragged list (an object numpy cannot make an array of) until python/src/arrays.cpp's
-# as_array refuses it instead of dereferencing the null array py::array::ensure gives (a segfault; docs/fuzzing.md,
-# "Findings so far"). Remove this line with that fix: the harness then checks it on every run.
-export PYRSEG_FUZZ_NO_RAGGED=1
 # Absolute paths: `long` runs each harness in its log folder (libFuzzer's -jobs writes fuzz-N.log there).
 build=$PWD/build/fuzz
 bin=$build/tests/fuzz

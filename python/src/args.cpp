@@ -185,4 +185,18 @@ void refuse_second_init(py::object cls, const char* type_name) {
         py::name("_init_once"), py::is_method(cls), py::doc(doc.c_str()));
 }
 
+py::array as_array(const py::object& obj, const std::string& what) {
+    if (obj.is_none()) throw py::type_error(what + " must be an array, not None");
+    py::array a = py::array::ensure(obj);
+    if (a) return a;
+    // ensure() clears numpy's exception; numpy.asarray raises it again, with numpy's reason.
+    std::string reason = "numpy cannot make one of a " + type_name(obj);
+    try {
+        a = py::module_::import("numpy").attr("asarray")(obj);
+    } catch (const py::error_already_set& e) {
+        reason = py::str(e.value()).cast<std::string>();
+    }
+    throw py::value_error(what + " cannot be made an array: " + reason);
+}
+
 }  // namespace pyrseg::python

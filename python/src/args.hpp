@@ -76,6 +76,11 @@ void def_args(Scope& scope, const char* name, std::span<const Param> params, con
 
 std::string type_name(py::handle v);
 
+// `obj` as a numpy array, viewed where numpy can (arrays, buffers, CPU tensors) and made otherwise (lists).
+// TypeError "<what> must be an array, not None" for None; ValueError naming `what` with numpy's own reason where
+// numpy cannot make an array of it (a ragged list).
+py::array as_array(const py::object& obj, const std::string& what);
+
 // Whether a pybind11 instance has had its C++ object made: T.__new__(T) makes the Python object alone, and
 // pybind11 would hand its methods uninitialised memory.
 [[nodiscard]] bool initialised(py::handle self);

@@ -1,5 +1,7 @@
 #include "arrays.hpp"
 
+#include "args.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
@@ -18,12 +20,6 @@ std::string shape_text(const py::array& a) {
 
 std::string dtype_text(const py::array& a) {
     return py::str(a.dtype()).cast<std::string>();
-}
-
-// Anything numpy can view (arrays, buffers, CPU tensors, lists) without copying what it need not.
-py::array as_array(const py::object& obj, const char* what) {
-    if (obj.is_none()) throw py::type_error(std::string(what) + " must be an array, not None");
-    return py::array::ensure(obj);
 }
 
 bool is_float(const py::array& a) {

@@ -28,14 +28,10 @@ py::tuple cloud_tuple(const io::PointCloud& c) {
     return py::make_tuple(array_of(c.points.data(), c.height, c.width, 3), normals);
 }
 
-// A numeric array (bool, integers, floats) from anything numpy can view; TypeError for None or anything else.
+// A numeric array (bool, integers, floats) from anything numpy can make one of (as_array); TypeError for any other
+// dtype.
 py::array numeric(const char* function, const char* what, const py::object& obj) {
-    if (obj.is_none()) throw py::type_error(std::string(function) + ": " + what + " must be an array, not None");
-    const py::array a = py::array::ensure(obj);
-    if (!a) {
-        PyErr_Clear();
-        throw py::type_error(std::string(function) + ": " + what + " must be an array, got " + type_name(obj));
-    }
+    const py::array a = as_array(obj, std::string(function) + ": " + what);
     const char k = a.dtype().kind();
     if (k != 'b' && k != 'i' && k != 'u' && k != 'f') {
         throw py::type_error(std::string(function) + ": " + what + " must be a numeric array, got dtype " +

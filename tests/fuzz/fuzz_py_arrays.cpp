@@ -174,14 +174,8 @@ std::optional<Array> make_array(FuzzedDataProvider& in, const std::vector<py::ss
     Interpreter& it = interpreter();
     const int kind = in.ConsumeIntegralInRange<int>(0, 15);
     Array a;
-    // numpy cannot make an array of this: py::array::ensure gives a null array, which python/src/arrays.cpp's
-    // as_array did not check (a segfault: docs/fuzzing.md, "Findings so far"). PYRSEG_FUZZ_NO_RAGGED=1 leaves it out,
-    // so that a long run can look past that finding until it is fixed.
-    static const bool no_ragged = std::getenv("PYRSEG_FUZZ_NO_RAGGED") != nullptr;
-    if (kind == 13 && no_ragged) {
-        a.object = py::none();
-        return a;
-    }
+    // numpy cannot make an array of this (the bindings once read the null array py::array::ensure gives for it: a
+    // segfault, docs/fuzzing.md "Findings so far"); every entry point must raise ValueError naming the argument.
     if (kind == 13) {
         py::list ragged;
         ragged.append(py::make_tuple(1.0, 2.0));

@@ -300,6 +300,34 @@ def test_none_where_an_array_is_needed():
         assert "None" in m, m
 
 
+def test_ragged_lists_are_value_errors_naming_the_argument():
+    # numpy cannot make an array of a ragged list; the bindings used the null array it left (a segfault, found by
+    # fuzz_py_arrays), so each call runs in a child interpreter.
+    assert_snippet_passes(
+        """
+        import numpy as np
+        import pyrseg
+        seg = pyrseg.Segmenter(8, 6, "cpu")
+        ragged = [[1.0], [1.0, 2.0]]
+        calls = {
+            "points": lambda: seg.segment(ragged),
+            "normals": lambda: seg.segment([[[0.0, 0.0, 1.0]] * 8] * 6, normals=ragged),
+            "depth": lambda: seg.segment_depth(ragged, 1, 1, 1, 1, 0.001),
+            "mask": lambda: seg.segment_mask(ragged),
+            "valid": lambda: seg.segment_mask(np.ones((6, 8), bool), valid=ragged),
+            "image": lambda: pyrseg.io.write_png_gray16("x.png", ragged),
+        }
+        for name, call in calls.items():
+            try:
+                call()
+            except ValueError as e:
+                assert name in str(e) and "cannot be made an array" in str(e), (name, str(e))
+            else:
+                raise AssertionError(name + ": no ValueError")
+        """
+    )
+
+
 # --- 4: out= that overlaps itself or the input -------------------------------------------------------------------
 
 
