@@ -51,7 +51,7 @@ class FrameLoop:
             self.seg = pyrseg.Segmenter(w, h, self.args.backend, preset=self.args.preset)
             self.labels = np.empty((h, w), np.uint32)
         start = time.perf_counter()
-        r = self.seg.segment_depth(depth, k.fx, k.fy, k.cx, k.cy, metres_per_unit=metres_per_unit, out=self.labels)
+        r = self.seg.segment_depth(depth, *k, metres_per_unit=metres_per_unit, out=self.labels)
         ms = (time.perf_counter() - start) * 1000
         self.times.append(ms)
         note = " (first frame: includes warm-up)" if len(self.times) == 1 else ""

@@ -148,15 +148,6 @@ io::Intrinsics& intrinsics_of(py::handle self) {
     return live<io::Intrinsics>(self, "pyrseg.io.Intrinsics", kIntrinsicsUninitialised);
 }
 
-// An argument that must be an Intrinsics (not any object pybind11 could not cast).
-const io::Intrinsics& intrinsics_arg(const char* function, const char* name, py::handle v) {
-    if (!py::isinstance<io::Intrinsics>(v)) {
-        throw py::type_error(std::string(function) + ": " + name + " must be a pyrseg.io.Intrinsics, got " +
-                             type_name(v));
-    }
-    return intrinsics_of(v);
-}
-
 // The functions' parameters (Args binds them; their docstrings show them).
 constexpr Param kPath[] = {{"path"}};
 constexpr Param kWritePcd[] = {{"path"}, {"points"}, {"normals", "None"}, {"labels", "None"}, {"encoding", "'binary'"}};
@@ -168,7 +159,8 @@ constexpr Param kLabel[] = {{"label"}};
 constexpr Param kStats[] = {{"path"}, {"segments"}, {"width"}, {"height"}, {"unit_mm", "1.0"}, {"source", "''"}};
 constexpr Param kParseIntrinsics[] = {{"text"}};
 constexpr Param kReadIntrinsics[] = {{"path"}, {"node", "''"}};
-constexpr Param kDepthToCloud[] = {{"depth"}, {"intrinsics"}, {"metres_per_unit"}};
+// As Segmenter.segment_depth's: one vocabulary for a depth camera (an Intrinsics unpacks into fx, fy, cx, cy).
+constexpr Param kDepthToCloud[] = {{"depth"}, {"fx"}, {"fy"}, {"cx"}, {"cy"}, {"metres_per_unit"}};
 
 // A reader: path -> what read(path) gives.
 template <class Read>
@@ -223,6 +215,12 @@ void bind_io(py::module_& io) {
     field("fy", &io::Intrinsics::fy);
     field("cx", &io::Intrinsics::cx);
     field("cy", &io::Intrinsics::cy);
+    // fx, fy, cx, cy in the order Segmenter.segment_depth and depth_to_cloud take them: seg.segment_depth(depth, *k,
+    // metres_per_unit=0.001).
+    intrinsics.def("__iter__", [](const py::object& self) {
+        const io::Intrinsics& k = intrinsics_of(self);
+        return py::iter(py::make_tuple(k.fx, k.fy, k.cx, k.cy));
+    });
     refuse_second_init(intrinsics, "pyrseg.io.Intrinsics");
 
     def_reader(io, "read_pcd", "read_pcd()",
@@ -347,13 +345,22 @@ void bind_io(py::module_& io) {
                  return io::read_intrinsics(a.path(0), a.text(1, ""));
              });
     def_args(io, "depth_to_cloud", kDepthToCloud,
-             "An H x W x 3 float32 cloud in millimetres from a depth image (NaN where no data); metres_per_unit is "
-             "the depth of one sample unit in metres, as in Segmenter.segment_depth (0.001 for millimetres).",
+             "An H x W x 3 float32 cloud in millimetres from a depth image (NaN where no data). The camera as in "
+             "Segmenter.segment_depth: the intrinsics in pixels (an Intrinsics k unpacks into them: "
+             "depth_to_cloud(depth, *k, 0.001)) and metres_per_unit, the depth of one sample unit in metres (0.001 "
+             "for millimetres).",
              [](const py::args& args, const py::kwargs& kwargs) {
                  const char* f = "depth_to_cloud()";
+                 // Before the arguments are counted: depth_to_cloud(depth, k, 0.001) was this function's form.
+                 if (args.size() >= 2 && py::isinstance<io::Intrinsics>(args[1])) {
+                     throw py::type_error(
+                         "depth_to_cloud(): fx must be a number: the camera is fx, fy, cx, cy, metres_per_unit as in "
+                         "Segmenter.segment_depth; unpack an Intrinsics k with depth_to_cloud(depth, *k, "
+                         "metres_per_unit)");
+                 }
                  const Args a(f, kDepthToCloud, args, kwargs);
-                 const io::Intrinsics k = intrinsics_arg(f, "intrinsics", a.object(1));
-                 const double metres_per_unit = a.number(2);
+                 const io::Intrinsics k{a.number(1), a.number(2), a.number(3), a.number(4)};
+                 const double metres_per_unit = a.number(5);
                  const auto depth = image_of<float>(f, a.object(0), "depth", 1, "float32 depth");
                  io::DepthImage d;
                  d.width = int(depth.shape(1));

@@ -47,6 +47,11 @@ def test_an_unusual_scale_is_a_warning_once_per_camera():
 
 def test_depth_to_cloud_checks_the_same_way():
     k = pyrseg.io.Intrinsics(K["fx"], K["fy"], K["cx"], K["cy"])
-    assert pyrseg.io.depth_to_cloud(wall(), k, 0.001)[0, 0, 2] == 800
+    assert pyrseg.io.depth_to_cloud(wall(), *k, 0.001)[0, 0, 2] == 800
     with pytest.raises(pyrseg.Error, match="metres_per_unit 0.001 makes it"):
-        pyrseg.io.depth_to_cloud(wall(), k, 1.0)
+        pyrseg.io.depth_to_cloud(wall(), *k, 1.0)
+    # The same words as segment_depth's: the camera's five numbers, in the same order, by keyword too.
+    seg = pyrseg.Segmenter(wall().shape[1], wall().shape[0], "cpu")
+    by_keyword = dict(fx=k.fx, fy=k.fy, cx=k.cx, cy=k.cy, metres_per_unit=0.001)
+    assert pyrseg.io.depth_to_cloud(wall(), **by_keyword)[0, 0, 2] == 800
+    assert seg.segment_depth(wall(), **by_keyword).segment_count >= 1

@@ -144,7 +144,7 @@ def test_uninitialised_intrinsics_raise():
         k = pyrseg.io.Intrinsics.__new__(pyrseg.io.Intrinsics)
         assert "not initialised" in repr(k)
         for f in (lambda: k.fx, lambda: setattr(k, "cy", 1.0),
-                  lambda: pyrseg.io.depth_to_cloud(np.zeros((2, 2), np.uint16), k, 0.001)):
+                  lambda: list(k)):
             try:
                 f()
             except TypeError as e:
@@ -241,7 +241,7 @@ def test_missing_arguments_are_named_without_the_arrays():
     m = short_type_error(lambda: seg.segment(np.zeros((480, 640, 3), np.float32), normalz=None))
     assert "normalz" in m, m
     m = short_type_error(lambda: pyrseg.io.depth_to_cloud(BIG))
-    assert "'intrinsics'" in m and "_per_unit'" in m, m
+    assert "'fx'" in m and "_per_unit'" in m, m
     m = short_type_error(lambda: pyrseg.io.write_pcd(points=np.zeros((480, 640, 3), np.float32)))
     assert "'path'" in m, m
     m = short_type_error(lambda: pyrseg.io.write_png_gray16(1, BIG))
@@ -263,8 +263,9 @@ def test_missing_arguments_are_named_without_the_arrays():
         (lambda: pyrseg.io.label_color("1"), "label", "integer"),
         (lambda: pyrseg.io.parse_intrinsics(1), "text", "str"),
         (lambda: pyrseg.io.Intrinsics("a", 1, 1, 1), "fx", "number"),
-        (lambda: pyrseg.io.depth_to_cloud(BIG, "k", 1.0), "intrinsics", "Intrinsics"),
-        (lambda: pyrseg.io.depth_to_cloud(BIG, pyrseg.io.Intrinsics(1, 1, 1, 1), "1"), "_per_unit", "number"),
+        (lambda: pyrseg.io.depth_to_cloud(BIG, "k", 1, 1, 1, 1.0), "fx", "number"),
+        (lambda: pyrseg.io.depth_to_cloud(BIG, pyrseg.io.Intrinsics(1, 1, 1, 1), 1.0), "*k", "unpack"),
+        (lambda: pyrseg.io.depth_to_cloud(BIG, *pyrseg.io.Intrinsics(1, 1, 1, 1), "1"), "_per_unit", "number"),
         (lambda: pyrseg.io.write_segment_stats("s.csv", np.zeros(0), "64", 48), "width", "integer"),
         (lambda: pyrseg.synthetic.generate(width="x"), "width", "integer"),
         (lambda: pyrseg.synthetic.generate(touching="x"), "touching", "True or False"),

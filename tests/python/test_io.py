@@ -56,7 +56,7 @@ def test_depth_images(tmp_path, cloud):
     assert back.dtype == np.float32
     np.testing.assert_array_equal(back, metres)
     k = pyrseg.io.Intrinsics(s.fx, s.fy, s.cx, s.cy)
-    cloud_mm = pyrseg.io.depth_to_cloud(mm, k, 0.001)
+    cloud_mm = pyrseg.io.depth_to_cloud(mm, *k, 0.001)
     valid = mm > 0
     np.testing.assert_allclose(cloud_mm[valid][:, 2], mm[valid])
     assert np.isnan(cloud_mm[~valid]).all()
