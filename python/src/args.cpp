@@ -166,7 +166,7 @@ bool initialised(py::handle self) {
     return inst->get_value_and_holder(nullptr, false).holder_constructed();
 }
 
-void refuse_second_init(py::object cls, const char* type_name) {
+void refuse_second_init(const py::object& cls, const char* type_name) {
     const py::object init = cls.attr("__init__");
     const std::string doc = py::str(init.attr("__doc__"));
     const std::string message = std::string(type_name) +

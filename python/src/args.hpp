@@ -95,6 +95,6 @@ T& live(py::handle self, const char* type, const char* message) {
 }
 // Replaces cls.__init__ by one that refuses an object already initialised: pybind11 silently ignores a second
 // __init__ (its C++ object cannot be made twice), leaving the caller to think it took the new arguments.
-void refuse_second_init(py::object cls, const char* type_name);
+void refuse_second_init(const py::object& cls, const char* type_name);
 
 }  // namespace pyrseg::python

@@ -31,7 +31,7 @@ py::tuple cloud_tuple(const io::PointCloud& c) {
 // A numeric array (bool, integers, floats) from anything numpy can make one of (as_array); TypeError for any other
 // dtype.
 py::array numeric(const char* function, const char* what, const py::object& obj) {
-    const py::array a = as_array(obj, std::string(function) + ": " + what);
+    py::array a = as_array(obj, std::string(function) + ": " + what);
     const char k = a.dtype().kind();
     if (k != 'b' && k != 'i' && k != 'u' && k != 'f') {
         throw py::type_error(std::string(function) + ": " + what + " must be a numeric array, got dtype " +

@@ -211,7 +211,8 @@ public:
 
     py::object segment(const py::args& args, const py::kwargs& kwargs) {
         const Args a("segment()", kSegment, args, kwargs);
-        const py::object points = a.object(0), normals = a.object(1), out = a.object(2), count = a.object(3);
+        const py::object points = a.object(0), normals = a.object(1), count = a.object(3);
+        py::object out = a.object(2);
         if (is_device_array(points)) {
             device().segment_cloud(*segmenter_, points, normals, out, count);
             return out;
@@ -224,7 +225,8 @@ public:
 
     py::object segment_depth(const py::args& args, const py::kwargs& kwargs) {
         const Args a("segment_depth()", kSegmentDepth, args, kwargs);
-        const py::object depth = a.object(0), out = a.object(6), count = a.object(7);
+        const py::object depth = a.object(0), count = a.object(7);
+        py::object out = a.object(6);
         DepthView camera;
         camera.fx = a.number(1);
         camera.fy = a.number(2);
@@ -597,6 +599,7 @@ void bind_errors(py::module_& m) {
     // NOLINTNEXTLINE(performance-unnecessary-value-param): pybind11 takes void(*)(std::exception_ptr)
     // std::bad_alloc too: a backend or the bindings themselves may let one out where the library's own checks
     // (Error(out_of_memory)) did not foresee it, and every backend should say the same for the same failure.
+    // NOLINTNEXTLINE(performance-unnecessary-value-param): pybind11's translator type takes it by value
     py::register_local_exception_translator([](std::exception_ptr p) {
         const auto set = [](const Error& e) {
             const py::object instance = obj(cached.error)(e.what());
