@@ -17,6 +17,8 @@
 #include <string>
 #include <system_error>
 
+#include "temporary_files.hpp"
+
 namespace pyrseg::io::detail {
 
 namespace {
@@ -276,6 +278,7 @@ void write_atomically(const std::filesystem::path& path,
         std::filesystem::path folder = std::filesystem::temp_directory_path(ec);
         if (ec) folder = "/tmp";
         const std::filesystem::path temporary = temporary_name(folder, path);
+        const RegisteredTemporary registered(temporary);
         try {
             write_to(temporary);
         } catch (...) {
@@ -300,6 +303,7 @@ void write_atomically(const std::filesystem::path& path,
                                                  : "the folder " + parent.string() + " does not exist");
     }
     const std::filesystem::path temporary = temporary_name(parent, target);
+    const RegisteredTemporary registered(temporary);
     try {
         write_to(temporary);
     } catch (...) {

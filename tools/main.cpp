@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "io/temporary_files.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/version.hpp"
 #include "tools/args.hpp"
@@ -83,5 +84,7 @@ int run_command(const std::vector<std::string>& all) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Ctrl-C or a SIGTERM in the middle of a frame leaves none of its hidden temporary outputs behind.
+    pyrseg::io::detail::remove_temporaries_on_termination_signals();
     return with_stdout_checked(run_command(std::vector<std::string>(argv + 1, argv + argc)));
 }

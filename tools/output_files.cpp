@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "io/file_util.hpp"
@@ -94,16 +95,18 @@ void OutputFiles::stage(const fs::path& target, const std::function<void(const f
                                             : "the folder " + printable(folder) + " does not exist");
     }
     s.temporary = temporary_name(folder.empty() ? fs::path(".") : folder, s.target);
-    staged_.push_back(s);  // before writing: a failed write's leftovers are removed with the rest
+    s.registered = io::detail::RegisteredTemporary(s.temporary);
+    staged_.push_back(std::move(s));  // before writing: a failed write's leftovers are removed with the rest
+    const Staged& staged = staged_.back();
     try {
-        write(s.temporary);
+        write(staged.temporary);
     } catch (const Error& e) {
         // Named by the target: the temporary file is an implementation detail.
         std::string message = e.what();
         constexpr std::string_view kPrefix = "pyrseg: ";  // Error's constructor adds it again
         if (message.starts_with(kPrefix)) message.erase(0, kPrefix.size());
         const std::string named = printable(target);
-        for (const std::string& temporary : {s.temporary.string(), printable(s.temporary)}) {
+        for (const std::string& temporary : {staged.temporary.string(), printable(staged.temporary)}) {
             for (std::size_t at = message.find(temporary); at != std::string::npos; at = message.find(temporary, at)) {
                 message.replace(at, temporary.size(), named);
                 at += named.size();
@@ -111,7 +114,7 @@ void OutputFiles::stage(const fs::path& target, const std::function<void(const f
         }
         throw Error(e.code(), message);
     }
-    if (!fs::is_regular_file(s.temporary, ec)) fail(target, "the writer left no file");
+    if (!fs::is_regular_file(staged.temporary, ec)) fail(target, "the writer left no file");
 }
 
 void OutputFiles::commit() {

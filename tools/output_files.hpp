@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "io/temporary_files.hpp"
+
 namespace pyrseg::cli {
 
 class OutputFiles {
@@ -30,6 +32,8 @@ private:
         std::filesystem::path target;     // where the file goes (a symbolic link's own target)
         std::filesystem::path temporary;  // where it is written first
         bool in_place = false;            // a device or FIFO: its bytes are copied into it
+        // For a termination signal's handler to remove (tools/main.cpp): Ctrl-C mid-frame leaves no temporary.
+        io::detail::RegisteredTemporary registered;
     };
     std::vector<Staged> staged_;
 };

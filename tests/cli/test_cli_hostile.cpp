@@ -1,7 +1,9 @@
 // `pyrseg segment` against a hostile caller (issue 32): no silent mistake, no hang, no crash, no lost file. Every
 // output path kind (a FIFO, a device, a folder, another input, the same file twice), control characters in names,
 // a full stdout, and what the run says (--quiet, -v, the first frame's warm-up).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -129,6 +131,52 @@ TEST_F(CliHostile, AFifoOutputWithNoReaderIsAnErrorNotAHang) {
     fs::create_symlink("/dev/null", dir_ / "out" / "null.npy");
     const CliRun null = run("segment " + input.string() + " --backend cpu --labels " + out("null.npy"));
     EXPECT_EQ(null.status, 0) << null.output;
+}
+
+// Ctrl-C or a SIGTERM while a frame's outputs are being written leaves none of their hidden temporary files (it once
+// left ".a.pyrseg-out-PID-N.png" beside a.png). The run is held in the middle of its outputs by a FIFO whose reader
+// takes nothing: the labels' 160 x 120 x 4 bytes fill the pipe, and a.png waits, staged, for its rename.
+TEST_F(CliHostile, ATerminationSignalMidOutputLeavesNoTemporaryFile) {
+    const fs::path input = cloud_frame("frame.pcd", 160, 120);
+    for (const int signal_number : {SIGTERM, SIGINT}) {
+        SCOPED_TRACE("signal " + std::to_string(signal_number));
+        fs::remove_all(dir_ / "out");
+        fs::create_directories(dir_ / "out");
+        const std::string fifo = out("fifo.npy");
+        ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+        const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+        ASSERT_GE(reader, 0);
+        std::fflush(nullptr);
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            // A child of the test's shell would inherit a SIGINT ignored; the CLI must see it as a terminal sends it.
+            std::signal(SIGINT, SIG_DFL);
+            const std::string tmp = "TMPDIR=" + (dir_ / "tmp").string();
+            ::putenv(const_cast<char*>(tmp.c_str()));
+            ::execl(PYRSEG_CLI_PATH, PYRSEG_CLI_PATH, "segment", input.c_str(), "--backend", "cpu", "--labels",
+                    fifo.c_str(), "--png", out("a.png").c_str(), "-q", static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ASSERT_GT(pid, 0);
+        // Held once the pipe is full (64 KiB on Linux, the labels 76,928 bytes): the writer waits on the reader.
+        int queued = 0;
+        for (int i = 0; i < 2000 && queued < 65536; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            if (::ioctl(reader, FIONREAD, &queued) != 0) queued = 0;
+        }
+        EXPECT_GE(queued, 65536) << "the run never filled the FIFO";
+        bool staged = false;
+        for (const std::string& name : files_in(dir_ / "out")) staged |= name.starts_with(".a.pyrseg-out-");
+        EXPECT_TRUE(staged) << "a.png's temporary file was not there while the run was held";
+        ::kill(pid, signal_number);
+        int status = 0;
+        ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+        ::close(reader);
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
+            << "the run should end by the signal, as without a handler";
+        EXPECT_EQ(files_in(dir_ / "out"), Names{"fifo.npy"});
+        EXPECT_EQ(files_in(dir_ / "tmp"), Names{});
+    }
 }
 
 // The library's writers have the same promise: a FIFO with no reader is a pyrseg::Error(io), never a hang.
