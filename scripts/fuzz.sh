@@ -29,6 +29,7 @@ targets=(
   "fuzz_calib calib 16000"
   "fuzz_intrinsics intrinsics 120000"
   "fuzz_args args 80000"
+  "fuzz_batch_plan batch_plan 8000"
   "fuzz_py_arrays py_arrays 1200"
 )
 # Absolute paths: `long` runs each harness in its log folder (libFuzzer's -jobs writes fuzz-N.log there).

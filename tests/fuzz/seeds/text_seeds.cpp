@@ -77,6 +77,23 @@ void py_arrays_seeds(const fs::path& dir) {
     }
 }
 
+// fuzz_batch_plan's inputs are FuzzedDataProvider's too, read from the end: the number of inputs, then per input
+// its pieces and whether it exists, then the output folder and the kinds. Three byte strings of small, medium and
+// large batches to start from; libFuzzer's mutations find the colliding names.
+void batch_plan_seeds(const fs::path& dir) {
+    const auto seed = [&](const std::string& name, std::string choices) {
+        write_seed(dir, name, std::string(choices.rbegin(), choices.rend()));
+    };
+    seed("one_npy", std::string("\x00\x01\x00\x00\x08\x01\x01\x01\x01", 9));
+    seed("stem_collisions", std::string("\x02\x01\x00\x00\x08\x01\x01\x00\x0a\x01\x01\x00\x09\x00\x00\x03"
+                                        "\x00\x01\x02\x03\x04\x05\x06",
+                                        23));
+    std::string every(1, '\x07');
+    for (int i = 0; i < 8; ++i) every += std::string{'\x01', char(i), char(8 + i), char(i % 2)};
+    every += std::string{'\x01', '\x08', 0, 1, 2, 3, 4, 5, 6, 7};
+    seed("every_kind", every);
+}
+
 }  // namespace
 
 void write_text_seeds(const fs::path& root) {
@@ -84,6 +101,7 @@ void write_text_seeds(const fs::path& root) {
     intrinsics_seeds(root / "fuzz_intrinsics");
     args_seeds(root / "fuzz_args");
     py_arrays_seeds(root / "fuzz_py_arrays");
+    batch_plan_seeds(root / "fuzz_batch_plan");
 }
 
 }  // namespace pyrseg::fuzz
