@@ -132,7 +132,8 @@ void write_atomically(const std::filesystem::path& path,
 // step checked. A FIFO is opened without blocking: with no reader that is ErrorCode::io "<path>: is a FIFO with no
 // reader" at once, never a hang; with one, the bytes are written as to any pipe. The one home of this rule: the
 // library's writers and the CLI's outputs both write non-regular files through it.
-void write_in_place(const std::filesystem::path& path, const void* data, std::size_t size);
+// Exported (not installed): the pyrseg tool writes its outputs through it, also against the shared libpyrseg_io.
+PYRSEG_IO_EXPORT void write_in_place(const std::filesystem::path& path, const void* data, std::size_t size);
 
 // What a cloud writer needs of its cloud: a positive size that fits int, 3 point values per pixel, and 0 or 3
 // normal values per pixel. ErrorCode::invalid_argument naming the file otherwise.

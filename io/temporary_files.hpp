@@ -6,12 +6,15 @@
 // such a handler; the library never does.
 #include <filesystem>
 
+#include "pyrseg/io_export.hpp"
+
 namespace pyrseg::io::detail {
 
 // Registers `path` for as long as it lives (moved, the registration goes with it); it never removes the file
 // itself. Paths over 4095 bytes, or more than 64 at once, are not registered (they are then left by a signal, as
-// before).
-class RegisteredTemporary {
+// before). Exported (not installed), as the functions below: the pyrseg tool uses them, also against the shared
+// libpyrseg_io, whose own writers register in the same table.
+class PYRSEG_IO_EXPORT RegisteredTemporary {
 public:
     RegisteredTemporary() = default;
     explicit RegisteredTemporary(const std::filesystem::path& path) noexcept;
@@ -26,10 +29,10 @@ private:
 };
 
 // Removes every registered temporary file. Async-signal-safe: for a signal handler.
-void remove_registered_temporaries() noexcept;
+PYRSEG_IO_EXPORT void remove_registered_temporaries() noexcept;
 
 // Installs handlers of SIGINT, SIGTERM, SIGHUP and SIGQUIT that remove the registered temporary files and then end
 // the process by the same signal (its exit status as without the handler). For main() of a program.
-void remove_temporaries_on_termination_signals();
+PYRSEG_IO_EXPORT void remove_temporaries_on_termination_signals();
 
 }  // namespace pyrseg::io::detail
