@@ -1,3 +1,9 @@
+# Every backend pyrseg knows, in the order 'auto' prefers them: the GPU backends, then the CPU (always built). The
+# registry (backends/CMakeLists.txt), install rules and tests follow this list; list_backends() gives it at run
+# time. Adding a backend: its name here, its _pyrseg_backend line below, its block in backends/CMakeLists.txt.
+set(PYRSEG_GPU_BACKENDS cuda vulkan opencl)
+set(PYRSEG_BACKENDS ${PYRSEG_GPU_BACKENDS} cpu)
+
 # Backend options: ON (required), OFF, or AUTO (built when the toolchain is found). One line per backend at
 # configure time says what is built and why the others are not.
 set(PYRSEG_WITH_CUDA AUTO CACHE STRING "Build the CUDA backend (ON/OFF/AUTO)")
@@ -34,6 +40,8 @@ function(_pyrseg_backend name opt found toolchain implemented pending)
 endfunction()
 
 message(STATUS "pyrseg backend cpu: built (always)")
+set(PYRSEG_BUILD_cpu ON)
+set(PYRSEG_WHY_cpu "built (always)")
 
 include(CheckLanguage)
 check_language(CUDA)

@@ -23,7 +23,7 @@ install(TARGETS ${_pyrseg_exported} EXPORT pyrsegTargets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The interop headers of backends this build lacks would declare functions the library does not have.
 set(_pyrseg_header_excludes "")
-foreach(_b cuda vulkan opencl)
+foreach(_b IN LISTS PYRSEG_GPU_BACKENDS)
   if(NOT PYRSEG_BUILD_${_b})
     list(APPEND _pyrseg_header_excludes PATTERN "${_b}.hpp" EXCLUDE)
   endif()

@@ -1,6 +1,7 @@
 #include <cstdlib>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/backend_registry.hpp"
 #include "pyrseg/backend.hpp"
@@ -24,6 +25,18 @@ BackendInfo describe(const core::KnownBackend& k) {
 }
 
 }  // namespace
+
+std::vector<std::string> backend_names() {
+    std::vector<std::string> names;
+    for (const core::KnownBackend& k : core::known_backends()) names.emplace_back(k.name);
+    return names;
+}
+
+std::string backend_names_text() {
+    std::string text;
+    for (const core::KnownBackend& k : core::known_backends()) text += (text.empty() ? "" : ", ") + std::string(k.name);
+    return text;
+}
 
 std::vector<BackendInfo> list_backends() {
     std::vector<BackendInfo> all;

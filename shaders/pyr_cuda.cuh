@@ -1,23 +1,19 @@
-/* CUDA: the dialect of the entry points (shaders/pyr_entries.h). Every kernel takes the Segmenter's buffers as one
- * PyrCudaCtx by value, then one PyrArgs; the host (backends/cuda/cuda_backend.cu) launches them on its stream.
- * Compiled with --fmad=false: no float contraction anywhere. */
+/* CUDA: the dialect of the entry points (shaders/pyr_entries.h). Every kernel takes the Segmenter's buffers (the buffer
+ * table, pyr_buffers.h) as one PyrCudaCtx by value, then one PyrArgs; the host (backends/cuda/cuda_backend.cu) launches
+ * them on its stream. Compiled with --fmad=false: no float contraction anywhere. */
 #ifndef PYR_CUDA_CUH
 #define PYR_CUDA_CUH
 
 #include "pyr_kernels.h"
 
-/* The buffers in gpu::Buffer order, then the image width. */
+#define PYR_CUDA_F32 float
+#define PYR_CUDA_U32 unsigned
+#define PYR_CUDA_MASK unsigned char
+/* The buffer table's buffers (pyr_buffers.h), in its order, then the image width. */
 struct PyrCudaCtx {
-    float* points; /* depth frames write it */
-    float* normals;
-    unsigned* quant; /* two words per pixel: pyr_pack_q16(qx, qy), pyr_pack_q16(qz, valid) */
-    unsigned char* mask;
-    unsigned* labels;
-    unsigned* lut; /* then the statistics words, PYR_STATS_WORDS per slot */
-    unsigned* sums;
-    unsigned* fill; /* the fills' union-find: parents, then minima */
-    unsigned* out;
-    unsigned* texels; /* the robust normals' texels, PYR_TEXEL_WORDS per pixel */
+#define PYR_CUDA_BUFFER_MEMBER(name, index, TYPE, QUAL) PYR_CUDA_##TYPE* name;
+    PYR_BUFFER_TABLE(PYR_CUDA_BUFFER_MEMBER)
+#undef PYR_CUDA_BUFFER_MEMBER
     unsigned w;
 };
 
@@ -43,18 +39,7 @@ struct PyrArgs {
 #define PYR_STATS_ADD(w, v) pyr_cuda_atomic_add(&pyr_ctx.lut[w], (v))
 #define PYR_STATS_MAX(w, v) pyr_cuda_atomic_max(&pyr_ctx.lut[w], (v))
 
-#include "pyr_compact.h"
-#include "pyr_depth.h"
-#include "pyr_edges.h"
-#include "pyr_fill.h"
-#include "pyr_labels.h"
-#include "pyr_metric.h"
-#include "pyr_mip.h"
-#include "pyr_normals.h"
-#include "pyr_quantize.h"
-#include "pyr_robust.h"
-#include "pyr_scan.h"
-#include "pyr_stats.h"
+#include "pyr_passes.h"
 
 /* 1D kernels index over blockIdx.y * gridDim.x blocks too: a grid may hold at most 65535 blocks in y, but the
  * host keeps x below 2^31 - 1, so any frame pyrseg accepts fits. */
@@ -62,15 +47,7 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
     return (blockIdx.y * gridDim.x + blockIdx.x) * blockDim.x + threadIdx.x;
 }
 
-#define pyr_buf_points pyr_ctx.points
-#define pyr_buf_normals pyr_ctx.normals
-#define pyr_buf_quant pyr_ctx.quant
-#define pyr_buf_mask pyr_ctx.mask
-#define pyr_buf_labels pyr_ctx.labels
-#define pyr_buf_lut pyr_ctx.lut
-#define pyr_buf_sums pyr_ctx.sums
-#define pyr_buf_fill pyr_ctx.fill
-#define pyr_buf_out pyr_ctx.out
+#define PYR_BUF(name) pyr_ctx.name
 
 #define PYR_KERNEL_1D(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)
 #define PYR_KERNEL_2D(name) __global__ void pyr_k_##name(PyrCudaCtx pyr_ctx, PyrArgs pyr_args)

@@ -8,9 +8,8 @@
  *    of its body (a workgroup's shared array is declared in one or the other, by dialect), PYR_BARRIER();
  *  - PYR_ARG(k), PYR_ARG_I32(k), PYR_ARG_F32(k): word k of the dispatch's PyrArgs;
  *  - PYR_W (the image width) and PYR_ENTRY_CTX (the context an entry point passes to shared functions);
- *  - the buffers pyr_buf_quant (two words per pixel: pyr_pack_q16 of qx, qy and of qz, valid), _mask, _labels,
- *    _lut, _sums, _fill, _out; PYR_POINT(k) and PYR_NORMAL(k) (float k of the xyz arrays), PYR_STORE_NORMAL(k, v);
- *    PYR_STORE_MASK(i, v)
+ *  - PYR_BUF(name): a buffer of the buffer table (shaders/pyr_buffers.h) as an array; PYR_POINT(k) and
+ *    PYR_NORMAL(k) (float k of the xyz arrays), PYR_STORE_POINT(k, v), PYR_STORE_NORMAL(k, v), PYR_STORE_MASK(i, v)
  *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer); PYR_UF_LOAD, PYR_UF_STORE
  *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h);
  *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
@@ -49,10 +48,11 @@ PYR_KERNEL_2D(depth_points) {
     if (x >= PYR_W || y >= h) return;
     pyr_u32 i = y * PYR_W + x;
     pyr_u32 format = PYR_ARG(1);
-    pyr_u32 word = format == PYR_DEPTH_U16 ? (pyr_buf_quant[i >> 1u] >> ((i & 1u) * 16u)) & 0xffffu : pyr_buf_quant[i];
+    pyr_u32 word =
+        format == PYR_DEPTH_U16 ? (PYR_BUF(quant)[i >> 1u] >> ((i & 1u) * 16u)) & 0xffffu : PYR_BUF(quant)[i];
     pyr_u32 rays = PYR_ARG(3);
-    PyrFVec3 p = pyr_depth_point(word, format, PYR_ARG_F32(2), PYR_BITS_FLOAT(pyr_buf_sums[rays + x]),
-                                 PYR_BITS_FLOAT(pyr_buf_sums[rays + PYR_W + y]));
+    PyrFVec3 p = pyr_depth_point(word, format, PYR_ARG_F32(2), PYR_BITS_FLOAT(PYR_BUF(sums)[rays + x]),
+                                 PYR_BITS_FLOAT(PYR_BUF(sums)[rays + PYR_W + y]));
     PYR_STORE_POINT(i * 3u + 0u, p.x);
     PYR_STORE_POINT(i * 3u + 1u, p.y);
     PYR_STORE_POINT(i * 3u + 2u, p.z);
@@ -94,8 +94,8 @@ PYR_KERNEL_1D(quantize) {
     if (i >= PYR_ARG(0)) return;
     PyrQuant q = pyr_quantize(PYR_POINT(i * 3u), PYR_POINT(i * 3u + 1u), PYR_POINT(i * 3u + 2u), PYR_NORMAL(i * 3u),
                               PYR_NORMAL(i * 3u + 1u), PYR_NORMAL(i * 3u + 2u));
-    pyr_buf_quant[i * 2u + 0u] = pyr_pack_q16(q.qx, q.qy);
-    pyr_buf_quant[i * 2u + 1u] = pyr_pack_q16(q.qz, PYR_I32(q.valid));
+    PYR_BUF(quant)[i * 2u + 0u] = pyr_pack_q16(q.qx, q.qy);
+    PYR_BUF(quant)[i * 2u + 1u] = pyr_pack_q16(q.qz, PYR_I32(q.valid));
 }
 #endif
 
@@ -133,7 +133,7 @@ PYR_KERNEL_1D(bind_mask) {
     if (i >= PYR_ARG(0)) return;
     pyr_u32 packed = PYR_MASK_INPUT(i);
     PYR_STORE_MASK(PYR_ARG(1) + i, packed & 1u);
-    pyr_buf_quant[i * 2u + 1u] = pyr_pack_q16(0, PYR_I32((packed >> 1u) & 1u));
+    PYR_BUF(quant)[i * 2u + 1u] = pyr_pack_q16(0, PYR_I32((packed >> 1u) & 1u));
 }
 #endif
 
@@ -154,7 +154,8 @@ PYR_KERNEL_2D(init_labels) {
     pyr_u32 x = PYR_X;
     pyr_u32 y = PYR_Y;
     if (x >= PYR_ARG(0) || y >= PYR_ARG(1)) return;
-    pyr_buf_labels[PYR_ARG(2) + y * PYR_ARG(0) + x] =
+    PYR_BUF(labels)
+    [PYR_ARG(2) + y * PYR_ARG(0) + x] =
         pyr_label_init_texel(PYR_ENTRY_CTX, pyr_level(PYR_ARG(0), PYR_ARG(1), PYR_ARG(2)),
                              pyr_level(PYR_ARG(3), PYR_ARG(4), PYR_ARG(5)), x, y, PYR_ARG(6));
 }
@@ -166,7 +167,7 @@ PYR_KERNEL_1D(anchor) {
     pyr_u32 i = PYR_I;
     if (i >= PYR_ARG(1)) return;
     i += PYR_ARG(0);
-    PYR_STORE_MASK(i, pyr_anchor_mask(PYR_U32(pyr_buf_mask[i]), pyr_buf_labels[i], PYR_ARG(2)));
+    PYR_STORE_MASK(i, pyr_anchor_mask(PYR_U32(PYR_BUF(mask)[i]), PYR_BUF(labels)[i], PYR_ARG(2)));
 }
 #endif
 
@@ -192,7 +193,7 @@ PYR_KERNEL_GROUPS(uf_init) {
     /* Where a run starting in this chunk would start: one past its last non-eligible texel (0: none). */
     pyr_u32 start = 0u;
     for (pyr_u32 x = x0; x < x1; ++x) {
-        if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[lv.offset + row + x])) == 0u) start = x + 1u;
+        if (pyr_uf_eligible(PYR_U32(PYR_BUF(mask)[lv.offset + row + x])) == 0u) start = x + 1u;
     }
     pyr_run_start[t] = start;
     PYR_BARRIER();
@@ -205,7 +206,7 @@ PYR_KERNEL_GROUPS(uf_init) {
     start = t > 0u ? pyr_run_start[t - 1u] : 0u;
     for (pyr_u32 x = x0; x < x1; ++x) {
         pyr_u32 k = row + x;
-        if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[lv.offset + k])) == 0u) {
+        if (pyr_uf_eligible(PYR_U32(PYR_BUF(mask)[lv.offset + k])) == 0u) {
             start = x + 1u;
             PYR_UF_STORE(k, k);
         } else {
@@ -250,9 +251,9 @@ PYR_KERNEL_1D(uf_gather) {
     pyr_u32 k = PYR_I;
     if (k >= PYR_ARG(1)) return;
     pyr_u32 i = PYR_ARG(0) + k;
-    if (pyr_uf_eligible(PYR_U32(pyr_buf_mask[i])) == 0u) return;
+    if (pyr_uf_eligible(PYR_U32(PYR_BUF(mask)[i])) == 0u) return;
     pyr_u32 m = PYR_UF_LOAD(PYR_ARG(1) + PYR_UF_LOAD(k));
-    pyr_buf_labels[i] = m == PYR_UF_NONE ? 0u : m;
+    PYR_BUF(labels)[i] = m == PYR_UF_NONE ? 0u : m;
 }
 #endif
 
@@ -292,12 +293,12 @@ PYR_KERNEL_GROUPS(final_lines) {
     pyr_u32 first = PYR_SCAN_NONE;
     for (pyr_u32 k = k0; k < k1; ++k) {
         pyr_u32 i = start + k * step;
-        pyr_u32 l = pyr_buf_labels[i];
+        pyr_u32 l = PYR_BUF(labels)[i];
         if (rows != 0u) {
             l = pyr_label_init_texel(PYR_ENTRY_CTX, lv, parent, k, line, PYR_INIT_INHERIT);
-            pyr_buf_labels[i] = l;
+            PYR_BUF(labels)[i] = l;
         }
-        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
+        if (l != 0u || (PYR_U32(PYR_BUF(mask)[i]) & PYR_MASK_FILLABLE) == 0u) {
             last = l;
             if (first == PYR_SCAN_NONE) first = l;
         }
@@ -321,11 +322,11 @@ PYR_KERNEL_GROUPS(final_lines) {
     f = f == PYR_SCAN_NONE ? 0u : f;
     for (pyr_u32 k = k0; k < k1; ++k) {
         pyr_u32 i = start + k * step;
-        pyr_u32 l = pyr_buf_labels[i];
-        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
+        pyr_u32 l = PYR_BUF(labels)[i];
+        if (l != 0u || (PYR_U32(PYR_BUF(mask)[i]) & PYR_MASK_FILLABLE) == 0u) {
             f = l;
         } else if (f != 0u) {
-            pyr_buf_labels[i] = f;
+            PYR_BUF(labels)[i] = f;
         }
     }
     /* Back: what is still 0 takes B. Pixels filled just now count as events: they lie after the run's first
@@ -333,11 +334,11 @@ PYR_KERNEL_GROUPS(final_lines) {
     b = b == PYR_SCAN_NONE ? 0u : b;
     for (pyr_u32 k = k1; k > k0; --k) {
         pyr_u32 i = start + (k - 1u) * step;
-        pyr_u32 l = pyr_buf_labels[i];
-        if (l != 0u || (PYR_U32(pyr_buf_mask[i]) & PYR_MASK_FILLABLE) == 0u) {
+        pyr_u32 l = PYR_BUF(labels)[i];
+        if (l != 0u || (PYR_U32(PYR_BUF(mask)[i]) & PYR_MASK_FILLABLE) == 0u) {
             b = l;
         } else if (b != 0u) {
-            pyr_buf_labels[i] = b;
+            PYR_BUF(labels)[i] = b;
         }
     }
 }
@@ -354,8 +355,8 @@ PYR_KERNEL_2D(edges) {
     pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
     pyr_u32 round = PYR_ARG(2);
     pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, round);
-    if (l != pyr_buf_labels[i]) {
-        pyr_buf_labels[i] = l;
+    if (l != PYR_BUF(labels)[i]) {
+        PYR_BUF(labels)[i] = l;
         if (round < PYR_ARG(3)) PYR_STORE_MASK(i, PYR_MASK(i) | (round << PYR_MASK_EDGE_SHIFT));
     }
 }
@@ -367,8 +368,8 @@ PYR_KERNEL_2D(edges) {
 PYR_KERNEL_1D(lut_mark) {
     pyr_u32 i = PYR_I;
     if (i >= PYR_ARG(0)) return;
-    pyr_u32 l = pyr_buf_labels[PYR_ARG(1) + i];
-    if (l != 0u) pyr_buf_lut[l] = 1u;
+    pyr_u32 l = PYR_BUF(labels)[PYR_ARG(1) + i];
+    if (l != 0u) PYR_BUF(lut)[l] = 1u;
 }
 #endif
 
@@ -379,7 +380,7 @@ PYR_KERNEL_1D(scan_count) {
     pyr_u32 c = PYR_I;
     if (c >= PYR_ARG(2)) return;
     pyr_u32 begin = c * PYR_ARG(1);
-    pyr_buf_sums[c] = pyr_count_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)));
+    PYR_BUF(sums)[c] = pyr_count_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)));
 }
 #endif
 
@@ -388,11 +389,11 @@ PYR_KERNEL_1D(scan_sums) {
     if (PYR_I != 0u) return;
     pyr_u32 running = 0u;
     for (pyr_u32 c = 0u; c < PYR_ARG(0); ++c) {
-        pyr_u32 n = pyr_buf_sums[c];
-        pyr_buf_sums[c] = running;
+        pyr_u32 n = PYR_BUF(sums)[c];
+        PYR_BUF(sums)[c] = running;
         running += n;
     }
-    pyr_buf_sums[PYR_ARG(0)] = running;
+    PYR_BUF(sums)[PYR_ARG(0)] = running;
 }
 #endif
 
@@ -401,7 +402,7 @@ PYR_KERNEL_1D(scan_number) {
     pyr_u32 c = PYR_I;
     if (c >= PYR_ARG(2)) return;
     pyr_u32 begin = c * PYR_ARG(1);
-    pyr_number_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)), pyr_buf_sums[c]);
+    pyr_number_marks(PYR_ENTRY_CTX, begin, min(PYR_ARG(0), begin + PYR_ARG(1)), PYR_BUF(sums)[c]);
 }
 #endif
 
@@ -410,8 +411,8 @@ PYR_KERNEL_1D(scan_number) {
 PYR_KERNEL_1D(compact) {
     pyr_u32 i = PYR_I;
     if (i >= PYR_ARG(0)) return;
-    pyr_u32 raw = pyr_buf_labels[PYR_ARG(1) + i];
-    pyr_buf_out[i] = PYR_ARG(2) != 0u ? pyr_compact_label(PYR_ENTRY_CTX, raw) : raw;
+    pyr_u32 raw = PYR_BUF(labels)[PYR_ARG(1) + i];
+    PYR_BUF(out)[i] = PYR_ARG(2) != 0u ? pyr_compact_label(PYR_ENTRY_CTX, raw) : raw;
 }
 #endif
 

@@ -4,11 +4,13 @@
  *    (core/CMakeLists.txt reads the names from this table);
  *  - dims: 1, invocations over a count (PYR_I); 2, over a width x height grid (PYR_X, PYR_Y); or 3, one workgroup
  *    per index of a count (PYR_GID; PYR_LID of PYR_LSIZE invocations, at most PYR_SCAN_GROUP_MAX).
- * Every kernel takes the Segmenter's buffers (bound once) and one PyrArgs of PYR_ARG_WORDS words per dispatch;
- * the words of each are listed where it is defined, in shaders/pyr_entries.h. Adding a kernel: one line here, its
- * body there, and its dispatch in core/gpu/gpu_executor.cpp. */
+ * Every kernel takes the Segmenter's buffers (the buffer table, pyr_buffers.h; bound once) and one PyrArgs of
+ * PYR_ARG_WORDS words per dispatch; the words of each are listed where it is defined, in shaders/pyr_entries.h. Adding
+ * a kernel: one line here, its body there, and its dispatch in core/gpu/gpu_executor.cpp. */
 #ifndef PYR_KERNELS_H
 #define PYR_KERNELS_H
+
+#include "pyr_buffers.h"
 
 #define PYR_KERNEL_TABLE(K)              \
     K(depth_points, DEPTH_POINTS, 2)     \

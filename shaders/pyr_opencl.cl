@@ -1,13 +1,16 @@
 /* OpenCL C 1.2: the dialect of the entry points (shaders/pyr_entries.h). Every kernel takes the Segmenter's buffers
- * and the image width first (PYR_CTX_PARAM, set once per Segmenter by the host), then one PyrArgs by value. */
-#define PYR_CTX_PARAM                                                                                              \
-    __global float *pyr_buf_points, __global float *pyr_buf_normals, __global uint *pyr_buf_quant,          \
-        __global uchar *pyr_buf_mask, __global uint *pyr_buf_labels, __global uint *pyr_buf_lut,                 \
-        __global uint *pyr_buf_sums, __global uint *pyr_buf_fill, __global uint *pyr_buf_out,                    \
-        __global uint *pyr_buf_texels, uint pyr_w
-#define PYR_CTX_ARG                                                                                               \
-    pyr_buf_points, pyr_buf_normals, pyr_buf_quant, pyr_buf_mask, pyr_buf_labels, pyr_buf_lut, pyr_buf_sums,     \
-        pyr_buf_fill, pyr_buf_out, pyr_buf_texels, pyr_w
+ * (the buffer table, pyr_buffers.h) and the image width first (PYR_CTX_PARAM, set once per Segmenter by the host),
+ * then one PyrArgs by value. */
+#include "pyr_kernels.h"
+
+#define PYR_CL_F32 float
+#define PYR_CL_U32 uint
+#define PYR_CL_MASK uchar
+#define PYR_CL_BUFFER_PARAM(name, index, TYPE, QUAL) __global PYR_CL_##TYPE *pyr_buf_##name,
+#define PYR_CL_BUFFER_ARG(name, index, TYPE, QUAL) pyr_buf_##name,
+#define PYR_CTX_PARAM PYR_BUFFER_TABLE(PYR_CL_BUFFER_PARAM) uint pyr_w
+#define PYR_CTX_ARG PYR_BUFFER_TABLE(PYR_CL_BUFFER_ARG) pyr_w
+#define PYR_BUF(name) pyr_buf_##name
 #define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
 #define PYR_TEXEL_WORD(i) pyr_buf_texels[i]
 #define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_texels[i] = (v))
@@ -24,19 +27,7 @@
 #define PYR_STATS_ADD(w, v) atomic_add(&pyr_buf_lut[w], (v))
 #define PYR_STATS_MAX(w, v) atomic_max(&pyr_buf_lut[w], (v))
 
-#include "pyr_compact.h"
-#include "pyr_depth.h"
-#include "pyr_edges.h"
-#include "pyr_fill.h"
-#include "pyr_kernels.h"
-#include "pyr_labels.h"
-#include "pyr_metric.h"
-#include "pyr_mip.h"
-#include "pyr_normals.h"
-#include "pyr_quantize.h"
-#include "pyr_robust.h"
-#include "pyr_scan.h"
-#include "pyr_stats.h"
+#include "pyr_passes.h"
 
 typedef struct PyrArgs {
     uint a[PYR_ARG_WORDS];

@@ -99,6 +99,7 @@ static inline unsigned int pyr_cuda_host_atomic_min(unsigned int* p, unsigned in
 #endif
 
 #else /* C++ (CPU backend, host code) */
+#define PYR_CPP 1
 #include <bit>
 #include <cmath>
 #include <cstdint>

@@ -59,7 +59,7 @@ constexpr const char* kSegmentUsage =
     "  --pcl-png OUT.png     PCL's organized segmentation of the same frame in colour, to compare (builds with\n"
     "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
     "                        PCL's defaults\n"
-    "  --backend NAME        cpu, cuda, vulkan, opencl or auto (default: $PYRSEG_BACKEND, else auto)\n"
+    "  --backend NAME        @BACKENDS@ or auto (default: $PYRSEG_BACKEND, else auto)\n"
     "  --quiet, -q           nothing on stderr but warnings and errors (no backend line, notes, hints or progress\n"
     "                        unless --progress is given); stdout still has the results: the frame's line, a batch's\n"
     "                        summary (redirect it to drop them)\n"
@@ -533,7 +533,9 @@ int cmd_segment(const std::vector<std::string>& argv) {
     flags.insert({"help", "quiet", "verbose"});
     const Args args(argv, values, flags, {{"-q", "quiet"}, {"-v", "verbose"}});
     if (args.flag("help")) {
-        std::printf("%s%s%s", kSegmentUsage, kInputHelp, kParameterHelp);
+        std::string usage = kSegmentUsage;
+        usage.replace(usage.find("@BACKENDS@"), 10, backend_names_text());
+        std::printf("%s%s%s", usage.c_str(), kInputHelp, kParameterHelp);
         return 0;
     }
     // Every option is checked before the first input is read: a mistake costs a message, not a partial run.

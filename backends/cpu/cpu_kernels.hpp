@@ -99,15 +99,5 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_STATS_MAX(w, v) ::pyrseg::cpu::atomic_max(ctx.stats[w], (v))
 
 namespace pyrseg::cpu::kernels {
-#include "shaders/pyr_compact.h"
-#include "shaders/pyr_depth.h"
-#include "shaders/pyr_edges.h"
-#include "shaders/pyr_fill.h"
-#include "shaders/pyr_labels.h"
-#include "shaders/pyr_metric.h"
-#include "shaders/pyr_mip.h"
-#include "shaders/pyr_normals.h"
-#include "shaders/pyr_quantize.h"
-#include "shaders/pyr_robust.h"
-#include "shaders/pyr_stats.h"
+#include "shaders/pyr_passes.h"
 }  // namespace pyrseg::cpu::kernels

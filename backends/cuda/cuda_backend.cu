@@ -201,17 +201,10 @@ public:
         staging_.reset(upload_.as<unsigned char>(), upload_.bytes(), download_.as<unsigned char>(), download_.bytes());
         // The ray tables, the only inline uploads, live in the sums buffer: no allocation when they change.
         inline_.reserve(std::max<size_t>(sizes[size_t(gpu::Buffer::sums)], size_t(64) << 10));
-        ctx_ = PyrCudaCtx{buffer<float>(gpu::Buffer::points),
-                          buffer<float>(gpu::Buffer::normals),
-                          buffer<unsigned>(gpu::Buffer::quant),
-                          buffer<unsigned char>(gpu::Buffer::mask),
-                          buffer<unsigned>(gpu::Buffer::labels),
-                          buffer<unsigned>(gpu::Buffer::lut),
-                          buffer<unsigned>(gpu::Buffer::sums),
-                          buffer<unsigned>(gpu::Buffer::fill),
-                          buffer<unsigned>(gpu::Buffer::out),
-                          buffer<unsigned>(gpu::Buffer::texels),
-                          image_width};
+#define PYR_CUDA_BUFFER_POINTER(name, index, TYPE, QUAL) ctx_.name = buffer<PYR_CUDA_##TYPE>(gpu::Buffer::name);
+        PYR_BUFFER_TABLE(PYR_CUDA_BUFFER_POINTER)
+#undef PYR_CUDA_BUFFER_POINTER
+        ctx_.w = image_width;
     }
 
     void upload(gpu::Buffer b, size_t offset, const void* src, size_t bytes) override {

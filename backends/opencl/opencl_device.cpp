@@ -20,8 +20,8 @@ namespace {
 using std::size_t;
 using std::uint32_t;
 
-constexpr cl_uint kContextArgs = 11;  // PYR_CTX_PARAM in shaders/pyr_opencl.cl: the buffers, then the width
-static_assert(kContextArgs == gpu::kBufferCount + 1);
+// PYR_CTX_PARAM in shaders/pyr_opencl.cl: the buffer table's buffers, then the width; the PyrArgs follow.
+constexpr cl_uint kContextArgs = gpu::kBufferCount + 1;
 
 size_t round_up(size_t v, size_t m) {
     return (v + m - 1) / m * m;

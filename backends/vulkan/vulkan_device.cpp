@@ -89,7 +89,8 @@ void VulkanDevice::allocate(const gpu::BufferSizes& sizes, uint32_t image_width)
         const std::string what = std::string("the ") + gpu::buffer_name(gpu::Buffer(b)) + " buffer";
         buffers_[b] = VulkanBuffer(*rt_, sizes[b], VulkanBuffer::Memory::device, what.c_str());
     }
-    // Points and normals (same size) beyond one binding's range continue in bindings 10 and 11.
+    // Points and normals (same size) beyond one binding's range continue in the two bindings after the buffer table's
+    // (vulkan_runtime.hpp).
     const VkDeviceSize xyz = sizes[size_t(gpu::Buffer::points)];
     split_bytes_ = xyz <= rt_->properties.limits.maxStorageBufferRange ? xyz : aligned_range();
     const gpu::StagingBytes staging = gpu::staging_bytes(sizes);

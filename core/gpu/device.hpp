@@ -33,10 +33,20 @@ struct Args {
     std::array<std::uint32_t, PYR_ARG_WORDS> words{};
 };
 
-// The buffers every GPU backend binds, in this order (OpenCL's kernel arguments, Vulkan's bindings, CUDA's
-// context). Sizes come from the plan (gpu::buffer_sizes); the mask holds mask_texel_bytes per texel.
-enum class Buffer : std::uint32_t { points, normals, quant, mask, labels, lut, sums, fill, out, texels, count };
+// The buffer table (shaders/pyr_buffers.h) as host ids, in binding order. Sizes come from the plan
+// (gpu::buffer_sizes); the mask holds mask_texel_bytes per texel.
+enum class Buffer : std::uint32_t {
+#define PYR_HOST_BUFFER_ID(name, index, TYPE, QUAL) name,
+    PYR_BUFFER_TABLE(PYR_HOST_BUFFER_ID)
+#undef PYR_HOST_BUFFER_ID
+        count
+};
 inline constexpr std::size_t kBufferCount = std::size_t(Buffer::count);
+#define PYR_HOST_BUFFER_INDEX(name, index, TYPE, QUAL) \
+    static_assert(std::uint32_t(Buffer::name) == (index), "shaders/pyr_buffers.h: " #name "'s index");
+PYR_BUFFER_TABLE(PYR_HOST_BUFFER_INDEX)
+#undef PYR_HOST_BUFFER_INDEX
+static_assert(kBufferCount == PYR_BUFFER_COUNT, "shaders/pyr_buffers.h: PYR_BUFFER_COUNT");
 [[nodiscard]] const char* buffer_name(Buffer b);
 using BufferSizes = std::array<std::size_t, kBufferCount>;  // bytes
 

@@ -37,8 +37,11 @@ constexpr KernelInfo kKernels[] = {
 };
 static_assert(std::size(kKernels) == kKernelCount);
 
-constexpr const char* kBufferNames[] = {"points", "normals", "quant", "mask", "labels",
-                                        "lut",    "sums",    "fill",  "out",  "texels"};
+constexpr const char* kBufferNames[] = {
+#define PYR_HOST_BUFFER_NAME(name, index, TYPE, QUAL) #name,
+    PYR_BUFFER_TABLE(PYR_HOST_BUFFER_NAME)
+#undef PYR_HOST_BUFFER_NAME
+};
 static_assert(std::size(kBufferNames) == kBufferCount);
 
 Args args(std::initializer_list<uint32_t> words) {
@@ -380,25 +383,46 @@ const char* buffer_name(Buffer b) {
     return kBufferNames[size_t(b)];
 }
 
-BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
+namespace {
+// A switch without a default, so that a buffer added to the table without a size does not build (-Wswitch).
+size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits) {
     const size_t px = plan.pixel_count();
     const size_t texels = size_t(plan.total_texels);
+    switch (b) {
+        case Buffer::points:  // also a mask frame's input words (4 per pixel)
+        case Buffer::normals:
+            return 12 * px;
+        case Buffer::quant:
+            return 8 * px;  // two words per pixel (shaders/pyr_types.h: pyr_pack_q16)
+        case Buffer::mask:
+            return limits.mask_texel_bytes * texels;
+        case Buffer::labels:
+            return 4 * texels;
+        case Buffer::lut:
+            return 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
+        case Buffer::sums:
+            // The scan's chunk sums, K, then the depth frames' ray slopes (W + H floats).
+            return 4 * (size_t(plan.scan_chunks()) + 1 + size_t(plan.width) + size_t(plan.height));
+        case Buffer::fill: {
+            // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
+            const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
+            return size_t(8) * fill_level.width * fill_level.height;
+        }
+        case Buffer::out:
+            return 4 * px;
+        case Buffer::texels:
+            // The robust normals' texels (shaders/pyr_robust.h), only for the robust metric.
+            return plan.params.metric == Metric::robust ? 4 * size_t(PYR_TEXEL_WORDS) * px : 0;
+        case Buffer::count:
+            break;
+    }
+    throw Error(ErrorCode::internal, "no size for GPU buffer " + std::to_string(uint32_t(b)));
+}
+}  // namespace
+
+BufferSizes buffer_sizes(const core::Plan& plan, const DeviceLimits& limits) {
     BufferSizes s{};
-    s[size_t(Buffer::points)] = 12 * px;  // also a mask frame's input words (4 per pixel)
-    s[size_t(Buffer::normals)] = 12 * px;
-    s[size_t(Buffer::quant)] = 8 * px;  // two words per pixel (shaders/pyr_types.h: pyr_pack_q16)
-    s[size_t(Buffer::mask)] = limits.mask_texel_bytes * texels;
-    s[size_t(Buffer::labels)] = 4 * texels;
-    s[size_t(Buffer::lut)] = 4 * (size_t(plan.lut_size()) + plan.stats_words());  // then the statistics words
-    // The scan's chunk sums, K, then the depth frames' ray slopes (W + H floats).
-    s[size_t(Buffer::sums)] = 4 * (size_t(plan.scan_chunks()) + 1 + size_t(plan.width) + size_t(plan.height));
-    // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
-    const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
-    s[size_t(Buffer::fill)] = size_t(8) * fill_level.width * fill_level.height;
-    s[size_t(Buffer::out)] = 4 * px;
-    // The robust normals' texels (shaders/pyr_robust.h), only for the robust metric.
-    s[size_t(Buffer::texels)] = plan.params.metric == Metric::robust ? 4 * size_t(PYR_TEXEL_WORDS) * px : 0;
-    for (size_t& bytes : s) bytes = std::max<size_t>(bytes, 4);
+    for (size_t b = 0; b < kBufferCount; ++b) s[b] = std::max<size_t>(buffer_bytes(Buffer(b), plan, limits), 4);
     return s;
 }
 

@@ -9,7 +9,7 @@
 namespace pyrseg {
 
 struct BackendInfo {
-    std::string name;                  // "cpu", "cuda", "vulkan", "opencl"
+    std::string name;                  // one of backend_names()
     bool available = false;            // can run on this machine now
     std::string reason;                // why not, when unavailable
     std::vector<std::string> devices;  // human-readable device descriptions when available
@@ -19,7 +19,12 @@ struct BackendInfo {
     std::string emulated_device;  // that device, when emulated
 };
 
-// Every backend pyrseg knows, in preference order: GPUs first, the CPU last.
+// Every backend pyrseg knows, in preference order: GPUs first, the CPU last; built or not, and probing no device.
+[[nodiscard]] PYRSEG_EXPORT std::vector<std::string> backend_names();
+// The same as one line for help texts: "cuda, vulkan, opencl, cpu".
+[[nodiscard]] PYRSEG_EXPORT std::string backend_names_text();
+
+// Every backend pyrseg knows (backend_names()), with whether it can run here, why not, and its devices.
 [[nodiscard]] PYRSEG_EXPORT std::vector<BackendInfo> list_backends();
 
 // The backend a request resolves to, and why, in one sentence for users ("auto: vulkan's device llvmpipe ... is a

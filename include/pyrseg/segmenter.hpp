@@ -27,7 +27,7 @@ struct PassTiming {
 
 class PYRSEG_EXPORT Segmenter {
 public:
-    // backend: "cpu", "cuda", "vulkan", "opencl", "auto", or empty for $PYRSEG_BACKEND (else "auto").
+    // backend: one of backend_names() (pyrseg/backend.hpp), "auto", or empty for $PYRSEG_BACKEND (else "auto").
     // Throws pyrseg::Error for invalid parameters, sizes that do not fit, or an unavailable backend.
     Segmenter(int width, int height, const Params& params = {}, std::string_view backend = {},
               const Outputs& outputs = {});

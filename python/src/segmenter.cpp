@@ -470,11 +470,13 @@ void bind_segmenter(py::module_& m) {
         py::arg("module") = module_name));
     m.attr("BackendInfo") = obj(cached.backend_type);
 
-    py::class_<PySegmenter> segmenter(m, "Segmenter", kLocal, R"(A segmenter for one backend and one frame size.
+    // The backend names come from the build's list; pybind11 keeps the pointer, so the text lives as long as the
+    // module.
+    static std::string segmenter_doc = R"(A segmenter for one backend and one frame size.
 
 Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, **params)
 
-backend: "cpu", "cuda", "vulkan", "opencl", "auto", or None for $PYRSEG_BACKEND (else "auto").
+backend: @BACKENDS@"auto", or None for $PYRSEG_BACKEND (else "auto").
 preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it.
 params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2 (docs/algorithm.md).
@@ -483,7 +485,11 @@ cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int c
 stream; None is the legacy default stream.
 
 Every argument of the wrong type is a TypeError naming it; a Segmenter made by Segmenter.__new__ alone raises
-TypeError from every member, and a second __init__ on a Segmenter raises TypeError (make a new one).)");
+TypeError from every member, and a second __init__ on a Segmenter raises TypeError (make a new one).)";
+    std::string quoted_names;
+    for (const std::string& name : backend_names()) quoted_names += "\"" + name + "\", ";
+    segmenter_doc.replace(segmenter_doc.find("@BACKENDS@"), 10, quoted_names);
+    py::class_<PySegmenter> segmenter(m, "Segmenter", kLocal, segmenter_doc.c_str());
     segmenter.def(py::init<const py::object&, const py::object&, const py::object&, const py::kwargs&>(),
                   py::arg("width"), py::arg("height"), py::arg("backend") = py::none());
     def_args(segmenter, "segment", kSegment,

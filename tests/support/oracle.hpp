@@ -125,7 +125,7 @@ inline bool skip_unavailable(const std::string& backend, std::string* reason) {
     } while (0)
 
 inline const std::vector<std::string>& all_backend_names() {
-    static const std::vector<std::string> names = {"cpu", "opencl", "vulkan", "cuda"};
+    static const std::vector<std::string> names = backend_names();
     return names;
 }
 

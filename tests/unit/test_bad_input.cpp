@@ -12,6 +12,7 @@
 
 #include <unistd.h>
 
+#include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
 
@@ -219,7 +220,7 @@ TEST(BadInput, TheCallersBuffersAreNotModified) {
 TEST(BadInput, UnknownAndUnavailableBackendsAreErrors) {
     expect_error(ErrorCode::backend_unavailable, "unknown backend 'nope'", [] { Segmenter(8, 8, {}, "nope"); });
     // A backend this build lacks names the reason (the configure-time one).
-    for (const char* name : {"cuda", "vulkan", "opencl"}) {
+    for (const std::string& name : backend_names()) {
         try {
             Segmenter s(16, 16, {}, name);
         } catch (const Error& e) {
