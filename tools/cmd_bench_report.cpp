@@ -173,12 +173,13 @@ std::string backend_of(const std::string& name) {
     return {};
 }
 
-// Every backend the rows name: the known ones in the order of the tables so far (the CPU, the native backend, first),
-// then any other in alphabetical order, so that a new backend gets its columns without a change here.
+// Every backend that ran a row (one that only skipped, for want of its device, is in the list of skips): the known
+// ones in the order of the tables so far (the CPU, the native backend, first), then any other in alphabetical order,
+// so that a new backend gets its columns without a change here.
 std::vector<std::string> backends_in(const Entries& entries) {
     std::set<std::string> named;
     for (const auto& [name, e] : entries) {
-        if (std::string b = backend_of(name); !b.empty()) named.insert(b);
+        if (std::string b = backend_of(name); !b.empty() && e.error.empty()) named.insert(b);
     }
     std::vector<std::string> out;
     for (const char* b : {"cpu", "cuda", "opencl", "vulkan"}) {
@@ -232,8 +233,8 @@ std::string machine(const nlohmann::json& doc) {
     if (!before.empty()) {
         s << "Load average (1, 5, 15 min) at the start: " << before;
         if (!after.empty()) s << "; at the end: " << after;
-        s << (busy ? ". **The machine was not idle**: absolute times are longer than a quiet machine's, ratios of "
-                     "runs side by side less so.\n\n"
+        s << (busy ? ". **The machine was not idle** (load 0.5 or more): times are longer than a quiet machine's and "
+                     "vary more, and so do the ratios of rows measured at different moments.\n\n"
                    : ".\n\n");
     }
     for (const auto& [key, value] : c.items()) {
