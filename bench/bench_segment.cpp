@@ -101,7 +101,7 @@ int register_all() {
                     ->UseRealTime();
                 // The same surface neighbourhood as the default radius on the PhoXi frame: at 4128x3088 (half the
                 // pixel spacing, the same 0.1 mm noise) radius 2 sees noise that fragments the mask
-                // (docs/performance.md, "Time per pixel"), so the frame size alone is compared on this row.
+                // (docs/performance-history.md, "Time per pixel"), so the frame size alone is compared on this row.
                 if (const int same_footprint = int(std::lround(kDefaultNormalRadius * double(w) / 2064.0));
                     !given && same_footprint > kDefaultNormalRadius) {
                     Params wider;

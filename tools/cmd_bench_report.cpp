@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -24,18 +25,25 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kUsage =
-    "Usage: pyrseg bench-report BENCH.json [--out-dir DIR]\n"
+    "Usage: pyrseg bench-report BENCH.json [--out-dir DIR | --update DOC.md | --check DOC.md]\n"
     "\n"
     "Reads the JSON that `pyrseg_bench --benchmark_format=json --benchmark_out=BENCH.json` writes and writes\n"
     "DIR/performance.md (default DIR: the JSON's folder) with, per frame size:\n"
+    "  - in short, per backend, the range of its ratios to PCL and to OpenCV over the frame sizes;\n"
     "  - the whole pipeline (points to labels) per backend, in ms and in multiples of a memcpy of the input bytes,\n"
     "    and PCL's organized segmentation (its own integral-image normals) divided by pyrseg's time;\n"
     "  - the segmentation stage (fillable mask to compacted labels) per backend, and OpenCV's connectedComponents\n"
     "    (SAUF, Spaghetti; 4- and 8-connected) of the same mask: pyrseg's time divided by OpenCV's;\n"
-    "  - the fills' worst cases (spiral, maze) with each GPU backend's dispatches and host waits per frame;\n"
-    "  - the per-pass times of the full-size frame;\n"
-    "and two plots, DIR/bench_vs_pcl.png and DIR/bench_vs_opencv.png. Ratios come from one run on one machine;\n"
-    "the report starts with that machine's description.\n"
+    "  - depth images, the robust metric, the fills' worst cases and the per-pass times of the full-size frame;\n"
+    "and two plots, DIR/bench_vs_pcl.png and DIR/bench_vs_opencv.png. Every backend the JSON's rows name gets its\n"
+    "columns. Ratios come from one run on one machine; the report starts with that machine's description and its\n"
+    "load.\n"
+    "\n"
+    "  --update DOC.md  the same report as a section of DOC.md: replaces what lies between its lines\n"
+    "                   <!-- bench-report:begin ... --> and <!-- bench-report:end -->, links BENCH.json relative to\n"
+    "                   DOC.md and writes the plots to DOC.md's images/ folder (docs/performance.md: the ctest\n"
+    "                   docs_performance_tables checks it with --check)\n"
+    "  --check DOC.md   writes nothing; fails (status 1) when DOC.md's section is not what --update would write\n"
     "The whole run is scripts/bench.sh.\n";
 
 struct Entry {
@@ -154,16 +162,30 @@ std::vector<Size> frame_sizes(const Entries& entries) {
     return sizes;
 }
 
+// The backend a benchmark name is about: pipeline*/<backend>/..., stage/<backend>/..., fills/<case>/<backend>/...;
+// empty for the peers and memcpy.
+std::string backend_of(const std::string& name) {
+    std::vector<std::string> parts;
+    std::stringstream in(name);
+    for (std::string part; std::getline(in, part, '/');) parts.push_back(part);
+    if (parts.size() >= 3 && (parts[0].rfind("pipeline", 0) == 0 || parts[0] == "stage")) return parts[1];
+    if (parts.size() >= 4 && parts[0] == "fills") return parts[2];
+    return {};
+}
+
+// Every backend that ran a row (one that only skipped, for want of its device, is in the list of skips): the known
+// ones in the order of the tables so far (the CPU, the native backend, first), then any other in alphabetical order,
+// so that a new backend gets its columns without a change here.
 std::vector<std::string> backends_in(const Entries& entries) {
+    std::set<std::string> named;
+    for (const auto& [name, e] : entries) {
+        if (std::string b = backend_of(name); !b.empty() && e.error.empty()) named.insert(b);
+    }
     std::vector<std::string> out;
     for (const char* b : {"cpu", "cuda", "opencl", "vulkan"}) {
-        for (const auto& [name, e] : entries) {
-            if (name.rfind(std::string("pipeline/") + b + "/", 0) == 0) {
-                out.emplace_back(b);
-                break;
-            }
-        }
+        if (named.erase(b) != 0) out.emplace_back(b);
     }
+    out.insert(out.end(), named.begin(), named.end());
     return out;
 }
 
@@ -192,10 +214,29 @@ std::string header(const std::vector<std::string>& cells) {
 std::string machine(const nlohmann::json& doc) {
     const nlohmann::json& c = doc.value("context", nlohmann::json::object());
     std::ostringstream s;
+    bool busy = false;
     s << "Machine: " << c.value("host_name", std::string("?")) << ", " << c.value("num_cpus", 0) << " CPUs at "
       << c.value("mhz_per_cpu", 0) << " MHz, run " << c.value("date", std::string("?"))
       << " (Google Benchmark's own library is a " << c.value("library_build_type", std::string("?"))
       << " build: Debian's package).\n\n";
+    // Google Benchmark's load averages when the run started; scripts/bench.sh adds them at its end.
+    const auto load = [&](const char* key) -> std::string {
+        const nlohmann::json& l = c.value(key, nlohmann::json::array());
+        if (!l.is_array() || l.empty() || !l[0].is_number()) return {};
+        std::string text;
+        for (const nlohmann::json& v : l) text += (text.empty() ? "" : ", ") + fixed(v.get<double>(), 2);
+        busy = busy || l[0].get<double>() >= 0.5;
+        return text;
+    };
+    const std::string before = load("load_avg");
+    const std::string after = load("load_avg_after");
+    if (!before.empty()) {
+        s << "Load average (1, 5, 15 min) at the start: " << before;
+        if (!after.empty()) s << "; at the end: " << after;
+        s << (busy ? ". **The machine was not idle** (load 0.5 or more): times are longer than a quiet machine's and "
+                     "vary more, and so do the ratios of rows measured at different moments.\n\n"
+                   : ".\n\n");
+    }
     for (const auto& [key, value] : c.items()) {
         if (key.rfind("backend ", 0) == 0 || key == "opencv" || key == "pcl" || key == "peers not built")
             s << "- " << key << ": " << (value.is_string() ? value.get<std::string>() : value.dump()) << "\n";
@@ -235,7 +276,8 @@ void fit_y(LineChart& chart) {
     for (double t = 0; t <= chart.y_max + 1e-9; t += step) chart.y_ticks.push_back(t);
 }
 
-Report build_report(const nlohmann::json& doc, const std::string& source) {
+// source: how the report names the JSON (markdown); images: the plots' folder as the report links them.
+Report build_report(const nlohmann::json& doc, const std::string& source, const std::string& images) {
     const Entries entries = read_entries(doc);
     const std::vector<Size> sizes = frame_sizes(entries);
     const std::vector<std::string> backends = backends_in(entries);
@@ -244,7 +286,41 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     }
     Report r;
     std::string& md = r.markdown;
-    md += "# pyrseg benchmark report\n\nFrom `" + source + "`. " + machine(doc);
+    md += "# pyrseg benchmark report\n\nFrom " + source + ". " + machine(doc);
+
+    // In short: each ratio's range over the frame sizes, per backend.
+    const auto range = [&](const std::function<double(const Size&)>& of) {
+        double lo = std::numeric_limits<double>::infinity();
+        double hi = -lo;
+        for (const Size& s : sizes) {
+            const double v = of(s);
+            if (!std::isfinite(v)) continue;
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+        if (!std::isfinite(lo)) return std::string("—");
+        return lo == hi ? ratio_cell(lo) : ratio_cell(lo) + " to " + ratio_cell(hi);
+    };
+    md += "## In short\n\nEach ratio's range over the frame sizes below (" + sizes.front().name + " to " +
+          sizes.back().name +
+          "). PCL ÷ pyrseg: above 1, pyrseg is faster; pyrseg ÷ OpenCV: below 1, pyrseg is faster.\n\n";
+    md += header({"backend", "PCL ÷ pyrseg, each estimating its normals", "PCL's labelling ÷ pyrseg, the same normals",
+                  "pyrseg's stage ÷ OpenCV SAUF-4, the same mask"});
+    for (const std::string& b : backends) {
+        md += table_row({b, range([&](const Size& s) {
+                             return ratio(find(entries, "pcl/organized_edge_aware/" + s.name + "/estimated_normals"),
+                                          find(entries, pipeline_name(b, s.name, "estimated_normals")));
+                         }),
+                         range([&](const Size& s) {
+                             return ratio(find(entries, "pcl/organized_edge_aware/" + s.name + "/given_normals"),
+                                          find(entries, pipeline_name(b, s.name, "given_normals")));
+                         }),
+                         range([&](const Size& s) {
+                             return ratio(find(entries, "stage/" + b + "/" + s.name),
+                                          find(entries, "opencv/sauf_4/" + s.name));
+                         })});
+    }
+    md += "\n";
 
     // Whole pipeline, per normals source. PCL's pipeline estimates its own normals (integral images); with the
     // scene's normals it runs only its labelling, which compares with pyrseg given the same normals.
@@ -477,19 +553,60 @@ Report build_report(const nlohmann::json& doc, const std::string& source) {
     r.vs_opencv.panels.push_back(cv_panel);
     fit_y(r.vs_pcl);
     fit_y(r.vs_opencv);
-    md += "![PCL / pyrseg](bench_vs_pcl.png)\n\n![pyrseg / OpenCV](bench_vs_opencv.png)\n";
+    md += "![PCL / pyrseg](" + images + "bench_vs_pcl.png)\n\n![pyrseg / OpenCV](" + images + "bench_vs_opencv.png)\n";
     return r;
+}
+
+constexpr const char* kBegin = "<!-- bench-report:begin";
+constexpr const char* kEnd = "<!-- bench-report:end -->";
+
+// The report as a section of another document: its headings one level down and no title of its own.
+std::string as_section(const std::string& report) {
+    std::string out;
+    std::stringstream in(report);
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("# ", 0) == 0) {
+            std::getline(in, line);  // the title and the empty line after it
+            continue;
+        }
+        if (line.rfind("## ", 0) == 0) line.insert(0, "#");
+        out += line + "\n";
+    }
+    return out;
+}
+
+// DOC's text with the section between the markers replaced; throws when the markers are not there once each.
+std::string replaced(const std::string& doc, const fs::path& path, const std::string& section) {
+    const auto begin = doc.find(kBegin);
+    const auto end = doc.find(kEnd);
+    if (begin == std::string::npos || end == std::string::npos || end < begin ||
+        doc.find(kBegin, begin + 1) != std::string::npos || doc.find(kEnd, end + 1) != std::string::npos) {
+        throw Error(ErrorCode::format, path.string() + ": needs one line " + kBegin + " ... --> and one line " + kEnd +
+                                           " after it, around the section bench-report writes");
+    }
+    const auto body = doc.find('\n', begin);
+    return doc.substr(0, body + 1) + "\n" + section + "\n" + doc.substr(end);
+}
+
+std::string read_text(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(ErrorCode::io, path.string() + ": cannot open");
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
 
 int cmd_bench_report(const std::vector<std::string>& argv) {
-    const Args args(argv, {"out-dir"}, {"help"});
+    const Args args(argv, {"out-dir", "update", "check"}, {"help"});
     if (args.flag("help")) {
         std::fputs(kUsage, stdout);
         return 0;
     }
     if (args.positional().size() != 1) throw UsageError{"expects one BENCH.json"};
+    const std::optional<std::string> update = args.value("update");
+    const std::optional<std::string> check = args.value("check");
+    if (int(update.has_value()) + int(check.has_value()) + int(args.value("out-dir").has_value()) > 1)
+        throw UsageError{"--update, --check and --out-dir exclude each other"};
     const fs::path input = args.positional()[0];
     std::ifstream in(input);
     if (!in) throw Error(ErrorCode::io, input.string() + ": cannot open");
@@ -499,11 +616,44 @@ int cmd_bench_report(const std::vector<std::string>& argv) {
     } catch (const nlohmann::json::exception& e) {
         throw Error(ErrorCode::format, input.string() + ": not JSON: " + e.what());
     }
+    const std::optional<fs::path> target = update ? update : check;
+    // In a document, the JSON is a link relative to it and the plots are in its images/ folder.
+    std::string source = "`" + input.filename().string() + "`";
+    if (target) {
+        const fs::path rel = fs::relative(input, fs::absolute(*target).parent_path());
+        source = "[" + rel.generic_string() + "](" + rel.generic_string() + ")";
+    }
     Report report;
     try {
-        report = build_report(doc, input.filename().string());
+        report = build_report(doc, source, target ? "images/" : "");
     } catch (const nlohmann::json::exception& e) {
         throw Error(ErrorCode::format, input.string() + ": not Google Benchmark JSON: " + e.what());
+    }
+    if (target) {
+        const std::string old_text = read_text(*target);
+        const std::string new_text = replaced(old_text, *target, as_section(report.markdown));
+        if (check) {
+            if (new_text == old_text) {
+                std::printf("%s: its bench-report section is what %s gives\n", target->string().c_str(),
+                            input.string().c_str());
+                return 0;
+            }
+            std::fprintf(stderr,
+                         "%s: its bench-report section differs from what %s gives (edited by hand, or the report "
+                         "changed); regenerate it: pyrseg bench-report %s --update %s\n",
+                         target->string().c_str(), input.string().c_str(), input.string().c_str(),
+                         target->string().c_str());
+            return 1;
+        }
+        write_text_file(*target, new_text);
+        const fs::path images = target->parent_path() / "images";
+        std::error_code ec;
+        fs::create_directories(images, ec);
+        write_png((images / "bench_vs_pcl.png").string(), render_line_chart(report.vs_pcl));
+        write_png((images / "bench_vs_opencv.png").string(), render_line_chart(report.vs_opencv));
+        std::printf("updated %s's bench-report section, %s and bench_vs_opencv.png\n", target->string().c_str(),
+                    (images / "bench_vs_pcl.png").string().c_str());
+        return 0;
     }
     const fs::path out_dir =
         args.value("out-dir").value_or(input.parent_path().empty() ? fs::path(".") : input.parent_path());

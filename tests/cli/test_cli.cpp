@@ -582,6 +582,94 @@ TEST(Cli, BenchReportWritesRatiosAndPlots) {
     fs::remove_all(dir);
 }
 
+namespace {
+
+nlohmann::json bench_entry(const std::string& name, double ms) {
+    return nlohmann::json{{"name", name + "/real_time"}, {"real_time", ms}, {"time_unit", "ms"}};
+}
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+// Every backend the rows name gets its columns, a name bench-report has never heard of too (it once knew four and
+// dropped the rows of any other without a word).
+TEST(Cli, BenchReportFollowsTheBackendsTheRowsName) {
+    const fs::path dir = temp_dir();
+    nlohmann::json doc;
+    doc["context"] = {{"host_name", "testhost"}, {"backend metal", "available"}};
+    doc["benchmarks"] = {bench_entry("memcpy/640x480/estimated_normals", 0.1),
+                         bench_entry("memcpy/640x480/mask", 0.01),
+                         bench_entry("pipeline/cpu/640x480/estimated_normals", 10.0),
+                         bench_entry("pipeline/metal/640x480/estimated_normals", 4.0),
+                         bench_entry("pcl/organized_edge_aware/640x480/estimated_normals", 150.0),
+                         bench_entry("stage/metal/640x480", 0.25),
+                         bench_entry("opencv/sauf_4/640x480", 0.5),
+                         bench_entry("fills/maze/metal/640x480", 7.0)};
+    std::ofstream(dir / "bench.json") << doc.dump();
+    const CliRun r = run("bench-report " + (dir / "bench.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string md = read_file(dir / "performance.md");
+    EXPECT_NE(md.find("| frame | memcpy | cpu | metal | fill rounds | PCL | PCL ÷ cpu | PCL ÷ metal |"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| 640x480 | 0.100 ms | 10.0 ms (100×) | 4.00 ms (40.0×) |"), std::string::npos) << md;
+    EXPECT_NE(md.find("37.5×"), std::string::npos) << "PCL 150 ms / metal 4 ms\n" << md;
+    EXPECT_NE(md.find("0.500×"), std::string::npos) << "metal's stage 0.25 ms / OpenCV 0.5 ms\n" << md;
+    EXPECT_NE(md.find("| maze | 640x480 | metal | 7.00 ms |"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
+// --update rewrites only the section between a document's markers, --check fails once that section differs from
+// what the JSON gives (docs/performance.md is checked so by the ctest docs_performance_tables).
+TEST(Cli, BenchReportUpdatesAndChecksADocumentsSection) {
+    const fs::path dir = temp_dir();
+    nlohmann::json doc;
+    doc["context"] = {{"host_name", "testhost"}, {"load_avg", {1.5, 1.0, 0.5}}};
+    doc["benchmarks"] = {bench_entry("memcpy/640x480/estimated_normals", 0.1), bench_entry("memcpy/640x480/mask", 0.01),
+                         bench_entry("pipeline/cpu/640x480/estimated_normals", 10.0)};
+    fs::create_directories(dir / "data");
+    std::ofstream(dir / "data" / "bench.json") << doc.dump();
+    const fs::path md = dir / "doc.md";
+    std::ofstream(md) << "# Doc\n\nBefore.\n\n<!-- bench-report:begin (generated) -->\nold tables\n"
+                         "<!-- bench-report:end -->\n\nAfter.\n";
+    const std::string json = (dir / "data" / "bench.json").string();
+    EXPECT_EQ(run("bench-report " + json + " --check " + md.string()).status, 1) << "stale before the update";
+    const CliRun up = run("bench-report " + json + " --update " + md.string());
+    ASSERT_EQ(up.status, 0) << up.output;
+    const std::string text = read_file(md);
+    EXPECT_EQ(text.rfind("# Doc\n\nBefore.\n\n<!-- bench-report:begin (generated) -->\n", 0), 0u) << text;
+    EXPECT_NE(text.find("<!-- bench-report:end -->\n\nAfter.\n"), std::string::npos) << text;
+    EXPECT_EQ(text.find("old tables"), std::string::npos) << text;
+    EXPECT_EQ(text.find("# pyrseg benchmark report"), std::string::npos) << "no title of its own\n" << text;
+    EXPECT_NE(text.find("### Whole pipeline"), std::string::npos) << "headings one level down\n" << text;
+    EXPECT_NE(text.find("[data/bench.json](data/bench.json)"), std::string::npos) << text;
+    EXPECT_NE(text.find("The machine was not idle"), std::string::npos) << "load 1.5 at the start\n" << text;
+    EXPECT_NE(text.find("(images/bench_vs_pcl.png)"), std::string::npos) << text;
+    EXPECT_TRUE(fs::exists(dir / "images" / "bench_vs_pcl.png"));
+    EXPECT_EQ(run("bench-report " + json + " --update " + md.string()).status, 0);
+    EXPECT_EQ(read_file(md), text) << "a second update changes nothing";
+
+    const CliRun same = run("bench-report " + json + " --check " + md.string());
+    EXPECT_EQ(same.status, 0) << same.output;
+    std::string edited = text;
+    edited.replace(edited.find("10.0 ms"), 7, "9.00 ms");
+    std::ofstream(md) << edited;
+    const CliRun stale = run("bench-report " + json + " --check " + md.string());
+    EXPECT_EQ(stale.status, 1) << stale.output;
+    EXPECT_NE(stale.output.find("--update"), std::string::npos) << "says how to regenerate it\n" << stale.output;
+    EXPECT_EQ(read_file(md), edited) << "--check writes nothing";
+
+    std::ofstream(md) << "# No markers\n";
+    const CliRun none = run("bench-report " + json + " --update " + md.string());
+    EXPECT_EQ(none.status, 1) << none.output;
+    EXPECT_NE(none.output.find("bench-report:begin"), std::string::npos) << none.output;
+    fs::remove_all(dir);
+}
+
 // Issue 17: what a new user trips over, each fixed and kept fixed.
 namespace {
 

@@ -175,7 +175,7 @@ std::optional<Array> make_array(FuzzedDataProvider& in, const std::vector<py::ss
     const int kind = in.ConsumeIntegralInRange<int>(0, 15);
     Array a;
     // numpy cannot make an array of this (the bindings once read the null array py::array::ensure gives for it: a
-    // segfault, docs/fuzzing.md "Findings so far"); every entry point must raise ValueError naming the argument.
+    // segfault, docs/fuzzing-ledger.md "Findings so far"); every entry point must raise ValueError naming the argument.
     if (kind == 13) {
         py::list ragged;
         ragged.append(py::make_tuple(1.0, 2.0));
