@@ -1,10 +1,11 @@
 #pragma once
-// The CPU backend's per-pixel passes over whole rows with Google Highway vectors: the normals of the paper metric
-// (shaders/pyr_normals.h, pyr_normal_q), quantize (pyr_quantize.h), the paper metric (pyr_metric.h) and mip
-// (pyr_mip.h). Each row function computes, lane by lane, exactly the integer and float operations of the shared
-// scalar function (contraction off, no fused multiply-add, integer divisions and square roots exact: see
-// cpu_simd.cpp), and calls the shared function itself for the pixels where the neighbour tests differ (image
-// borders), so the bytes are those of the scalar path on every target.
+// The CPU backend's per-pixel passes over whole rows with Google Highway vectors (RowKernels below: depth images,
+// normals, quantize and both metrics, the fused front end's rows, mip, label init, step 6's fill and edges, and
+// compaction's lookup; each family in its *-inl.h file next to this one). Each row function computes, lane by
+// lane, exactly the integer and float operations of the shared scalar function (contraction off, no fused
+// multiply-add, integer divisions and square roots exact: see cpu_simd.cpp), and calls the shared function itself
+// for the pixels where the neighbour tests differ (image borders), so the bytes are those of the scalar path on
+// every target.
 //
 // One binary holds every target Highway can build for the architecture (x86: SSSE3, SSE4, AVX2, AVX3 (AVX-512)
 // and Highway's one-lane scalar; Arm: NEON, SVE, SVE2) and picks the best one the CPU runs. The environment

@@ -1,9 +1,7 @@
 // The robust metric's vector rows (docs/algorithm.md sections 2b and 8b; shaders/pyr_robust.h): texels, normals from
-// window sums and the fillable test, each the scalar function's operations lane by lane. Included by cpu_simd.cpp
-// inside each target's namespace, after the helpers it shares with the paper metric's rows (load_points,
-// point_valid, msb, shift_magnitude, normal_direction, normal_from_direction, store_normals, load_quant, or_bits,
-// interior_vectors),
-// once per target like the rest of that file: no include guard.
+// window sums and the fillable test, each the scalar function's operations lane by lane. They use the helpers of the
+// paper metric's families (point_loads-inl.h, normals_rows-inl.h, metric_rows-inl.h, pixel_bits-inl.h).
+// Included by cpu_simd.cpp inside each target's namespace, once per target (foreach_target.h): no include guard.
 // NOLINTBEGIN(llvm-header-guard)
 
 // G(v) (pyr_robust_fixed) of n values: the product by the power of two `scale` is exact where it does not overflow,
