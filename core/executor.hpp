@@ -1,6 +1,9 @@
 #pragma once
 // What a backend implements: one method per pass of the contract. core/pipeline.cpp calls them in the contract's
-// order; a backend holds only the code that runs a pass on its device (the per-pixel logic is in shaders/).
+// order, and is the only place that does; a backend holds only the code that runs a pass on its device (the
+// per-pixel logic is in shaders/). Where a backend runs several passes as one, it says so in a query
+// (fuses_points_to_mask, fuses_edges_into_final_fill, marks_labels_before_compact) and the pipeline calls the
+// fused pass instead: no pass depends on what an earlier call of the frame chose.
 #include <cstdint>
 #include <vector>
 
@@ -45,11 +48,18 @@ public:
     virtual void init_labels(int level, std::uint32_t mode) = 0;  // PYR_INIT_* (shaders/pyr_types.h)
     virtual void fill_to_fixed_point(int level, std::uint32_t anchor_max) = 0;  // steps 2 and 4
     virtual void final_fill(int level) = 0;  // steps 5 and 6 a, b (level N): one call, so a backend may fuse them
-    // Step 6 c. A backend may also mark the labels present for compaction here, while each row is in cache.
-    virtual void label_edges() = 0;
-    // Step 7: counts the distinct labels of level N (the segment count K, reported by read_back) and, when apply,
-    // renumbers them. after_edges: label_edges ran just before (so a backend that marks there need not again).
-    virtual void compact(bool apply, bool after_edges) = 0;
+    // A backend that returns true runs step 6c with steps 5 and 6 a, b, while each row is in cache: the pipeline
+    // then calls final_fill_with_edges instead of final_fill and label_edges.
+    [[nodiscard]] virtual bool fuses_edges_into_final_fill() const { return false; }
+    virtual void final_fill_with_edges(int /*level*/) {}
+    virtual void label_edges() = 0;  // step 6c
+    // Step 7 marks the labels present at level N, counts them (the segment count K, reported by read_back) and,
+    // when apply, renumbers them. compact does all of it, unless the backend returns true here: its label_edges
+    // then marks them as well (each row while it is in cache), the pipeline calls mark_labels where label_edges does
+    // not run (with the level that holds level N's labels), and compact only counts and renumbers.
+    [[nodiscard]] virtual bool marks_labels_before_compact() const { return false; }
+    virtual void mark_labels(int /*level*/) {}
+    virtual void compact(bool apply) = 0;
     // Per-segment statistics into plan.stats_slots slots (docs/algorithm.md section 10), after compact; read_back
     // returns them (core/segment_stats.hpp decodes the words).
     virtual void segment_stats() = 0;

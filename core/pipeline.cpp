@@ -47,6 +47,8 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
             clock.run("metric", [&] { ex.metric(); });
         }
     }
+    const bool marks = ex.marks_labels_before_compact();
+    bool marked = false;  // the labels present are marked for step 7 (marks only)
     if (plan.small_image) {
         // The contract's fallback: plain 4-connected components of B, each labelled 1 + its smallest index,
         // which is the fixed point of the step-2 fill from pixel-index labels.
@@ -65,11 +67,21 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
             for (int k = m + 1; k <= n - 1; ++k) ex.init_labels(k, PYR_INIT_INHERIT);  // step 3
         });
         clock.run("fill", [&] { ex.fill_to_fixed_point(n - 1, plan.old_label_max); });  // step 4
-        clock.run("final_fill", [&] { ex.final_fill(n); });                             // steps 5, 6 a, b
-        if (plan.params.label_edges) clock.run("edges", [&] { ex.label_edges(); });     // step 6 c
+        const bool edges = plan.params.label_edges;
+        if (edges && ex.fuses_edges_into_final_fill()) {
+            clock.run("final_fill", [&] { ex.final_fill_with_edges(n); });  // steps 5, 6 a, b, c
+            // Every label of level N comes from level N - 1 (step 5 copies each one to the four children of its
+            // texel, and steps 6 only copy labels): marking that level's labels marks the same set from a quarter
+            // of the texels.
+            if (marks) clock.run("edges", [&] { ex.mark_labels(n - 1); });
+        } else {
+            clock.run("final_fill", [&] { ex.final_fill(n); });        // steps 5, 6 a, b
+            if (edges) clock.run("edges", [&] { ex.label_edges(); });  // step 6 c (and the marks, with marks)
+        }
+        marked = marks && edges;
     }
-    const bool after_edges = !plan.small_image && plan.params.label_edges;
-    clock.run("compact", [&] { ex.compact(plan.params.compact, after_edges); });  // step 7
+    if (marks && !marked) clock.run("compact", [&] { ex.mark_labels(n); });
+    clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7
     if (plan.stats_slots != 0) clock.run("stats", [&] { ex.segment_stats(); });
 }
 

@@ -222,7 +222,7 @@ public:
         }
     }
 
-    void compact(bool apply, bool /*after_edges*/) override {
+    void compact(bool apply) override {
         const uint32_t count = plan_.lut_size();
         const uint32_t chunks = plan_.scan_chunks();
         device_->zero(Buffer::lut, 0, 4 * size_t(count));

@@ -1,0 +1,187 @@
+// Points to the fillable mask: normals (when estimated), quantize and the metric (paper or robust) as separate passes,
+// or the paper metric's three fused (points_to_mask, backends/cpu/points_to_mask.hpp).
+#include <bit>
+
+#include "backends/cpu/cpu_executor.hpp"
+
+namespace pyrseg::cpu {
+
+using std::size_t;
+using std::uint32_t;
+
+namespace {
+
+void store_normal_q(const PyrIVec3& q, float* n) {
+    n[0] = float(q.x) * PYR_NORMAL_UNIT;
+    n[1] = float(q.y) * PYR_NORMAL_UNIT;
+    n[2] = float(q.z) * PYR_NORMAL_UNIT;
+}
+
+}  // namespace
+
+void CpuExecutor::estimate_normals() {
+    const size_t w = size_t(plan_.width);
+    if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
+    const auto radius = uint32_t(plan_.params.normal_radius);
+    const auto window = uint32_t(plan_.params.normal_window);
+    const float scale = plan_.thresholds.point_scale;
+    const bool robust = plan_.params.metric == Metric::robust;
+    const auto h = uint32_t(plan_.height);
+    PassContext c = context();
+    if (robust) {
+        // Each pixel's tangents once, rather than once for every window that holds the pixel.
+        c.robust_texels = robust_planes();
+        if (simd_ != nullptr) {
+            rows(size_t(h), [&](size_t y) { simd_->robust_texels_row(c, uint32_t(w), h, uint32_t(y), radius, scale); });
+        } else {
+            rows(size_t(h), [&](size_t y) {
+                for (size_t x = 0; x < w; ++x) {
+                    c.robust_texels.store(y * w + x, kernels::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x),
+                                                                               uint32_t(y), radius, scale));
+                }
+            });
+        }
+        windows_.build(c.robust_texels, w, size_t(h), window, simd_,
+                       [&](size_t n, const auto& body) { rows(n, body); });
+        if (simd_ != nullptr) {
+            // The vector rows take the windows inside the image's columns; the others are the scalar code's.
+            const size_t words = (w + 63) / 64;
+            if (robust_rest_.size() < size_t(h) * words) robust_rest_.resize(size_t(h) * words);  // once
+            rows(size_t(h), [&](size_t y) {
+                std::uint64_t* rest = robust_rest_.data() + y * words;
+                simd_->robust_normals_row(c, windows_.row(y), uint32_t(w), h, uint32_t(y), window,
+                                          normals_.data() + 3 * y * w, rest);
+                for (size_t i = 0; i < words; ++i) {
+                    for (std::uint64_t bits = rest[i]; bits != 0; bits &= bits - 1) {
+                        const size_t x = i * 64 + size_t(std::countr_zero(bits));
+                        store_normal_q(robust_normal(c, x, y), normals_.data() + 3 * (y * w + x));
+                    }
+                }
+            });
+            normals_estimated_ = true;
+            return;
+        }
+    }
+    if (!robust && simd_ != nullptr) {
+        rows(size_t(plan_.height), [&](size_t y) {
+            simd_->normals_row(c, uint32_t(w), h, uint32_t(y), radius, normals_.data() + 3 * y * w);
+        });
+        normals_estimated_ = true;
+        return;
+    }
+    rows(size_t(plan_.height), [&](size_t y) {
+        for (size_t x = 0; x < w; ++x) {
+            const PyrIVec3 q = robust ? robust_normal(c, x, y)
+                                      : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
+            store_normal_q(q, normals_.data() + 3 * (y * w + x));
+        }
+    });
+    normals_estimated_ = true;
+}
+
+void CpuExecutor::quantize() {
+    const size_t w = size_t(plan_.width);
+    if (simd_ != nullptr) {
+        const size_t normal_floats = normals_estimated_ ? 3 : layout_.point_floats;
+        rows(size_t(plan_.height), [&](size_t y) {
+            simd_->quantize_row(point(0, y), layout_.point_floats, normal(0, y), normal_floats, uint32_t(w),
+                                quant_.data() + kQuantWords * y * w);
+        });
+        return;
+    }
+    rows(size_t(plan_.height), [&](size_t y) {
+        for (size_t x = 0; x < w; ++x) {
+            const float* p = point(x, y);
+            const float* n = normal(x, y);
+            const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+            store_quant(quant_.data() + kQuantWords * (y * w + x), q.qx, q.qy, q.qz, q.valid, p[2]);
+        }
+    });
+}
+
+void CpuExecutor::metric() {
+    const PassContext c = context();
+    const PyrLevel full = plan_.full();
+    const core::Thresholds t = plan_.thresholds;
+    const bool robust = plan_.params.metric == Metric::robust;
+    const auto stride = uint32_t(plan_.params.curvature_stride);
+    if (simd_ != nullptr) {
+        rows(full.height, [&](size_t y) {
+            std::uint8_t* out = mask_.data() + full.offset + y * full.width;
+            if (robust) {
+                simd_->metric_robust_row(c, full.width, full.height, uint32_t(y), stride, t.curvature_base,
+                                         t.curvature_growth, t.depth, t.depth_growth, out);
+            } else {
+                simd_->metric_row(c, full.width, full.height, uint32_t(y), t.curvature, t.depth, out);
+            }
+        });
+        return;
+    }
+    rows(full.height, [&](size_t y) {
+        std::uint8_t* out = mask_.data() + full.offset + y * full.width;
+        for (uint32_t x = 0; x < full.width; ++x) {
+            out[x] = std::uint8_t(
+                robust
+                    ? kernels::pyr_metric_robust_fillable(c, full.width, full.height, x, uint32_t(y), stride,
+                                                          t.curvature_base, t.curvature_growth, t.depth, t.depth_growth)
+                    : kernels::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y), t.curvature, t.depth));
+        }
+    });
+}
+
+void CpuExecutor::points_to_mask(bool estimate_normals) {
+    PointsToMaskFrame f;
+    f.points = context();
+    f.given_normals = estimate_normals ? nullptr : cloud_.normals;
+    f.width = plan_.width;
+    f.height = plan_.height;
+    f.normal_radius = uint32_t(plan_.params.normal_radius);
+    f.curvature = plan_.thresholds.curvature;
+    f.depth = plan_.thresholds.depth;
+    if (estimate_normals && plan_.keep_normals) {
+        if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
+        f.normals_out = normals_.data();
+    }
+    // The statistics read each pixel's qn; nothing else reads the quantized pixels after the metric.
+    if (plan_.stats_slots != 0) f.quant_out = quant_.data();
+    f.mask_out = mask_.data() + plan_.full().offset;
+    f.valid_out = mask_valid_.data();
+    points_to_mask_.run(pool_, *simd_, f);
+    normals_estimated_ = estimate_normals;
+    valid_bytes_ = true;
+}
+
+// The robust texels' planes (RobustTexelPlanes) in robust_texels_, sized on first use.
+RobustTexelPlanes CpuExecutor::robust_planes() {
+    const size_t pixels = plan_.pixel_count();
+    if (robust_texels_.empty()) robust_texels_.resize(8 * pixels);  // once per Segmenter
+    std::int32_t* p = robust_texels_.data();
+    RobustTexelPlanes planes;
+    planes.gz = p;
+    planes.tangents = reinterpret_cast<std::uint32_t*>(p + pixels);
+    for (size_t k = 0; k < 3; ++k) {
+        planes.th[k] = p + (2 + k) * pixels;
+        planes.tv[k] = p + (5 + k) * pixels;
+    }
+    return planes;
+}
+
+// Section 8b's normal of pixel (x, y): from the box sums when its whole window is members, else the window
+// pixel by pixel (the shared function); the same words either way (backends/cpu/robust_windows.hpp).
+PyrIVec3 CpuExecutor::robust_normal(const PassContext& c, size_t x, size_t y) const {
+    const float scale = plan_.thresholds.point_scale;
+    const float* p = point(x, y);
+    if (kernels::pyr_point_valid(p[0], p[1], p[2]) != 0u) {
+        const std::int32_t zi = kernels::pyr_robust_fixed(p[2], scale);
+        if (windows_.all_members(x, y, zi, zi >> 4)) {
+            PyrIVec3 u{};
+            PyrIVec3 v{};
+            windows_.sums(x, y, u, v);
+            return kernels::pyr_robust_normal_from_sums(u, v, p[0], p[1], p[2]);
+        }
+    }
+    return kernels::pyr_robust_normal_q(c, uint32_t(plan_.width), uint32_t(plan_.height), uint32_t(x), uint32_t(y),
+                                        uint32_t(plan_.params.normal_window), scale);
+}
+
+}  // namespace pyrseg::cpu
