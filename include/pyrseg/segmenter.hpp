@@ -19,8 +19,9 @@ struct SegmenterAccess;  // the library's own access to a Segmenter's insides (c
 }
 
 struct PassTiming {
-    // "depth" (a DepthView's back-projection), "normals", "quantize", "metric", "mip", "labels", "fill", "final_fill",
-    // "edges", "compact", "stats", then "upload" (the frame to the backend) and "download" (the results back).
+    // "depth" (a DepthView's back-projection), "normals", "quantize", "metric" (or "points_to_mask": the three as one
+    // pass, on a backend that fuses them), "mip", "labels", "fill", "final_fill", "edges", "compact", "stats", then
+    // "upload" (the frame to the backend) and "download" (the results back).
     const char* pass;
     double milliseconds;
 };
