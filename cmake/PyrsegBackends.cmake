@@ -76,7 +76,3 @@ _pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and he
 
 find_package(OpenCL QUIET)
 _pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" ON "")
-
-set(PYRSEG_HAVE_OPENCL ${PYRSEG_BUILD_opencl})
-set(PYRSEG_HAVE_CUDA ${PYRSEG_BUILD_cuda})
-set(PYRSEG_HAVE_VULKAN ${PYRSEG_BUILD_vulkan})

@@ -1,8 +1,8 @@
 #pragma once
 // The registry of backends. Each backend describes itself once, as a BackendEntry in its own files
-// (backends/<name>/<name>_backend.hpp); core/CMakeLists.txt generates the list of every backend pyrseg knows, in the
-// order 'auto' prefers them, with the built ones' entries and why the others are not built. Adding a backend: its
-// entry, and its name in that list.
+// (backends/<name>/<name>_backend.hpp); backends/CMakeLists.txt generates the list of every backend pyrseg knows, in
+// the order 'auto' prefers them, with the built ones' entries and why the others are not built. Adding a backend: its
+// entry, and its name in PYRSEG_BACKENDS (cmake/PyrsegBackends.cmake).
 #include <memory>
 #include <span>
 #include <string>
@@ -32,7 +32,7 @@ struct KnownBackend {
     const char* why_not_built;  // when entry is nullptr
 };
 
-// Every backend pyrseg knows, GPUs first and the CPU last (generated: core/CMakeLists.txt).
+// Every backend pyrseg knows, GPUs first and the CPU last (generated: backends/CMakeLists.txt).
 [[nodiscard]] std::span<const KnownBackend> known_backends();
 
 // Creates the executor of a backend that resolve_backend_name() accepted. `plan` must outlive it.

@@ -1,7 +1,7 @@
 /* The kernel table: every GPU entry point, once. K(name, NAME, dims) per kernel:
  *  - name: the entry point is pyr_k_<name> (OpenCL, CUDA) and the host's gpu::Kernel::<name>;
  *  - NAME: the GLSL build compiles shaders/pyr_entries.h once per kernel with -DPYR_ENTRY_<NAME>
- *    (core/CMakeLists.txt reads the names from this table);
+ *    (backends/CMakeLists.txt reads the names from this table);
  *  - dims: 1, invocations over a count (PYR_I); 2, over a width x height grid (PYR_X, PYR_Y); or 3, one workgroup
  *    per index of a count (PYR_GID; PYR_LID of PYR_LSIZE invocations, at most PYR_SCAN_GROUP_MAX).
  * Every kernel takes the Segmenter's buffers (the buffer table, pyr_buffers.h; bound once) and one PyrArgs of

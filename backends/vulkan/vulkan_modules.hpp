@@ -1,6 +1,6 @@
 #pragma once
 // The SPIR-V of every entry point of shaders/pyr_vulkan.comp, compiled and checked at build time
-// (core/CMakeLists.txt generates the table).
+// (backends/CMakeLists.txt generates the table).
 #include <cstddef>
 #include <cstdint>
 
