@@ -13,11 +13,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/device_choice.hpp"
+#include "core/gpu/api_error.hpp"
 #include "core/gpu/device.hpp"
 #include "core/gpu/gpu_executor.hpp"
 #include "core/gpu/staging.hpp"
@@ -45,19 +47,18 @@ constexpr KernelFn kKernelFns[] = {
 };
 static_assert(std::size(kKernelFns) == gpu::kKernelCount);
 
-// Allocation failures are the caller's to handle; a launch failure or an illegal address leaves the context unusable
-// (a sticky error), so this Segmenter cannot run on it any more. Anything else is pyrseg's bug.
+// CUDA's codes for the kinds of failure core/gpu/api_error.hpp gives their meaning: a launch failure or an illegal
+// address leaves the context unusable (a sticky error), a device that cannot go on.
 [[noreturn]] void fail(cudaError_t err, const char* what) {
-    ErrorCode code = ErrorCode::internal;
-    std::string after;
+    std::optional<gpu::Fault> fault;
     if (err == cudaErrorMemoryAllocation) {
-        code = ErrorCode::out_of_memory;
+        fault = gpu::Fault::out_of_memory;
     } else if (err == cudaErrorLaunchFailure || err == cudaErrorIllegalAddress) {
-        code = ErrorCode::backend_unavailable;
-        after = "; the device failed: this Segmenter cannot run it any more";
+        fault = gpu::Fault::device_lost;
     }
-    throw Error(code, std::string("CUDA: ") + what + " failed: " + cudaGetErrorName(err) + " (" +
-                          cudaGetErrorString(err) + ")" + after);
+    gpu::throw_api_failure({"CUDA", what,
+                            std::string(cudaGetErrorName(err)) + " (" + cudaGetErrorString(err) + ")", fault,
+                            "; the device failed: this Segmenter cannot run it any more"});
 }
 
 void check(cudaError_t err, const char* what) {

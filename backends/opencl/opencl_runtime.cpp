@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/device_choice.hpp"
+#include "core/gpu/api_error.hpp"
 #include "core/gpu/device_fault.hpp"
 #include "pyrseg/error.hpp"
 
@@ -102,20 +103,18 @@ const char* error_name(cl_int code) {
     }
 }
 
-// Allocation failures are the caller's to handle (a smaller frame, fewer Segmenters); CL_OUT_OF_RESOURCES is what
-// drivers report once a context has faulted (NVIDIA after a kernel error), so the device cannot run this Segmenter
-// any more. Anything else is pyrseg's bug.
+// OpenCL's codes for the kinds of failure core/gpu/api_error.hpp gives their meaning. CL_OUT_OF_RESOURCES is what
+// drivers report once a context has faulted (NVIDIA after a kernel error): a device that cannot go on.
 void fail(cl_int code, const char* what) {
-    ErrorCode kind = ErrorCode::internal;
-    std::string after;
+    std::optional<gpu::Fault> fault;
     if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_HOST_MEMORY) {
-        kind = ErrorCode::out_of_memory;
+        fault = gpu::Fault::out_of_memory;
     } else if (code == CL_OUT_OF_RESOURCES) {
-        kind = ErrorCode::backend_unavailable;
-        after = "; the device failed: this Segmenter cannot run it any more (make a new one, or use another backend)";
+        fault = gpu::Fault::device_lost;
     }
-    throw Error(kind, std::string("OpenCL: ") + what + " failed: " + error_name(code) + " (" + std::to_string(code) +
-                          ")" + after);
+    gpu::throw_api_failure(
+        {"OpenCL", what, std::string(error_name(code)) + " (" + std::to_string(code) + ")", fault,
+         "; the device failed: this Segmenter cannot run it any more (make a new one, or use another backend)"});
 }
 
 std::vector<DeviceRef> enumerate_devices(std::string* why_none) {

@@ -5,12 +5,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "backends/vulkan/vulkan_modules.hpp"
 #include "core/device_choice.hpp"
+#include "core/gpu/api_error.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::vulkan {
@@ -226,19 +228,17 @@ const char* result_name(VkResult result) {
     }
 }
 
-// Allocation failures are the caller's to handle (a smaller frame, fewer Segmenters); a lost device cannot run this
-// Segmenter any more. Anything else is pyrseg's bug.
+// Vulkan's codes for the kinds of failure core/gpu/api_error.hpp gives their meaning.
 void fail(VkResult result, const char* what) {
-    ErrorCode code = ErrorCode::internal;
-    std::string after;
+    std::optional<gpu::Fault> fault;
     if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
-        code = ErrorCode::out_of_memory;
+        fault = gpu::Fault::out_of_memory;
     } else if (result == VK_ERROR_DEVICE_LOST) {
-        code = ErrorCode::backend_unavailable;
-        after = "; the device was lost: this Segmenter cannot run it any more (make a new one, or use another backend)";
+        fault = gpu::Fault::device_lost;
     }
-    throw Error(code, std::string("Vulkan: ") + what + " failed: " + result_name(result) + " (" +
-                          std::to_string(int(result)) + ")" + after);
+    gpu::throw_api_failure(
+        {"Vulkan", what, std::string(result_name(result)) + " (" + std::to_string(int(result)) + ")", fault,
+         "; the device was lost: this Segmenter cannot run it any more (make a new one, or use another backend)"});
 }
 
 void throw_on_validation_messages(const char* during) {
