@@ -21,6 +21,7 @@
 #endif
 #ifdef PYRSEG_BENCH_VULKAN
 #include "pyrseg/vulkan.hpp"
+#include "tests/support/vulkan_device.hpp"
 #endif
 #ifdef PYRSEG_BENCH_CUDA
 #include <cuda_runtime_api.h>
@@ -128,105 +129,33 @@ void opencl_frames(benchmark::State& state, int width, int height, bool depth) {
 #endif
 
 #ifdef PYRSEG_BENCH_VULKAN
-// The application's Vulkan objects: the first device with a compute queue, device-local buffers (filled once
-// through a host-visible staging buffer, as an application's own upload would).
+// The application's Vulkan objects (tests/support/vulkan_device.hpp: the first device with a compute queue, as the
+// interop tests make it), device-local buffers, and a fence for the frames.
 struct VulkanApp {
-    VkInstance instance = VK_NULL_HANDLE;
-    VkPhysicalDevice physical = VK_NULL_HANDLE;
-    std::uint32_t family = 0;
-    VkDevice device = VK_NULL_HANDLE;
-    VkQueue queue = VK_NULL_HANDLE;
+    test::VulkanDevice vk;
     VkFence fence = VK_NULL_HANDLE;
-    std::vector<std::pair<VkBuffer, VkDeviceMemory>> buffers;
+    std::vector<test::VulkanDevice::Buffer> buffers;
 
     VulkanApp() {
-        VkApplicationInfo app{};
-        app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
-        app.apiVersion = VK_API_VERSION_1_1;
-        VkInstanceCreateInfo info{};
-        info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
-        info.pApplicationInfo = &app;
-        if (vkCreateInstance(&info, nullptr, &instance) != VK_SUCCESS) return;
-        std::uint32_t count = 0;
-        vkEnumeratePhysicalDevices(instance, &count, nullptr);
-        std::vector<VkPhysicalDevice> physicals(count);
-        if (count > 0) vkEnumeratePhysicalDevices(instance, &count, physicals.data());
-        for (VkPhysicalDevice p : physicals) {
-            std::uint32_t n = 0;
-            vkGetPhysicalDeviceQueueFamilyProperties(p, &n, nullptr);
-            std::vector<VkQueueFamilyProperties> families(n);
-            vkGetPhysicalDeviceQueueFamilyProperties(p, &n, families.data());
-            for (std::uint32_t f = 0; f < n && physical == VK_NULL_HANDLE; ++f) {
-                if ((families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0) {
-                    physical = p;
-                    family = f;
-                }
-            }
-        }
-        if (physical == VK_NULL_HANDLE) return;
-        const float priority = 1.0f;
-        VkDeviceQueueCreateInfo queue_info{};
-        queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-        queue_info.queueFamilyIndex = family;
-        queue_info.queueCount = 1;
-        queue_info.pQueuePriorities = &priority;
-        VkDeviceCreateInfo device_info{};
-        device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-        device_info.queueCreateInfoCount = 1;
-        device_info.pQueueCreateInfos = &queue_info;
-        if (vkCreateDevice(physical, &device_info, nullptr, &device) != VK_SUCCESS) return;
-        vkGetDeviceQueue(device, family, 0, &queue);
+        if (!vk.why_unavailable().empty()) return;
         VkFenceCreateInfo fence_info{};
         fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-        vkCreateFence(device, &fence_info, nullptr, &fence);
+        vkCreateFence(vk.device(), &fence_info, nullptr, &fence);
     }
     ~VulkanApp() {
-        for (const auto& [b, m] : buffers) {
-            vkDestroyBuffer(device, b, nullptr);
-            vkFreeMemory(device, m, nullptr);
-        }
-        if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
-        if (device != VK_NULL_HANDLE) vkDestroyDevice(device, nullptr);
-        if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+        for (const test::VulkanDevice::Buffer& b : buffers) vk.destroy(b);
+        if (fence != VK_NULL_HANDLE) vkDestroyFence(vk.device(), fence, nullptr);
     }
     VulkanApp(const VulkanApp&) = delete;
     VulkanApp& operator=(const VulkanApp&) = delete;
 
     // A buffer with the transfer usages, in memory with `flags` (host-visible ones are filled from `data`).
     VkBuffer buffer(VkDeviceSize bytes, VkMemoryPropertyFlags flags, const void* data = nullptr) {
-        VkBufferCreateInfo info{};
-        info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-        info.size = bytes;
-        info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        VkBuffer b = VK_NULL_HANDLE;
-        if (vkCreateBuffer(device, &info, nullptr, &b) != VK_SUCCESS) return VK_NULL_HANDLE;
-        VkMemoryRequirements req{};
-        vkGetBufferMemoryRequirements(device, b, &req);
-        VkPhysicalDeviceMemoryProperties types{};
-        vkGetPhysicalDeviceMemoryProperties(physical, &types);
-        VkMemoryAllocateInfo alloc{};
-        alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-        alloc.allocationSize = req.size;
-        alloc.memoryTypeIndex = types.memoryTypeCount;
-        for (std::uint32_t t = 0; t < types.memoryTypeCount && alloc.memoryTypeIndex == types.memoryTypeCount; ++t) {
-            if ((req.memoryTypeBits & (1u << t)) != 0 && (types.memoryTypes[t].propertyFlags & flags) == flags)
-                alloc.memoryTypeIndex = t;
-        }
-        VkDeviceMemory m = VK_NULL_HANDLE;
-        if (alloc.memoryTypeIndex == types.memoryTypeCount ||
-            vkAllocateMemory(device, &alloc, nullptr, &m) != VK_SUCCESS) {
-            vkDestroyBuffer(device, b, nullptr);
-            return VK_NULL_HANDLE;
-        }
-        vkBindBufferMemory(device, b, m, 0);
-        if (data != nullptr) {
-            void* mapped = nullptr;
-            vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &mapped);
-            std::memcpy(mapped, data, bytes);
-            vkUnmapMemory(device, m);
-        }
-        buffers.emplace_back(b, m);
-        return b;
+        const test::VulkanDevice::Buffer b = vk.make_buffer(bytes, flags);
+        if (b.buffer == VK_NULL_HANDLE) return VK_NULL_HANDLE;
+        if (data != nullptr && b.mapped != nullptr) std::memcpy(b.mapped, data, bytes);
+        buffers.push_back(b);
+        return b.buffer;
     }
 };
 
@@ -255,8 +184,7 @@ void vulkan_frames(benchmark::State& state, int width, int height, bool depth) {
         state.SkipWithError("could not allocate the buffers");
         return;
     }
-    Segmenter segmenter =
-        vulkan::make_segmenter(width, height, {app.instance, app.physical, app.device, app.family, app.queue});
+    Segmenter segmenter = vulkan::make_segmenter(width, height, app.vk.handles());
     vulkan::LabelBuffers out;
     out.labels = labels;
     out.labels_bytes = 4 * pixels;
@@ -275,8 +203,8 @@ void vulkan_frames(benchmark::State& state, int width, int height, bool depth) {
         } else {
             vulkan::submit(segmenter, cloud, out, {}, {}, {}, app.fence);
         }
-        vkWaitForFences(app.device, 1, &app.fence, VK_TRUE, UINT64_MAX);
-        vkResetFences(app.device, 1, &app.fence);
+        vkWaitForFences(app.vk.device(), 1, &app.fence, VK_TRUE, UINT64_MAX);
+        vkResetFences(app.vk.device(), 1, &app.fence);
     });
     state.counters["dispatches"] = segmenter.last_dispatches();
 }

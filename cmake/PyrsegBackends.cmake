@@ -1,6 +1,7 @@
 # Every backend pyrseg knows, in the order 'auto' prefers them: the GPU backends, then the CPU (always built). The
-# registry (backends/CMakeLists.txt), install rules and tests follow this list; list_backends() gives it at run
-# time. Adding a backend: its name here, its _pyrseg_backend line below, its block in backends/CMakeLists.txt.
+# registry (backends/CMakeLists.txt), install rules, examples, bench and tests follow this list; list_backends() gives
+# it at run time. Adding a backend: its name here, its option, toolchain test, _pyrseg_backend line and
+# _pyrseg_gpu_api line below, its block in backends/CMakeLists.txt (docs/architecture.md has the whole checklist).
 set(PYRSEG_GPU_BACKENDS cuda vulkan opencl)
 set(PYRSEG_BACKENDS ${PYRSEG_GPU_BACKENDS} cpu)
 
@@ -9,16 +10,21 @@ set(PYRSEG_BACKENDS ${PYRSEG_GPU_BACKENDS} cpu)
 set(PYRSEG_WITH_CUDA AUTO CACHE STRING "Build the CUDA backend (ON/OFF/AUTO)")
 set(PYRSEG_WITH_VULKAN AUTO CACHE STRING "Build the Vulkan backend (ON/OFF/AUTO)")
 set(PYRSEG_WITH_OPENCL AUTO CACHE STRING "Build the OpenCL backend (ON/OFF/AUTO)")
-foreach(opt PYRSEG_WITH_CUDA PYRSEG_WITH_VULKAN PYRSEG_WITH_OPENCL)
-  set_property(CACHE ${opt} PROPERTY STRINGS ON OFF AUTO)
+foreach(_b IN LISTS PYRSEG_GPU_BACKENDS)
+  string(TOUPPER "${_b}" _opt)
+  set_property(CACHE PYRSEG_WITH_${_opt} PROPERTY STRINGS ON OFF AUTO)
 endforeach()
+# The sanitizer, cross, fuzz and package builds: the CPU backend alone, whatever the options above say.
+option(PYRSEG_CPU_ONLY "Build the CPU backend only (every PYRSEG_WITH_<GPU backend> taken as OFF)" OFF)
 
 # _pyrseg_backend(NAME OPTION FOUND TOOLCHAIN_TEXT IMPLEMENTED NOT_IMPLEMENTED_TEXT)
 function(_pyrseg_backend name opt found toolchain implemented pending)
   set(value "${${opt}}")
   string(TOUPPER "${value}" value)
   set(build OFF)
-  if(value STREQUAL "OFF")
+  if(PYRSEG_CPU_ONLY)
+    set(why "disabled (PYRSEG_CPU_ONLY=ON)")
+  elseif(value STREQUAL "OFF")
     set(why "disabled (${opt}=OFF)")
   elseif(NOT found)
     set(why "not built: ${toolchain} not found")
@@ -37,6 +43,19 @@ function(_pyrseg_backend name opt found toolchain implemented pending)
   message(STATUS "pyrseg backend ${name}: ${why}")
   set(PYRSEG_BUILD_${name} ${build} PARENT_SCOPE)
   set(PYRSEG_WHY_${name} "${why}" PARENT_SCOPE)
+endfunction()
+
+# _pyrseg_gpu_api(NAME LIBRARY PACKAGE PC_REQUIRES PC_LIBS DIALECT): what the rest of the build needs of a GPU
+# backend's API, for those who follow the list: the import target an application links (the interop tests, the
+# examples, the bench), the package a consumer's find_package(pyrseg) finds first and the pkg-config Requires and
+# Libs of a static install (cmake/PyrsegInstall.cmake), and the dialect tests/dialect/check.sh compiles its shaders
+# as ("" where the API adds none of them).
+function(_pyrseg_gpu_api name library package pc_requires pc_libs dialect)
+  set(PYRSEG_API_LIBRARY_${name} "${library}" PARENT_SCOPE)
+  set(PYRSEG_API_PACKAGE_${name} "${package}" PARENT_SCOPE)
+  set(PYRSEG_API_PC_REQUIRES_${name} "${pc_requires}" PARENT_SCOPE)
+  set(PYRSEG_API_PC_LIBS_${name} "${pc_libs}" PARENT_SCOPE)
+  set(PYRSEG_DIALECT_${name} "${dialect}" PARENT_SCOPE)
 endfunction()
 
 message(STATUS "pyrseg backend cpu: built (always)")
@@ -64,6 +83,7 @@ if(PYRSEG_BUILD_cuda)
   set(CMAKE_CUDA_STANDARD_REQUIRED ON)
   find_package(CUDAToolkit REQUIRED)
 endif()
+_pyrseg_gpu_api(cuda CUDA::cudart_static CUDAToolkit "" "-L${CUDAToolkit_LIBRARY_DIR} -lcudart_static -ldl -lrt" cuda)
 
 find_package(Vulkan 1.1 QUIET COMPONENTS glslangValidator)
 find_program(PYRSEG_SPIRV_VAL spirv-val DOC "spirv-val (SPIRV-Tools), which checks the embedded SPIR-V")
@@ -73,6 +93,8 @@ if(Vulkan_FOUND AND Vulkan_glslangValidator_FOUND AND PYRSEG_SPIRV_VAL)
 endif()
 _pyrseg_backend(vulkan PYRSEG_WITH_VULKAN ${_vk_found} "the Vulkan loader and headers, glslangValidator and spirv-val"
                 ON "")
+_pyrseg_gpu_api(vulkan Vulkan::Vulkan Vulkan vulkan "" glsl)
 
 find_package(OpenCL QUIET)
 _pyrseg_backend(opencl PYRSEG_WITH_OPENCL ${OpenCL_FOUND} "the OpenCL ICD loader and headers" ON "")
+_pyrseg_gpu_api(opencl OpenCL::OpenCL OpenCL OpenCL "" opencl)

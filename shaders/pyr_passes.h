@@ -1,5 +1,5 @@
 /* Every pass's shared functions, for the code that compiles them: the GPU dialects (pyr_opencl.cl,
- * pyr_vulkan.comp, pyr_cuda.cuh), the CPU backend (backends/cpu/cpu_kernels.hpp) and the dialect checks
+ * pyr_vulkan.comp, pyr_cuda.cuh), the CPU backend (backends/cpu/cpu_dialect.hpp) and the dialect checks
  * (tests/dialect/). The includer defines the accessor macros first (pyr_shim.h lists them). Adding a pass: its
  * header here. */
 #ifndef PYR_PASSES_H

@@ -21,7 +21,7 @@ void CpuExecutor::label_edges() {
                 const uint32_t i = full.offset + uint32_t(y) * full.width + x;
                 // Only edge pixels change, and no other pixel reads them: writing only changes keeps rows
                 // free of races on the fillable labels they read.
-                const uint32_t l = kernels::pyr_edge_label(c, full, x, uint32_t(y), 1u);
+                const uint32_t l = pixel::pyr_edge_label(c, full, x, uint32_t(y), 1u);
                 if (l != labels_[i]) labels_[i] = l;
             }
             mark_row(y);
@@ -65,7 +65,7 @@ void CpuExecutor::label_edges() {
             }
             std::fill_n(bits, words, std::uint64_t{0});
             for (uint32_t x = 0; x < w; ++x) {
-                next[x] = kernels::pyr_edge_label(c, full, x, uint32_t(y), round);
+                next[x] = pixel::pyr_edge_label(c, full, x, uint32_t(y), round);
                 if (next[x] == labels_[full.offset + y * w + x]) continue;
                 bits[x / 64] |= std::uint64_t{1} << (x % 64);
                 changed[y] = 1;

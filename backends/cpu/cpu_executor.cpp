@@ -38,7 +38,7 @@ CpuExecutor::CpuExecutor(const core::Plan& plan)
       lut_(plan.lut_size()),
       fill_scratch_(fill_scratch_size(plan)),
       stats_(plan.stats_words()),
-      simd_(simd::kernels_from_environment()),
+      simd_(simd::rows_from_environment()),
       sweeps_(use_sweeps_for_fixed_points()) {}
 
 PassContext CpuExecutor::context() {
@@ -70,7 +70,7 @@ void CpuExecutor::mip(int parent_level) {
     rows(parent.height, [&](size_t y) {
         std::uint8_t* out = mask_.data() + parent.offset + y * parent.width;
         for (uint32_t x = 0; x < parent.width; ++x)
-            out[x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, uint32_t(y)));
+            out[x] = std::uint8_t(pixel::pyr_mip_texel(c, child, x, uint32_t(y)));
     });
 }
 
@@ -91,7 +91,7 @@ void CpuExecutor::init_labels(int level, uint32_t mode) {
 void CpuExecutor::init_row(const PassContext& c, const PyrLevel& lv, const PyrLevel& parent, uint32_t y,
                            uint32_t mode) {
     uint32_t* out = labels_.data() + lv.offset + size_t(y) * lv.width;
-    for (uint32_t x = 0; x < lv.width; ++x) out[x] = kernels::pyr_label_init_texel(c, lv, parent, x, y, mode);
+    for (uint32_t x = 0; x < lv.width; ++x) out[x] = pixel::pyr_label_init_texel(c, lv, parent, x, y, mode);
 }
 
 // Rows in parallel, each in one run: a row adds each stretch of equal labels to its slot at once.
@@ -102,7 +102,7 @@ void CpuExecutor::segment_stats() {
     const uint32_t with_points = from_mask_ ? 0u : 1u;
     const float scale = plan_.stats_point_scale();
     rows(full.height, [&](size_t y) {
-        kernels::pyr_stats_row_run(c, full, uint32_t(y), 0u, full.width, with_points, scale, 0u, plan_.stats_slots);
+        pixel::pyr_stats_row_run(c, full, uint32_t(y), 0u, full.width, with_points, scale, 0u, plan_.stats_slots);
     });
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU backend's executor: the shared pass functions (cpu_kernels.hpp) or their vector rows (simd/cpu_simd.hpp)
+// The CPU backend's executor: the shared pass functions (cpu_dialect.hpp) or their vector rows (simd/cpu_simd.hpp)
 // over the image's rows on a thread pool. Its methods live with the passes they run: cpu_executor.cpp (its buffers,
 // the pyramid's passes, statistics), cpu_inputs.cpp, cpu_front_end.cpp (normals to mask), cpu_fills.cpp (steps 2
 // and 4), cpu_final_fill.cpp (steps 5 and 6 a, b), cpu_edges.cpp (6c), cpu_compact.cpp (7), cpu_read_back.cpp.
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/points_to_mask.hpp"
 #include "backends/cpu/robust_windows.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
@@ -36,7 +36,7 @@ public:
     void estimate_normals() override;
     void quantize() override;
     void metric() override;
-    // The paper metric on the vector kernels: fused (backends/cpu/points_to_mask.hpp). The robust metric's windows
+    // The paper metric on the vector rows: fused (backends/cpu/points_to_mask.hpp). The robust metric's windows
     // and the scalar path run as separate passes.
     [[nodiscard]] bool fuses_points_to_mask() const override {
         return simd_ != nullptr && plan_.params.metric == Metric::paper;
@@ -132,7 +132,7 @@ private:
     std::vector<std::uint32_t> stats_;       // per-segment statistics words, when asked for
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
-    const simd::RowKernels* simd_;
+    const simd::VectorRows* simd_;
     bool sweeps_;  // PYRSEG_CPU_FILL=sweeps (cpu_fills.cpp)
     std::uint32_t segment_count_ = 0;
     std::uint32_t fill_rounds_ = 0;

@@ -33,7 +33,7 @@ bool column_block(const PassContext& c, uint32_t row, uint32_t from, uint32_t x0
     for (uint32_t x = x0; x < x1; ++x) {
         if ((m[row + x] & PYR_MASK_FILLABLE) == 0) continue;
         const uint32_t cur = l[row + x];
-        const uint32_t next = kernels::pyr_fill_step(cur, m[row + x], l[from + x], m[from + x], once ? 1u : 0u);
+        const uint32_t next = pixel::pyr_fill_step(cur, m[row + x], l[from + x], m[from + x], once ? 1u : 0u);
         if (next != cur) {
             l[row + x] = next;
             ch = true;
@@ -55,7 +55,7 @@ void CpuExecutor::fill_to_fixed_point(int level, uint32_t anchor_max) {
             const uint32_t* l = labels + lv.offset + y * lv.width;
             const uint32_t n = lv.width;
             const uint32_t max = anchor_max;
-            for (uint32_t x = 0; x < n; ++x) m[x] = std::uint8_t(kernels::pyr_anchor_mask(m[x], l[x], max));
+            for (uint32_t x = 0; x < n; ++x) m[x] = std::uint8_t(pixel::pyr_anchor_mask(m[x], l[x], max));
         });
     }
     if (sweeps_) {
@@ -78,7 +78,7 @@ bool CpuExecutor::sweep(const PyrLevel& lv, bool once, bool init_rows_first) {
     rows(lv.height, [&](size_t y) {
         if (init_rows_first) init_row(c, lv, parent, uint32_t(y), PYR_INIT_INHERIT);
         const bool row_changed =
-            once ? sweep_row_once(c, lv, uint32_t(y)) : kernels::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u;
+            once ? sweep_row_once(c, lv, uint32_t(y)) : pixel::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u;
         if (row_changed) changed.store(true, std::memory_order_relaxed);
     });
     // Columns in a few wide strips, one per task: each row of a strip is a long contiguous run.
@@ -106,14 +106,14 @@ bool CpuExecutor::sweep_row_once(const PassContext& c, const PyrLevel& lv, uint3
         const uint32_t n = std::min(kSkipBlock, lv.width - b);
         if (!has_unlabelled_fillable(c.mask + row + b, c.labels + row + b, n)) continue;
         const uint32_t start = b == 0 ? row : row + b - 1;
-        changed |= kernels::pyr_sweep_line(c, start, 1u, b == 0 ? n : n + 1, 1u) != 0u;
+        changed |= pixel::pyr_sweep_line(c, start, 1u, b == 0 ? n : n + 1, 1u) != 0u;
     }
     for (uint32_t e = lv.width; e > 0; e -= std::min(kSkipBlock, e)) {
         const uint32_t n = std::min(kSkipBlock, e);
         const uint32_t b = e - n;
         if (!has_unlabelled_fillable(c.mask + row + b, c.labels + row + b, n)) continue;
         const uint32_t start = e == lv.width ? row + e - 1 : row + e;
-        changed |= kernels::pyr_sweep_line(c, start, 0xffffffffu, e == lv.width ? n : n + 1, 1u) != 0u;
+        changed |= pixel::pyr_sweep_line(c, start, 0xffffffffu, e == lv.width ? n : n + 1, 1u) != 0u;
     }
     return changed;
 }

@@ -39,7 +39,7 @@ void CpuExecutor::final_fill_with_edges(int level) {
 // non-fillable texels at the regions' borders), and its schedule reduces to runs of them: a row's run takes the
 // label of the pixel left of it when that one is fillable (so labelled), else of the one right of it, else stays
 // 0; then a column's run of those still unlabelled takes the label above it, else the one below it. So one pass
-// over the rows runs step 5 with a vector kernel that also marks those pixels in a bitmap, and steps 6 a and the
+// over the rows runs step 5 with a vector row that also marks those pixels in a bitmap, and steps 6 a and the
 // downward sweep then touch only the marked pixels; the upward sweep visits the pixels still marked, bottom up.
 
 // Row y's validity bytes: the mask's own, else from the quantized pixels into scratch.

@@ -36,8 +36,8 @@ void CpuExecutor::estimate_normals() {
         } else {
             rows(size_t(h), [&](size_t y) {
                 for (size_t x = 0; x < w; ++x) {
-                    c.robust_texels.store(y * w + x, kernels::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x),
-                                                                               uint32_t(y), radius, scale));
+                    c.robust_texels.store(
+                        y * w + x, pixel::pyr_robust_texel(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius, scale));
                 }
             });
         }
@@ -72,7 +72,7 @@ void CpuExecutor::estimate_normals() {
     rows(size_t(plan_.height), [&](size_t y) {
         for (size_t x = 0; x < w; ++x) {
             const PyrIVec3 q = robust ? robust_normal(c, x, y)
-                                      : kernels::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
+                                      : pixel::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
             store_normal_q(q, normals_.data() + 3 * (y * w + x));
         }
     });
@@ -93,7 +93,7 @@ void CpuExecutor::quantize() {
         for (size_t x = 0; x < w; ++x) {
             const float* p = point(x, y);
             const float* n = normal(x, y);
-            const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+            const PyrQuant q = pixel::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
             store_quant(quant_.data() + kQuantWords * (y * w + x), q.qx, q.qy, q.qz, q.valid, p[2]);
         }
     });
@@ -122,9 +122,9 @@ void CpuExecutor::metric() {
         for (uint32_t x = 0; x < full.width; ++x) {
             out[x] = std::uint8_t(
                 robust
-                    ? kernels::pyr_metric_robust_fillable(c, full.width, full.height, x, uint32_t(y), stride,
-                                                          t.curvature_base, t.curvature_growth, t.depth, t.depth_growth)
-                    : kernels::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y), t.curvature, t.depth));
+                    ? pixel::pyr_metric_robust_fillable(c, full.width, full.height, x, uint32_t(y), stride,
+                                                        t.curvature_base, t.curvature_growth, t.depth, t.depth_growth)
+                    : pixel::pyr_metric_fillable(c, full.width, full.height, x, uint32_t(y), t.curvature, t.depth));
         }
     });
 }
@@ -171,17 +171,17 @@ RobustTexelPlanes CpuExecutor::robust_planes() {
 PyrIVec3 CpuExecutor::robust_normal(const PassContext& c, size_t x, size_t y) const {
     const float scale = plan_.thresholds.point_scale;
     const float* p = point(x, y);
-    if (kernels::pyr_point_valid(p[0], p[1], p[2]) != 0u) {
-        const std::int32_t zi = kernels::pyr_robust_fixed(p[2], scale);
+    if (pixel::pyr_point_valid(p[0], p[1], p[2]) != 0u) {
+        const std::int32_t zi = pixel::pyr_robust_fixed(p[2], scale);
         if (windows_.all_members(x, y, zi, zi >> 4)) {
             PyrIVec3 u{};
             PyrIVec3 v{};
             windows_.sums(x, y, u, v);
-            return kernels::pyr_robust_normal_from_sums(u, v, p[0], p[1], p[2]);
+            return pixel::pyr_robust_normal_from_sums(u, v, p[0], p[1], p[2]);
         }
     }
-    return kernels::pyr_robust_normal_q(c, uint32_t(plan_.width), uint32_t(plan_.height), uint32_t(x), uint32_t(y),
-                                        uint32_t(plan_.params.normal_window), scale);
+    return pixel::pyr_robust_normal_q(c, uint32_t(plan_.width), uint32_t(plan_.height), uint32_t(x), uint32_t(y),
+                                      uint32_t(plan_.params.normal_window), scale);
 }
 
 }  // namespace pyrseg::cpu

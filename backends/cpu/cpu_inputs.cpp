@@ -51,7 +51,7 @@ void CpuExecutor::depth_to_points() {
                 } else {
                     std::memcpy(&bits, row + 4 * x, 4);
                 }
-                const PyrFVec3 p = kernels::pyr_depth_point(bits, format, t.scale, t.ku[x], t.kv[y]);
+                const PyrFVec3 p = pixel::pyr_depth_point(bits, format, t.scale, t.ku[x], t.kv[y]);
                 float* out = depth_points_.data() + 3 * (y * w + x);
                 out[0] = p.x;
                 out[1] = p.y;

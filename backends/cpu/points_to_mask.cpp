@@ -96,7 +96,7 @@ void PointsToMask::release(size_t slot) {
     busy_[slot] = false;
 }
 
-void PointsToMask::run(ThreadPool& pool, const simd::RowKernels& kernels, const PointsToMaskFrame& frame) {
+void PointsToMask::run(ThreadPool& pool, const simd::VectorRows& vector_rows, const PointsToMaskFrame& frame) {
     const size_t threads = pool.size();
     if (scratch_.size() != threads) {  // the first frame
         // Made whole before it is kept: an allocation failing half-way (out_of_memory) must not leave scratch_ sized
@@ -112,14 +112,14 @@ void PointsToMask::run(ThreadPool& pool, const simd::RowKernels& kernels, const 
     pool.parallel_for(rows, grain, [&](size_t y0, size_t y1) {
         size_t slot = 0;
         Scratch& s = acquire(slot);
-        run_rows(kernels, frame, uint32_t(y0), uint32_t(y1), s);
+        run_rows(vector_rows, frame, uint32_t(y0), uint32_t(y1), s);
         release(slot);
     });
 }
 
 // Rows y0 .. y1 - 1 of the mask. The metric of row y reads the quantized rows y - 1 .. y + 1 that exist; row j is
 // made into window[j % 3] once the metric of row j - 2 is done with the row there before it.
-void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskFrame& f, uint32_t y0, uint32_t y1,
+void PointsToMask::run_rows(const simd::VectorRows& vector_rows, const PointsToMaskFrame& f, uint32_t y0, uint32_t y1,
                             Scratch& s) const {
     const size_t w = f.width;
     const uint32_t h = f.height;
@@ -132,7 +132,7 @@ void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskF
     const auto point_row = [&](uint32_t j, size_t role) -> const simd::PointRow& {
         const size_t slot = ring ? j % slots : role;
         if (s.point_rows[slot] != j) {
-            kernels.split_points_row(c.points + size_t(j) * c.row_floats, c.point_floats, f.width, s.points[slot]);
+            vector_rows.split_points_row(c.points + size_t(j) * c.row_floats, c.point_floats, f.width, s.points[slot]);
             s.point_rows[slot] = j;
         }
         return s.points[slot];
@@ -147,8 +147,8 @@ void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskF
         std::uint8_t* valid = f.valid_out != nullptr && own(y) ? f.valid_out + size_t(y) * w : nullptr;
         if (f.given_normals != nullptr) {
             const size_t at = size_t(y) * c.row_floats;
-            kernels.quantize_quant_row(c.points + at, c.point_floats, f.given_normals + at, c.point_floats, f.width,
-                                       quant, valid, out);
+            vector_rows.quantize_quant_row(c.points + at, c.point_floats, f.given_normals + at, c.point_floats, f.width,
+                                           quant, valid, out);
             return;
         }
         float* normals = f.normals_out != nullptr && own(y) ? f.normals_out + 3 * size_t(y) * w : nullptr;
@@ -161,7 +161,7 @@ void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskF
             ahead.at[0] = c.points + (size_t(y) + 1 + r) * c.row_floats;
             ahead.bytes = row_bytes;
         }
-        kernels.normals_quant_row(c, up, row, down, f.width, h, y, r, normals, quant, valid, out, ahead);
+        vector_rows.normals_quant_row(c, up, row, down, f.width, h, y, r, normals, quant, valid, out, ahead);
     };
     uint32_t next = y0 > 0 ? y0 - 1 : 0;  // the next row to make
     for (uint32_t y = y0; y < y1; ++y) {
@@ -177,8 +177,8 @@ void PointsToMask::run_rows(const simd::RowKernels& kernels, const PointsToMaskF
             ahead.at[1] = f.given_normals + at;
             ahead.bytes = row_bytes;
         }
-        kernels.metric_quant_row(above, s.window[y % kWindowRows], below, f.width, f.curvature, f.depth,
-                                 f.mask_out + size_t(y) * w, ahead);
+        vector_rows.metric_quant_row(above, s.window[y % kWindowRows], below, f.width, f.curvature, f.depth,
+                                     f.mask_out + size_t(y) * w, ahead);
     }
 }
 

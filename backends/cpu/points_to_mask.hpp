@@ -7,13 +7,13 @@
 // structures of arrays, with the sums the metric's neighbourhoods share), so that each row is unpacked once, not
 // once for each of the three metric rows that read it; estimated normals read the point rows split the same way
 // (simd::PointRow), each point row split once, not deinterleaved for each of the five normals that read it. The row
-// functions are the vector kernels of backends/cpu/simd: the bytes are those of the separate passes.
+// functions are the vector rows of backends/cpu/simd: the bytes are those of the separate passes.
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "backends/cpu/thread_pool.hpp"
 
@@ -35,7 +35,7 @@ struct PointsToMaskFrame {
 
 class PointsToMask {
 public:
-    void run(ThreadPool& pool, const simd::RowKernels& kernels, const PointsToMaskFrame& frame);
+    void run(ThreadPool& pool, const simd::VectorRows& vector_rows, const PointsToMaskFrame& frame);
 
     // Bytes of the per-thread scratch run allocates on the first frame, for `threads` threads.
     [[nodiscard]] static std::size_t scratch_bytes(std::uint32_t width, std::uint32_t normal_radius,
@@ -53,7 +53,7 @@ private:
     Scratch& acquire(std::size_t& slot);
     void release(std::size_t slot);
     void allocate(Scratch& s, std::uint32_t width, std::uint32_t normal_radius) const;
-    void run_rows(const simd::RowKernels& kernels, const PointsToMaskFrame& f, std::uint32_t y0, std::uint32_t y1,
+    void run_rows(const simd::VectorRows& vector_rows, const PointsToMaskFrame& f, std::uint32_t y0, std::uint32_t y1,
                   Scratch& s) const;
 
     std::vector<Scratch> scratch_;

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "shaders/pyr_types.h"
 
@@ -21,7 +21,7 @@ public:
     // once sized).
     template <class Rows>
     void build(const RobustTexelPlanes& texels, std::size_t width, std::size_t height, std::uint32_t window,
-               const simd::RowKernels* simd, const Rows& rows) {
+               const simd::VectorRows* simd, const Rows& rows) {
         size(width, height, window);
         rows(height, [&](std::size_t y) { prefix_row(texels, y); });
         rows(kComponents, [&](std::size_t k) { accumulate_columns(k); });

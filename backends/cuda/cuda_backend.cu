@@ -56,9 +56,8 @@ static_assert(std::size(kKernelFns) == gpu::kKernelCount);
     } else if (err == cudaErrorLaunchFailure || err == cudaErrorIllegalAddress) {
         fault = gpu::Fault::device_lost;
     }
-    gpu::throw_api_failure({"CUDA", what,
-                            std::string(cudaGetErrorName(err)) + " (" + cudaGetErrorString(err) + ")", fault,
-                            "; the device failed: this Segmenter cannot run it any more"});
+    gpu::throw_api_failure({"CUDA", what, std::string(cudaGetErrorName(err)) + " (" + cudaGetErrorString(err) + ")",
+                            fault, "; the device failed: this Segmenter cannot run it any more"});
 }
 
 void check(cudaError_t err, const char* what) {

@@ -13,11 +13,11 @@
 namespace pyrseg::gpu {
 
 struct ApiFailure {
-    const char* api = "";          // "Vulkan"
-    const char* what = "";         // the call that failed, in the backend's words
-    std::string code;              // the API's name for the code, as its users know it: "VK_ERROR_DEVICE_LOST (-4)"
-    std::optional<Fault> fault;    // the kind the backend sorted the code into; none: pyrseg's bug
-    const char* after_lost = "";   // what the message adds for a lost device: the API's words for what happened
+    const char* api = "";         // "Vulkan"
+    const char* what = "";        // the call that failed, in the backend's words
+    std::string code;             // the API's name for the code, as its users know it: "VK_ERROR_DEVICE_LOST (-4)"
+    std::optional<Fault> fault;   // the kind the backend sorted the code into; none: pyrseg's bug
+    const char* after_lost = "";  // what the message adds for a lost device: the API's words for what happened
 };
 
 // The ErrorCode of a fault of that kind (none: ErrorCode::internal).

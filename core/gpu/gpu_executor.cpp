@@ -12,8 +12,8 @@
 
 #include "core/depth_tables.hpp"
 #include "core/gpu/device_fault.hpp"
+#include "core/gpu/host_frame.hpp"
 #include "core/segment_stats.hpp"
-#include "core/staging.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_depth.h"
 
@@ -30,12 +30,12 @@ struct KernelInfo {
     int dims;
 };
 
-constexpr KernelInfo kKernels[] = {
+constexpr KernelInfo kRows[] = {
 #define PYR_HOST_KERNEL_INFO(name, NAME, dims) {"pyr_k_" #name, #NAME, dims},
     PYR_KERNEL_TABLE(PYR_HOST_KERNEL_INFO)
 #undef PYR_HOST_KERNEL_INFO
 };
-static_assert(std::size(kKernels) == kKernelCount);
+static_assert(std::size(kRows) == kKernelCount);
 
 constexpr const char* kBufferNames[] = {
 #define PYR_HOST_BUFFER_NAME(name, index, TYPE, QUAL) #name,
@@ -66,7 +66,7 @@ public:
         check_fits(plan_, sizes, limits_, device_->description());
         device_->allocate(sizes, uint32_t(plan_.width));
         const size_t px = plan_.pixel_count();
-        staged_.resize(core::StagedResults::kBytesPerPixel * px);
+        staged_.resize(StagedResults::kBytesPerPixel * px);
         host_stats_.resize(plan_.stats_words());
     }
 
@@ -249,7 +249,7 @@ public:
         const size_t px = plan_.pixel_count();
         const size_t full = plan_.full().offset;
         const size_t texel = limits_.mask_texel_bytes;
-        using S = core::StagedResults;
+        using S = StagedResults;
         unsigned char* staged = staged_.data();
         device_->download(Buffer::out, 0, staged + S::kLabels * px, 4 * px);
         if (outputs.raw_labels) device_->download(Buffer::labels, 4 * full, staged + S::kRawLabels * px, 4 * px);
@@ -261,7 +261,7 @@ public:
         out.width = plan_.width;
         out.height = plan_.height;
         out.segment_count = segment_count_;
-        core::unstage_results(staged, px, texel == 4, outputs, !from_mask_, out);
+        unstage_results(staged, px, texel == 4, outputs, !from_mask_, out);
         out.segments.clear();
         if (plan_.stats_slots != 0) {
             const size_t words = std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
@@ -336,9 +336,9 @@ private:
     // Packed clouds go straight from the caller's memory; strided ones through staging sized once per Segmenter.
     void upload_xyz(const CloudView& cloud, const float* data, Buffer b, std::vector<float>& staging) {
         const float* src = data;
-        if (!core::is_packed_xyz(cloud)) {
+        if (!is_packed_xyz(cloud)) {
             staging.resize(3 * plan_.pixel_count());
-            core::pack_xyz(cloud, data, staging.data());
+            pack_xyz(cloud, data, staging.data());
             src = staging.data();
         }
         device_->upload(b, 0, src, 12 * plan_.pixel_count());
@@ -360,7 +360,7 @@ private:
     uint32_t depth_format_ = PYR_DEPTH_U16;
     float depth_scale_ = 0;
     std::vector<uint32_t> host_mask_;
-    std::vector<unsigned char> staged_;  // the frame's results, laid out as core::StagedResults
+    std::vector<unsigned char> staged_;  // the frame's results, laid out as StagedResults
     std::vector<uint32_t> host_stats_;
     uint32_t segment_count_ = 0;
     uint32_t dispatches_ = 0;
@@ -371,13 +371,13 @@ private:
 }  // namespace
 
 const char* kernel_entry_name(Kernel k) {
-    return kKernels[size_t(k)].entry;
+    return kRows[size_t(k)].entry;
 }
 const char* kernel_glsl_name(Kernel k) {
-    return kKernels[size_t(k)].glsl;
+    return kRows[size_t(k)].glsl;
 }
 int kernel_dims(Kernel k) {
-    return kKernels[size_t(k)].dims;
+    return kRows[size_t(k)].dims;
 }
 const char* buffer_name(Buffer b) {
     return kBufferNames[size_t(b)];

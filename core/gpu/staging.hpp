@@ -8,13 +8,13 @@
 #include <vector>
 
 #include "core/gpu/device.hpp"
-#include "core/staging.hpp"
+#include "core/gpu/host_frame.hpp"
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::gpu {
 
 // The staging areas a device needs for the executor's transfers between two waits: in, the points and normals; out,
-// the results (core::StagedResults), the segment count and the statistics words (within the lut buffer's size);
+// the results (StagedResults), the segment count and the statistics words (within the lut buffer's size);
 // each with room for the arena's alignment.
 struct StagingBytes {
     std::size_t upload;
@@ -24,7 +24,7 @@ inline StagingBytes staging_bytes(const BufferSizes& sizes) {
     constexpr std::size_t kAlignmentRoom = 256;
     const std::size_t pixels = sizes[std::size_t(Buffer::out)] / 4;
     return {sizes[std::size_t(Buffer::points)] + sizes[std::size_t(Buffer::normals)] + kAlignmentRoom,
-            core::StagedResults::kBytesPerPixel * pixels + sizes[std::size_t(Buffer::lut)] + kAlignmentRoom};
+            StagedResults::kBytesPerPixel * pixels + sizes[std::size_t(Buffer::lut)] + kAlignmentRoom};
 }
 
 class StagingArena {

@@ -13,12 +13,12 @@ namespace pyrseg::test {
 
 inline std::vector<std::string> target_names() {
     std::vector<std::string> names;
-    for (const cpu::simd::RowKernels* k : cpu::simd::available_targets()) names.emplace_back(k->name);
+    for (const cpu::simd::VectorRows* k : cpu::simd::available_targets()) names.emplace_back(k->name);
     return names;
 }
 
-inline const cpu::simd::RowKernels& kernels_named(const std::string& name) {
-    for (const cpu::simd::RowKernels* k : cpu::simd::available_targets()) {
+inline const cpu::simd::VectorRows& rows_named(const std::string& name) {
+    for (const cpu::simd::VectorRows* k : cpu::simd::available_targets()) {
         if (name == k->name) return *k;
     }
     throw std::runtime_error("no target " + name);

@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
@@ -33,7 +33,7 @@ namespace pyrseg::test {
 namespace {
 
 namespace simd = ::pyrseg::cpu::simd;
-namespace kernels = ::pyrseg::cpu::kernels;
+namespace pixel = ::pyrseg::cpu::pixel;
 using ::pyrseg::cpu::kQuantWords;
 using ::pyrseg::cpu::PassContext;
 
@@ -167,7 +167,7 @@ class CpuSimdRows : public ::testing::TestWithParam<std::string> {};
 
 // pyr_normal_q, pixel by pixel, against the target's normals_row: every size, radius, scale and layout.
 TEST_P(CpuSimdRows, NormalsMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 1;
     const float scales[] = {1.0f, 1e30f, 1e-38f, 1e-30f, 3e36f};
     std::size_t defined = 0;
@@ -188,7 +188,7 @@ TEST_P(CpuSimdRows, NormalsMatchTheSharedFunction) {
                     std::vector<float> expected(packed.size());
                     for (std::uint32_t y = 0; y < h; ++y) {
                         for (std::uint32_t x = 0; x < w; ++x) {
-                            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, std::uint32_t(r));
+                            const PyrIVec3 q = pixel::pyr_normal_q(c, w, h, x, y, std::uint32_t(r));
                             float* n = &expected[3 * (std::size_t(y) * w + x)];
                             n[0] = float(q.x) * PYR_NORMAL_UNIT;
                             n[1] = float(q.y) * PYR_NORMAL_UNIT;
@@ -216,7 +216,7 @@ TEST_P(CpuSimdRows, NormalsMatchTheSharedFunction) {
 // component rounds up to the next power of two in float (2^30 - 1 = 32767 * 32769: u = (32767, -2, a),
 // v = (32767, 32767, b)), parallel tangents, tiny and huge ones.
 TEST_P(CpuSimdRows, NormalsOfCraftedTangentsMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(21);
     const std::uint32_t w = 70;
     const std::uint32_t blocks = 60;
@@ -278,7 +278,7 @@ TEST_P(CpuSimdRows, NormalsOfCraftedTangentsMatchTheSharedFunction) {
     int defined = 0;
     for (std::uint32_t y = 0; y < h; ++y) {
         for (std::uint32_t x = 0; x < w; ++x) {
-            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, 1);
+            const PyrIVec3 q = pixel::pyr_normal_q(c, w, h, x, y, 1);
             float* n = &expected[3 * (std::size_t(y) * w + x)];
             n[0] = float(q.x) * PYR_NORMAL_UNIT;
             n[1] = float(q.y) * PYR_NORMAL_UNIT;
@@ -295,7 +295,7 @@ TEST_P(CpuSimdRows, NormalsOfCraftedTangentsMatchTheSharedFunction) {
 
 // pyr_quantize against quantize_row: special points and normals, ties, components past +-1, layouts.
 TEST_P(CpuSimdRows, QuantizeMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 100;
     for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 131, 1000}) {
         for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{12}}) {
@@ -310,7 +310,7 @@ TEST_P(CpuSimdRows, QuantizeMatchesTheSharedFunction) {
                 for (std::size_t x = 0; x < std::size_t(w); ++x) {
                     const float* p = &lp.floats[x * pf];
                     const float* n = &ln.floats[x * nf];
-                    const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                    const PyrQuant q = pixel::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
                     ::pyrseg::cpu::store_quant(expected.data() + kQuantWords * x, q.qx, q.qy, q.qz, q.valid, p[2]);
                 }
                 k.quantize_row(lp.floats.data(), pf, ln.floats.data(), nf, std::uint32_t(w), actual.data());
@@ -372,7 +372,7 @@ std::uint32_t bits_of(float f) {
 std::string split_difference(const float* points, std::size_t stride, std::uint32_t w, const simd::PointRow& row) {
     for (std::size_t x = 0; x < w; ++x) {
         const float* p = points + x * stride;
-        const std::int32_t valid = kernels::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
+        const std::int32_t valid = pixel::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
         if (bits_of(row.x[x]) != bits_of(p[0]) || bits_of(row.y[x]) != bits_of(p[1]) ||
             bits_of(row.z[x]) != bits_of(p[2]) || row.valid[x] != valid) {
             return "point " + std::to_string(x);
@@ -410,7 +410,7 @@ std::string unpacked_difference(const std::uint32_t* words, std::uint32_t w, con
 // split_points_row against the points and pyr_point_valid, on clouds that end at their last point's third float
 // (the padding of PCL's points is never read past it).
 TEST_P(CpuSimdRows, SplitPointsMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 200;
     for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 131, 1000}) {
         for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{7}}) {
@@ -428,7 +428,7 @@ TEST_P(CpuSimdRows, SplitPointsMatchTheSharedFunction) {
 // normals_quant_row, on rows split by split_points_row, against pyr_normal_q and pyr_quantize pixel by pixel:
 // normals, quantize's words, validity bytes and the unpacked row, every size, radius, scale and layout.
 TEST_P(CpuSimdRows, FusedNormalsMatchTheSharedFunctions) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 300;
     std::size_t defined = 0;
     std::size_t pixels = 0;
@@ -455,13 +455,13 @@ TEST_P(CpuSimdRows, FusedNormalsMatchTheSharedFunctions) {
                     for (std::uint32_t y = 0; y < h; ++y) {
                         for (std::uint32_t x = 0; x < w; ++x) {
                             const std::size_t i = std::size_t(y) * w + x;
-                            const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, ur);
+                            const PyrIVec3 q = pixel::pyr_normal_q(c, w, h, x, y, ur);
                             float* n = &expected_normals[3 * i];
                             n[0] = float(q.x) * PYR_NORMAL_UNIT;
                             n[1] = float(q.y) * PYR_NORMAL_UNIT;
                             n[2] = float(q.z) * PYR_NORMAL_UNIT;
                             const float* p = c.points + y * c.row_floats + x * c.point_floats;
-                            const PyrQuant v = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                            const PyrQuant v = pixel::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
                             ::pyrseg::cpu::store_quant(&expected_words[kQuantWords * i], v.qx, v.qy, v.qz, v.valid,
                                                        p[2]);
                             expected_valid[i] = std::uint8_t(v.valid);
@@ -515,7 +515,7 @@ TEST_P(CpuSimdRows, FusedNormalsMatchTheSharedFunctions) {
 // quantize_quant_row against pyr_quantize: quantize's words, validity bytes and the unpacked row, on special points
 // and normals, ties, components past +-1 and layouts (clouds that end at their last point's third float).
 TEST_P(CpuSimdRows, FusedQuantizeMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 400;
     for (const int w : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 18, 31, 33, 64, 65, 131, 1000}) {
         for (const std::size_t pf : {std::size_t{3}, std::size_t{4}, std::size_t{12}}) {
@@ -531,7 +531,7 @@ TEST_P(CpuSimdRows, FusedQuantizeMatchesTheSharedFunction) {
                 for (std::size_t x = 0; x < std::size_t(w); ++x) {
                     const float* p = lp.data() + x * pf;
                     const float* n = ln.data() + x * nf;
-                    const PyrQuant q = kernels::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
+                    const PyrQuant q = pixel::pyr_quantize(p[0], p[1], p[2], n[0], n[1], n[2]);
                     ::pyrseg::cpu::store_quant(expected.data() + kQuantWords * x, q.qx, q.qy, q.qz, q.valid, p[2]);
                     expected_valid[x] = std::uint8_t(q.valid);
                 }
@@ -559,7 +559,7 @@ TEST_P(CpuSimdRows, FusedQuantizeMatchesTheSharedFunction) {
 // quantizes back to qn; a tiny normal for a valid qn of 0, none for a pixel that is not valid) and quantized by
 // quantize_quant_row, a row at a time as the fused front end does; the expected bytes come from pyr_quantize's words
 // of the same points and normals (a pixel whose depth is not a valid point's is then not valid either).
-void check_fused_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h,
+void check_fused_metric(const simd::VectorRows& k, std::uint32_t w, std::uint32_t h,
                         const std::vector<QuantPixel>& quant, std::int32_t tc, float dt) {
     std::vector<float> points(3 * quant.size());
     std::vector<float> normals(3 * quant.size());
@@ -573,7 +573,7 @@ void check_fused_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_
         point[2] = p.z;
         for (int c = 0; c < 3; ++c) normal[c] = p.valid != 0 ? float(p.q[c]) / 8192.0f : 0.0f;
         if (p.valid != 0 && p.q[0] == 0 && p.q[1] == 0 && p.q[2] == 0) normal[0] = 1e-7f;
-        const PyrQuant q = kernels::pyr_quantize(point[0], point[1], point[2], normal[0], normal[1], normal[2]);
+        const PyrQuant q = pixel::pyr_quantize(point[0], point[1], point[2], normal[0], normal[1], normal[2]);
         ::pyrseg::cpu::store_quant(&words[kQuantWords * i], q.qx, q.qy, q.qz, q.valid, point[2]);
     }
     PassContext c;
@@ -591,7 +591,7 @@ void check_fused_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_
     ahead.bytes = points.size() * sizeof(float);
     for (std::uint32_t y = 0; y < h; ++y) {
         for (std::uint32_t x = 0; x < w; ++x) {
-            expected[std::size_t(y) * w + x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+            expected[std::size_t(y) * w + x] = std::uint8_t(pixel::pyr_metric_fillable(c, w, h, x, y, tc, dt));
         }
         k.metric_quant_row(y > 0 ? &store.quant[y - 1] : nullptr, store.quant[y],
                            y + 1 < h ? &store.quant[y + 1] : nullptr, w, tc, dt, actual.data() + std::size_t(y) * w,
@@ -603,7 +603,7 @@ void check_fused_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_
 
 // pyr_metric_fillable against metric_row over a whole image (and against metric_quant_row: check_fused_metric);
 // returns how many pixels are fillable.
-int check_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h, const std::vector<QuantPixel>& quant,
+int check_metric(const simd::VectorRows& k, std::uint32_t w, std::uint32_t h, const std::vector<QuantPixel>& quant,
                  std::int32_t tc, float dt) {
     check_fused_metric(k, w, h, quant, tc, dt);
     const std::vector<std::uint32_t> words = to_words(quant);
@@ -614,7 +614,7 @@ int check_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h, co
     int fillable = 0;
     for (std::uint32_t y = 0; y < h; ++y) {
         for (std::uint32_t x = 0; x < w; ++x) {
-            expected[std::size_t(y) * w + x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+            expected[std::size_t(y) * w + x] = std::uint8_t(pixel::pyr_metric_fillable(c, w, h, x, y, tc, dt));
             fillable += expected[std::size_t(y) * w + x];
         }
         k.metric_row(c, w, h, y, tc, dt, actual.data() + std::size_t(y) * w);
@@ -626,7 +626,7 @@ int check_metric(const simd::RowKernels& k, std::uint32_t w, std::uint32_t h, co
 
 // Random quantized pixels (random validity, qn, depths of every magnitude) and thresholds over their whole range.
 TEST_P(CpuSimdRows, MetricMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(5);
     std::uniform_int_distribution<int> qn(-8192, 8192);
     std::uniform_int_distribution<int> near(-40, 40);
@@ -668,7 +668,7 @@ TEST_P(CpuSimdRows, MetricMatchesTheSharedFunction) {
 
 // The thresholds' ties: s == k * tc (fillable) and dmax - dmin == dt (fillable), on many pixels.
 TEST_P(CpuSimdRows, MetricTiesMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(6);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     const float depths[] = {1000.0f, 1001.0f, 1003.0f, 1000.5f};
@@ -695,7 +695,7 @@ TEST_P(CpuSimdRows, MetricTiesMatchTheSharedFunction) {
 // pyr_mip_texel against mip_row, called as the CPU backend calls it, on random mask bytes (all bits set at random:
 // only bit 0 counts).
 TEST_P(CpuSimdRows, MipMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(9);
     for (int cw = 1; cw <= 140; cw += (cw < 40 ? 1 : 13)) {
         for (const int ch : {1, 2, 3, 6, 7}) {
@@ -710,7 +710,7 @@ TEST_P(CpuSimdRows, MipMatchesTheSharedFunction) {
             std::vector<std::uint8_t> actual(expected.size(), 0x77);
             for (std::uint32_t y = 0; y < ph; ++y) {
                 for (std::uint32_t x = 0; x < pw; ++x) {
-                    expected[std::size_t(y) * pw + x] = std::uint8_t(kernels::pyr_mip_texel(c, child, x, y));
+                    expected[std::size_t(y) * pw + x] = std::uint8_t(pixel::pyr_mip_texel(c, child, x, y));
                 }
                 const std::size_t cy = 2 * std::size_t(y);
                 const std::uint8_t* top =
@@ -726,7 +726,7 @@ TEST_P(CpuSimdRows, MipMatchesTheSharedFunction) {
 // pyr_depth_point against depth_row, both formats, on samples that hit every branch (no data, special floats,
 // products that underflow, overflow or turn subnormal), for rows aligned and starting at an odd byte.
 TEST_P(CpuSimdRows, DepthRowMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(13);
     const float special[] = {0.0f,  -0.0f, kDenorm, -kDenorm, kMin, -kMin,  kNaN,  -kNaN,   kInf,
                              -kInf, kMax,  1.0f,    -1.0f,    0.5f, 1e-30f, 1e30f, 3.0e38f, 65535.0f};
@@ -767,7 +767,7 @@ TEST_P(CpuSimdRows, DepthRowMatchesTheSharedFunction) {
                             } else {
                                 std::memcpy(&value, bytes.data() + offset + 4 * x, 4);
                             }
-                            const PyrFVec3 p = kernels::pyr_depth_point(value, format, scale, ku[x], kv);
+                            const PyrFVec3 p = pixel::pyr_depth_point(value, format, scale, ku[x], kv);
                             expected[3 * x] = p.x;
                             expected[3 * x + 1] = p.y;
                             expected[3 * x + 2] = p.z;

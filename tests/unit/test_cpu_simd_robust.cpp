@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/robust_windows.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "pyrseg/presets.hpp"
@@ -29,7 +29,7 @@ namespace pyrseg::test {
 namespace {
 
 namespace simd = ::pyrseg::cpu::simd;
-namespace kernels = ::pyrseg::cpu::kernels;
+namespace pixel = ::pyrseg::cpu::pixel;
 using ::pyrseg::cpu::kQuantWords;
 using ::pyrseg::cpu::PassContext;
 using ::pyrseg::cpu::RobustTexelPlanes;
@@ -105,7 +105,7 @@ const float kScales[] = {16.0f, 1.0f, 0x1p-10f, 0x1p12f, 0x1p20f};
 class CpuSimdRobustRows : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CpuSimdRobustRows, TexelsMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 1;
     std::size_t with_both = 0;
     std::size_t pixels = 0;
@@ -122,7 +122,7 @@ TEST_P(CpuSimdRobustRows, TexelsMatchTheSharedFunction) {
                 for (std::uint32_t y = 0; y < h; ++y) k.robust_texels_row(c, w, h, y, r, scale);
                 for (std::uint32_t y = 0; y < h; ++y) {
                     for (std::uint32_t x = 0; x < w; ++x) {
-                        const PyrRobustTexel e = kernels::pyr_robust_texel(c, w, h, x, y, r, scale);
+                        const PyrRobustTexel e = pixel::pyr_robust_texel(c, w, h, x, y, r, scale);
                         const PyrRobustTexel a = actual.planes.load(std::size_t(y) * w + x);
                         const bool same = a.gz == e.gz && a.tangents == e.tangents && a.th.x == e.th.x &&
                                           a.th.y == e.th.y && a.th.z == e.th.z && a.tv.x == e.tv.x &&
@@ -144,7 +144,7 @@ TEST_P(CpuSimdRobustRows, TexelsMatchTheSharedFunction) {
 // sums, or pixel by pixel where a window holds a non-member); they leave every pixel whose window reaches past the
 // image's columns.
 TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::uint32_t seed = 7;
     std::size_t taken = 0;
     std::size_t left = 0;
@@ -163,7 +163,7 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
                 c.robust_texels = texels.planes;
                 for (std::uint32_t y = 0; y < h; ++y) {
                     for (std::uint32_t x = 0; x < w; ++x) {
-                        texels.planes.store(std::size_t(y) * w + x, kernels::pyr_robust_texel(c, w, h, x, y, r, scale));
+                        texels.planes.store(std::size_t(y) * w + x, pixel::pyr_robust_texel(c, w, h, x, y, r, scale));
                     }
                 }
                 cpu::RobustWindows windows;
@@ -177,11 +177,11 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
                     k.robust_normals_row(c, windows.row(y), w, h, y, window, out.data(), rest.data());
                     for (std::uint32_t x = 0; x < w; ++x) {
                         const float* p = cloud.floats.data() + std::size_t(y) * cloud.row_floats + x * pf;
-                        const bool valid = kernels::pyr_point_valid(p[0], p[1], p[2]) != 0u;
+                        const bool valid = pixel::pyr_point_valid(p[0], p[1], p[2]) != 0u;
                         const bool inside = x >= window && x + window < w;
                         bool members = false;
                         if (valid) {
-                            const std::int32_t zi = kernels::pyr_robust_fixed(p[2], scale);
+                            const std::int32_t zi = pixel::pyr_robust_fixed(p[2], scale);
                             members = windows.all_members(x, y, zi, zi >> 4);
                         }
                         const bool was_left = ((rest[x / 64] >> (x % 64)) & 1u) != 0;
@@ -193,7 +193,7 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
                             ++left;
                             continue;
                         }
-                        const PyrIVec3 q = kernels::pyr_robust_normal_q(c, w, h, x, y, window, scale);
+                        const PyrIVec3 q = pixel::pyr_robust_normal_q(c, w, h, x, y, window, scale);
                         const float e[3] = {float(q.x) * PYR_NORMAL_UNIT, float(q.y) * PYR_NORMAL_UNIT,
                                             float(q.z) * PYR_NORMAL_UNIT};
                         for (std::size_t i = 0; i < 3; ++i) {
@@ -221,7 +221,7 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
 
 // The windows' depth range along a row, clipped at both ends, against the minimum and maximum written out.
 TEST_P(CpuSimdRobustRows, RangeRowMatchesTheWindowsExtremes) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(31);
     for (const std::uint32_t w : {1u, 2u, 5u, 15u, 16u, 17u, 33u, 64u, 100u, 257u}) {
         for (const std::uint32_t r : {1u, 2u, 3u, 7u, 20u}) {
@@ -244,7 +244,7 @@ TEST_P(CpuSimdRobustRows, RangeRowMatchesTheWindowsExtremes) {
 
 // Random quantized pixels, every stride, and thresholds that grow with depth or do not.
 TEST_P(CpuSimdRobustRows, MetricMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(21);
     std::uniform_int_distribution<int> near(-300, 300);
     std::uniform_int_distribution<int> qn(-8192, 8192);
@@ -283,8 +283,8 @@ TEST_P(CpuSimdRobustRows, MetricMatchesTheSharedFunction) {
                 k.metric_robust_row(c, w, h, y, stride, t.base, t.growth, t.dt, t.depth_growth,
                                     actual.data() + std::size_t(y) * w);
                 for (std::uint32_t x = 0; x < w; ++x) {
-                    const std::uint32_t e = kernels::pyr_metric_robust_fillable(c, w, h, x, y, stride, t.base, t.growth,
-                                                                                t.dt, t.depth_growth);
+                    const std::uint32_t e = pixel::pyr_metric_robust_fillable(c, w, h, x, y, stride, t.base, t.growth,
+                                                                              t.dt, t.depth_growth);
                     ASSERT_EQ(std::uint32_t(actual[std::size_t(y) * w + x]), e)
                         << s.w << "x" << s.h << " stride=" << stride << " thresholds " << round << " pixel " << x << ","
                         << y;

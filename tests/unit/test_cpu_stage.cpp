@@ -1,4 +1,4 @@
-// The CPU backend's segmentation stage on the vector kernels: step 5's label init row (inherit_row) and step 6c's
+// The CPU backend's segmentation stage on the vector rows: step 5's label init row (inherit_row) and step 6c's
 // edge row (edge_row) against the shared functions on every Highway target this CPU runs, and whole masks (noise,
 // thin lines and single pixels, which make step 6's runs, blocks and band borders, at odd sizes) segmented on every
 // target against the scalar path, whose steps are the shared functions pixel by pixel.
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "backends/cpu/thread_pool.hpp"
 #include "backends/cpu/union_find_fill.hpp"
@@ -26,7 +26,7 @@ namespace pyrseg::test {
 namespace {
 
 namespace simd = ::pyrseg::cpu::simd;
-namespace kernels = ::pyrseg::cpu::kernels;
+namespace pixel = ::pyrseg::cpu::pixel;
 using ::pyrseg::cpu::PassContext;
 
 const std::uint32_t kWidths[] = {1, 2, 3, 4, 5, 7, 8, 15, 16, 17, 31, 32, 33, 63, 64, 65, 66, 127, 129, 130, 257, 1000};
@@ -36,7 +36,7 @@ class CpuStageRows : public ::testing::TestWithParam<std::string> {};
 // pyr_label_init_texel (PYR_INIT_INHERIT) pixel by pixel against inherit_row, and the bitmap of the fillable pixels
 // it leaves at 0; masks with every bit pattern, parents with zeros.
 TEST_P(CpuStageRows, InheritRowMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(11);
     for (const std::uint32_t w : kWidths) {
         for (int trial = 0; trial < 6; ++trial) {
@@ -61,7 +61,7 @@ TEST_P(CpuStageRows, InheritRowMatchesTheSharedFunction) {
             k.inherit_row(mask.data() + pw, labels.data(), w, without.data(), nullptr);
             bool expected_any = false;
             for (std::uint32_t x = 0; x < w; ++x) {
-                const std::uint32_t e = kernels::pyr_label_init_texel(c, level, parent, x, 0, PYR_INIT_INHERIT);
+                const std::uint32_t e = pixel::pyr_label_init_texel(c, level, parent, x, 0, PYR_INIT_INHERIT);
                 ASSERT_EQ(actual[x], e) << "width " << w << " x " << x;
                 ASSERT_EQ(without[x], e) << "width " << w << " x " << x;
                 const bool hole = (mask[pw + x] & PYR_MASK_FILLABLE) != 0 && e == 0;
@@ -81,7 +81,7 @@ TEST_P(CpuStageRows, InheritRowMatchesTheSharedFunction) {
 // words, single bits, none), neighbours fillable or not, labelled or not; the marks of the pixels that took a label
 // are cleared and no word past the row is touched.
 TEST_P(CpuStageRows, ColumnStepMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(23);
     for (const std::uint32_t w : kWidths) {
         for (int trial = 0; trial < 8; ++trial) {
@@ -103,7 +103,7 @@ TEST_P(CpuStageRows, ColumnStepMatchesTheSharedFunction) {
             bool expected_took = false;
             for (std::uint32_t x = 0; x < w; ++x) {
                 if (((marked[x / 64] >> (x % 64)) & 1u) == 0) continue;
-                expected[x] = kernels::pyr_fill_step(row[x], PYR_MASK_FILLABLE, from[x], from_mask[x], 1u);
+                expected[x] = pixel::pyr_fill_step(row[x], PYR_MASK_FILLABLE, from[x], from_mask[x], 1u);
                 if (expected[x] != 0) {
                     expected_marks[x / 64] &= ~(std::uint64_t{1} << (x % 64));
                     expected_took = true;
@@ -121,7 +121,7 @@ TEST_P(CpuStageRows, ColumnStepMatchesTheSharedFunction) {
 // left, an unlabelled fillable pixel takes the label of a fillable, labelled neighbour, visible to the next pixel),
 // on rows marked as inherit_row leaves them: runs of every length, across words, at the row's ends, whole rows.
 TEST_P(CpuStageRows, RowRunsMatchTheContractsRowSweeps) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(31);
     for (const std::uint32_t w : kWidths) {
         for (int trial = 0; trial < 10; ++trial) {
@@ -176,7 +176,7 @@ TEST_P(CpuStageRows, RowRunsMatchTheContractsRowSweeps) {
 // compact_row against the table lookup: long runs of one label (many vectors' worth), short ones, zeros inside runs,
 // a new label at every pixel.
 TEST_P(CpuStageRows, CompactRowMatchesTheTable) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(29);
     std::vector<std::uint32_t> lut(4096);
     for (std::size_t i = 1; i < lut.size(); ++i) lut[i] = std::uint32_t(rng());
@@ -200,7 +200,7 @@ TEST_P(CpuStageRows, CompactRowMatchesTheTable) {
 // pyr_edge_label (round 1) against edge_row (and edge_row_from_candidates) on three-row images whose non-fillable
 // pixels are unlabelled (the contract's state), and the minimum with the pixel's own label when it has one.
 TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(12);
     for (const std::uint32_t w : kWidths) {
         for (std::uint32_t h = 1; h <= 3; ++h) {
@@ -226,14 +226,14 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
                     for (std::uint32_t x = 0; x < w; ++x) {
                         const std::size_t i = std::size_t(y) * w + x;
                         if (!own_labels) {
-                            expected[i] = kernels::pyr_edge_label(c, level, x, y, 1u);
+                            expected[i] = pixel::pyr_edge_label(c, level, x, y, 1u);
                             continue;
                         }
                         // With its own label: the minimum of it and what it would get unlabelled.
                         const std::uint32_t own = labels[i];
                         const bool edge = (mask[i] & PYR_MASK_FILLABLE) == 0 && valid[i] != 0;
                         if (edge) labels[i] = 0;
-                        const std::uint32_t fresh = kernels::pyr_edge_label(c, level, x, y, 1u);
+                        const std::uint32_t fresh = pixel::pyr_edge_label(c, level, x, y, 1u);
                         labels[i] = own;
                         if (edge && own != 0 && (fresh == 0 || own < fresh))
                             expected[i] = own;
@@ -279,7 +279,7 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
 // ones, which must not count), labels on fillable pixels and on pixels labelled in a round; exactly the pixels whose
 // label pyr_edge_label changes are marked, with that label, and nothing is written past the row.
 TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
-    const simd::RowKernels& k = kernels_named(GetParam());
+    const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(13);
     std::size_t taken = 0;
     for (const std::uint32_t w : kWidths) {
@@ -317,7 +317,7 @@ TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
                         valid.data() + i, w, round, out.data(), changed.data());
                     bool expected_any = false;
                     for (std::uint32_t x = 0; x < w; ++x) {
-                        const std::uint32_t expected = kernels::pyr_edge_label(c, level, x, y, round);
+                        const std::uint32_t expected = pixel::pyr_edge_label(c, level, x, y, round);
                         const bool takes = expected != labels[i + x];
                         const bool marked = ((changed.data()[x / 64] >> (x % 64)) & 1u) != 0;
                         ASSERT_EQ(marked, takes) << w << "x" << h << " round " << round << " pixel " << x << "," << y;

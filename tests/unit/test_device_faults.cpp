@@ -59,12 +59,23 @@ std::string unavailable(const std::string& name) {
     return "not a backend of this build";
 }
 
-// The API's own name for each fault, and the code pyrseg gives it.
+// Each API's own name for the faults, as its users know them. A backend without a row (a new one, until it has its
+// line here) is held to the form every backend's message has (core/gpu/api_error.hpp: "<API>: <what> failed: ...").
+struct ApiWords {
+    const char* backend;
+    const char* out_of_memory;
+    const char* device_lost;
+};
+constexpr ApiWords kApiWords[] = {
+    {"cuda", "cudaErrorMemoryAllocation", "cudaErrorLaunchFailure"},
+    {"vulkan", "VK_ERROR_OUT_OF_DEVICE_MEMORY", "VK_ERROR_DEVICE_LOST"},
+    {"opencl", "CL_MEM_OBJECT_ALLOCATION_FAILURE", "CL_OUT_OF_RESOURCES"},
+};
 std::string api_error(const std::string& backend, Fault fault) {
-    const bool oom = fault == Fault::out_of_memory;
-    if (backend == "vulkan") return oom ? "VK_ERROR_OUT_OF_DEVICE_MEMORY" : "VK_ERROR_DEVICE_LOST";
-    if (backend == "opencl") return oom ? "CL_MEM_OBJECT_ALLOCATION_FAILURE" : "CL_OUT_OF_RESOURCES";
-    return oom ? "cudaErrorMemoryAllocation" : "cudaErrorLaunchFailure";
+    for (const ApiWords& words : kApiWords) {
+        if (backend == words.backend) return fault == Fault::out_of_memory ? words.out_of_memory : words.device_lost;
+    }
+    return " failed: ";
 }
 ErrorCode expected_code(Fault fault) {
     return fault == Fault::out_of_memory ? ErrorCode::out_of_memory : ErrorCode::backend_unavailable;

@@ -75,7 +75,7 @@ TEST(Segmenter, ReportsTimingsOfEveryPass) {
         passes.emplace_back(t.pass);
         EXPECT_GE(t.milliseconds, 0.0);
     }
-    // The CPU's vector kernels run normals, quantize and metric as one pass (PYRSEG_CPU_SIMD=scalar: three).
+    // The CPU's vector rows run normals, quantize and metric as one pass (PYRSEG_CPU_SIMD=scalar: three).
     const char* simd = std::getenv("PYRSEG_CPU_SIMD");
     std::vector<std::string> expected = {"points_to_mask"};
     if (simd != nullptr && std::string(simd) == "scalar") expected = {"normals", "quantize", "metric"};

@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-#include "backends/cpu/cpu_kernels.hpp"
+#include "backends/cpu/cpu_dialect.hpp"
 #include "pyrseg/error.hpp"
 
 #undef HWY_TARGET_INCLUDE
@@ -75,34 +75,34 @@ constexpr std::size_t kMaxLanes = hn::MaxLanes(DF());
 // clang-format on
 
 // This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
-constexpr RowKernels kKernels = {"",
-                                 HWY_TARGET,
-                                 &normals_row,
-                                 &quantize_row,
-                                 &metric_row,
-                                 &mip_row,
-                                 &inherit_row,
-                                 &edge_row,
-                                 &normals_to_row,
-                                 &depth_row,
-                                 &column_step,
-                                 &compact_row,
-                                 &row_runs,
-                                 &split_points_row,
-                                 &normals_quant_row,
-                                 &quantize_quant_row,
-                                 &metric_quant_row,
-                                 &edge_round_row,
-                                 &robust_texels_row,
-                                 &robust_range_row,
-                                 &robust_normals_row,
-                                 &metric_robust_row,
-                                 &edge_candidates,
-                                 &edge_row_from_candidates};
+constexpr VectorRows kRows = {"",
+                              HWY_TARGET,
+                              &normals_row,
+                              &quantize_row,
+                              &metric_row,
+                              &mip_row,
+                              &inherit_row,
+                              &edge_row,
+                              &normals_to_row,
+                              &depth_row,
+                              &column_step,
+                              &compact_row,
+                              &row_runs,
+                              &split_points_row,
+                              &normals_quant_row,
+                              &quantize_quant_row,
+                              &metric_quant_row,
+                              &edge_round_row,
+                              &robust_texels_row,
+                              &robust_range_row,
+                              &robust_normals_row,
+                              &metric_robust_row,
+                              &edge_candidates,
+                              &edge_row_from_candidates};
 
 // Only returns the address of constant data; see available_targets.
-const RowKernels* get_kernels() {
-    return &kKernels;
+const VectorRows* get_rows() {
+    return &kRows;
 }
 
 }  // namespace HWY_NAMESPACE
@@ -112,7 +112,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace pyrseg::cpu::simd {
 
-HWY_EXPORT(get_kernels);
+HWY_EXPORT(get_rows);
 
 namespace {
 
@@ -124,8 +124,8 @@ std::string lower_name(std::int64_t target) {
 }
 
 struct Registry {
-    std::vector<RowKernels> kernels;  // best first
-    std::vector<std::string> names;   // the storage of kernels[i].name
+    std::vector<VectorRows> rows;    // best first
+    std::vector<std::string> names;  // the storage of rows[i].name
 };
 
 // Every entry of the dispatch table that this CPU runs. Calling an entry only returns the address of its target's
@@ -134,23 +134,23 @@ const Registry& registry() {
     static const Registry r = [] {
         Registry out;
         const std::int64_t supported = hwy::SupportedTargets();
-        for (const auto entry : HWY_DISPATCH_TABLE(get_kernels)) {
+        for (const auto entry : HWY_DISPATCH_TABLE(get_rows)) {
             if (entry == nullptr) continue;
-            const RowKernels* k = entry();
+            const VectorRows* k = entry();
             if ((k->target & supported) == 0) continue;
 #if HWY_ARCH_ARM_V7
             // 32-bit Arm's NEON flushes subnormal floats to zero: not the IEEE arithmetic the passes need.
             if (k->target == HWY_NEON) continue;
 #endif
-            const bool seen = std::any_of(out.kernels.begin(), out.kernels.end(),
-                                          [&](const RowKernels& e) { return e.target == k->target; });
-            if (!seen) out.kernels.push_back(*k);
+            const bool seen = std::any_of(out.rows.begin(), out.rows.end(),
+                                          [&](const VectorRows& e) { return e.target == k->target; });
+            if (!seen) out.rows.push_back(*k);
         }
         // Highway's better targets have the lower bits.
-        std::sort(out.kernels.begin(), out.kernels.end(),
-                  [](const RowKernels& a, const RowKernels& b) { return a.target < b.target; });
-        out.names.reserve(out.kernels.size());
-        for (RowKernels& k : out.kernels) {
+        std::sort(out.rows.begin(), out.rows.end(),
+                  [](const VectorRows& a, const VectorRows& b) { return a.target < b.target; });
+        out.names.reserve(out.rows.size());
+        for (VectorRows& k : out.rows) {
             out.names.push_back(lower_name(k.target));
             k.name = out.names.back().c_str();
         }
@@ -159,8 +159,8 @@ const Registry& registry() {
     return r;
 }
 
-const RowKernels* by_target(std::int64_t target) {
-    for (const RowKernels& k : registry().kernels) {
+const VectorRows* by_target(std::int64_t target) {
+    for (const VectorRows& k : registry().rows) {
         if (k.target == target) return &k;
     }
     return nullptr;
@@ -168,29 +168,29 @@ const RowKernels* by_target(std::int64_t target) {
 
 }  // namespace
 
-std::vector<const RowKernels*> available_targets() {
-    std::vector<const RowKernels*> out;
-    for (const RowKernels& k : registry().kernels) out.push_back(&k);
+std::vector<const VectorRows*> available_targets() {
+    std::vector<const VectorRows*> out;
+    for (const VectorRows& k : registry().rows) out.push_back(&k);
     return out;
 }
 
 std::vector<std::string> accepted_names() {
     std::vector<std::string> out = {"scalar"};
-    for (const RowKernels& k : registry().kernels) out.emplace_back(k.name);
+    for (const VectorRows& k : registry().rows) out.emplace_back(k.name);
     return out;
 }
 
-const RowKernels* kernels_from_environment() {
+const VectorRows* rows_from_environment() {
     const char* env = std::getenv("PYRSEG_CPU_SIMD");
     const std::string want = env == nullptr ? "" : env;
     if (want == "scalar") return nullptr;
     if (want.empty() || want == "auto") {
         // Highway's own choice; it is always among the registry's (when not, or with none: the scalar path).
-        const RowKernels* best = by_target(HWY_DYNAMIC_DISPATCH(get_kernels)()->target);
-        if (best != nullptr || registry().kernels.empty()) return best;
-        return &registry().kernels.front();
+        const VectorRows* best = by_target(HWY_DYNAMIC_DISPATCH(get_rows)()->target);
+        if (best != nullptr || registry().rows.empty()) return best;
+        return &registry().rows.front();
     }
-    for (const RowKernels& k : registry().kernels) {
+    for (const VectorRows& k : registry().rows) {
         if (want == k.name) return &k;
     }
     std::string names;

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU backend's per-pixel passes over whole rows with Google Highway vectors (RowKernels below: depth images,
+// The CPU backend's per-pixel passes over whole rows with Google Highway vectors (VectorRows below: depth images,
 // normals, quantize and both metrics, the fused front end's rows, mip, label init, step 6's fill and edges, and
 // compaction's lookup; each family in its *-inl.h file next to this one). Each row function computes, lane by
 // lane, exactly the integer and float operations of the shared scalar function (contraction off, no fused
@@ -67,7 +67,7 @@ struct RobustWindowRow {
 };
 
 // The row functions of one Highway target. Rows are independent: the passes call these from many threads.
-struct RowKernels {
+struct VectorRows {
     const char* name = "";    // the PYRSEG_CPU_SIMD name
     std::int64_t target = 0;  // Highway's HWY_* bit
 
@@ -75,7 +75,7 @@ struct RowKernels {
     void (*normals_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,
                         float* out) = nullptr;
     // One row of quantize (pyr_quantize): w pixels; points and normals each point_floats / normal_floats apart; out
-    // gets kQuantWords words a pixel (cpu_kernels.hpp).
+    // gets kQuantWords words a pixel (cpu_dialect.hpp).
     void (*quantize_row)(const float* points, std::size_t point_floats, const float* normals, std::size_t normal_floats,
                          std::uint32_t w, std::uint32_t* out) = nullptr;
     // Row y of the paper metric (pyr_metric_fillable) over c.quant: w mask bytes, 1 where fillable.
@@ -184,11 +184,11 @@ struct RowKernels {
 };
 
 // The targets of this build that this CPU runs, best first.
-[[nodiscard]] std::vector<const RowKernels*> available_targets();
+[[nodiscard]] std::vector<const VectorRows*> available_targets();
 
-// What PYRSEG_CPU_SIMD asks for (see above): nullptr for "scalar", else the kernels to use. Throws pyrseg::Error
+// What PYRSEG_CPU_SIMD asks for (see above): nullptr for "scalar", else the vector rows to use. Throws pyrseg::Error
 // (invalid_argument) for a value that names nothing available here.
-[[nodiscard]] const RowKernels* kernels_from_environment();
+[[nodiscard]] const VectorRows* rows_from_environment();
 
 // The names PYRSEG_CPU_SIMD accepts here: "scalar", then the available targets, best first.
 [[nodiscard]] std::vector<std::string> accepted_names();

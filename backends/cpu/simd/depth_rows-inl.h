@@ -58,7 +58,7 @@ void depth_row(const void* samples, std::uint32_t format, std::uint32_t w, float
         return v;
     };
     const auto scalar = [&](std::size_t x) {
-        const PyrFVec3 p = kernels::pyr_depth_point(value_at(x), format, scale, ku[x], kv);
+        const PyrFVec3 p = pixel::pyr_depth_point(value_at(x), format, scale, ku[x], kv);
         out[3 * x] = p.x;
         out[3 * x + 1] = p.y;
         out[3 * x + 2] = p.z;

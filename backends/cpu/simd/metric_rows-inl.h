@@ -86,7 +86,7 @@ void metric_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uin
     const DI di;
     const std::size_t n = hn::Lanes(df);
     const auto scalar = [&](std::uint32_t x) {
-        out[x] = std::uint8_t(kernels::pyr_metric_fillable(c, w, h, x, y, tc, dt));
+        out[x] = std::uint8_t(pixel::pyr_metric_fillable(c, w, h, x, y, tc, dt));
     };
     if (std::size_t(w) < n + 2 || n > kMetricChunk) {
         for (std::uint32_t x = 0; x < w; ++x) scalar(x);
@@ -164,7 +164,7 @@ std::uint8_t metric_pixel(const QuantRow* const rows[3], std::uint32_t w, std::u
     }
     PassContext c;
     c.quant = words;
-    return std::uint8_t(kernels::pyr_metric_fillable(c, box_w, box_h, x - x0, box_y, tc, dt));
+    return std::uint8_t(pixel::pyr_metric_fillable(c, box_w, box_h, x - x0, box_y, tc, dt));
 }
 
 // pyr_metric_fillable for the pixels x .. x + n - 1 of a row, which have both horizontal neighbours, from the

@@ -256,13 +256,13 @@ void normals_to_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std:
     const DI di;
     const std::size_t n = hn::Lanes(df);
     const auto scalar = [&](std::uint32_t x) {
-        const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, r);
+        const PyrIVec3 q = pixel::pyr_normal_q(c, w, h, x, y, r);
         float v[3];
         store_normal(q, v);
         if (normals != nullptr) std::copy_n(v, 3, normals + 3 * std::size_t(x));
         if (quant == nullptr) return;
         const float* p = c.points + std::size_t(y) * c.row_floats + std::size_t(x) * c.point_floats;
-        const PyrQuant pq = kernels::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
+        const PyrQuant pq = pixel::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
         store_quant(quant + kQuantWords * x, pq.qx, pq.qy, pq.qz, pq.valid, p[2]);
     };
     const std::size_t pf = c.point_floats;

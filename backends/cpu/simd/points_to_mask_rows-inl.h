@@ -64,7 +64,7 @@ void split_points_row(const float* points, std::size_t point_floats, std::uint32
             out.x[x] = p[0];
             out.y[x] = p[1];
             out.z[x] = p[2];
-            out.valid[x] = kernels::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
+            out.valid[x] = pixel::pyr_point_valid(p[0], p[1], p[2]) != 0 ? -1 : 0;
         }
         return;
     }
@@ -137,12 +137,12 @@ void normals_quant_row(const PassContext& c, const PointRow& up, const PointRow&
     const DI di;
     const std::size_t n = hn::Lanes(df);
     const auto scalar = [&](std::uint32_t x) {
-        const PyrIVec3 q = kernels::pyr_normal_q(c, w, h, x, y, r);
+        const PyrIVec3 q = pixel::pyr_normal_q(c, w, h, x, y, r);
         float v[3];
         store_normal(q, v);
         if (normals != nullptr) std::copy_n(v, 3, normals + 3 * std::size_t(x));
         const float* p = c.points + std::size_t(y) * c.row_floats + std::size_t(x) * c.point_floats;
-        const PyrQuant pq = kernels::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
+        const PyrQuant pq = pixel::pyr_quantize(p[0], p[1], p[2], v[0], v[1], v[2]);
         if (quant != nullptr) store_quant(quant + kQuantWords * x, pq.qx, pq.qy, pq.qz, pq.valid, p[2]);
         if (valid != nullptr) valid[x] = std::uint8_t(pq.valid);
         store_quant_pixel(pq, p[2], out, x);

@@ -37,7 +37,7 @@ void quantize_pixels(const float* points, std::size_t point_floats, const float*
     for (std::size_t x = 0; x < w; ++x) {
         const float* p = points + x * point_floats;
         const float* q = normals + x * normal_floats;
-        const PyrQuant v = kernels::pyr_quantize(p[0], p[1], p[2], q[0], q[1], q[2]);
+        const PyrQuant v = pixel::pyr_quantize(p[0], p[1], p[2], q[0], q[1], q[2]);
         if (quant != nullptr) store_quant(quant + kQuantWords * x, v.qx, v.qy, v.qz, v.valid, p[2]);
         if (valid != nullptr) valid[x] = std::uint8_t(v.valid);
         if (out != nullptr) store_quant_pixel(v, p[2], *out, x);

@@ -17,7 +17,7 @@ void robust_texels_row(const PassContext& c, std::uint32_t w, std::uint32_t h, s
                        float scale) {
     const RobustTexelPlanes& t = c.robust_texels;
     const std::size_t row0 = std::size_t(y) * w;
-    const auto scalar = [&](std::uint32_t x) { t.store(row0 + x, kernels::pyr_robust_texel(c, w, h, x, y, r, scale)); };
+    const auto scalar = [&](std::uint32_t x) { t.store(row0 + x, pixel::pyr_robust_texel(c, w, h, x, y, r, scale)); };
     const DF df;
     const DI di;
     const std::size_t n = hn::Lanes(df);
@@ -192,8 +192,8 @@ void robust_normals_row(const PassContext& c, const RobustWindowRow& sums, std::
 void metric_robust_row(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t stride,
                        float curvature_base, float curvature_growth, float dt, float depth_growth, std::uint8_t* out) {
     const auto scalar = [&](std::uint32_t x) {
-        out[x] = std::uint8_t(kernels::pyr_metric_robust_fillable(c, w, h, x, y, stride, curvature_base,
-                                                                  curvature_growth, dt, depth_growth));
+        out[x] = std::uint8_t(pixel::pyr_metric_robust_fillable(c, w, h, x, y, stride, curvature_base, curvature_growth,
+                                                                dt, depth_growth));
     };
     const DF df;
     const DI di;

@@ -1,6 +1,8 @@
 #pragma once
-// Copying a caller's cloud into packed xyz staging memory: in one memcpy when it is packed already, point by point
-// when it is strided (PCL point types, interleaved normals). Shared by the backends that upload frames.
+// A frame's host side of the GPU executor's transfers: a caller's cloud copied into packed xyz for the upload (in
+// one memcpy when it is packed already, point by point when it is strided: PCL point types, interleaved normals),
+// and the layout of the results it downloads in one copy and unpacks into the Result. The staging memory these
+// bytes pass through is core/gpu/staging.hpp's.
 #include <cstddef>
 #include <cstring>
 
@@ -11,13 +13,13 @@
 #include "pyrseg/result.hpp"
 #include "shaders/pyr_types.h"
 
-namespace pyrseg::core {
+namespace pyrseg::gpu {
 
 // `data` is cloud.points or cloud.normals (same layout); dst holds 3 * width * height floats.
 inline void pack_xyz(const CloudView& cloud, const float* data, float* dst) {
     const std::size_t w = std::size_t(cloud.width);
     const std::size_t h = std::size_t(cloud.height);
-    const CloudLayout layout = cloud_layout(cloud);
+    const core::CloudLayout layout = core::cloud_layout(cloud);
     if (layout.packed(w)) {
         std::memcpy(dst, data, 3 * w * h * sizeof(float));
         return;
@@ -30,7 +32,7 @@ inline void pack_xyz(const CloudView& cloud, const float* data, float* dst) {
 
 // Whether pack_xyz would only copy (the backend may then upload straight from the caller's memory).
 inline bool is_packed_xyz(const CloudView& cloud) {
-    return cloud_layout(cloud).packed(std::size_t(cloud.width));
+    return core::cloud_layout(cloud).packed(std::size_t(cloud.width));
 }
 
 // Where a frame's results lie in a backend's download staging memory (bytes from its start): labels, raw labels,
@@ -76,4 +78,4 @@ inline void unstage_results(const unsigned char* staged, std::size_t pixels, boo
     }
 }
 
-}  // namespace pyrseg::core
+}  // namespace pyrseg::gpu

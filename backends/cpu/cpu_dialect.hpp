@@ -1,5 +1,5 @@
 #pragma once
-// The shared pass functions (shaders/) compiled as C++ for the CPU backend, with the accessor macros reading
+// The CPU backend's dialect file: the per-pixel functions (shaders/) compiled as C++, with the accessor macros reading
 // the backend's buffers through a PassContext. They live in their own namespace so that another backend's
 // host-compiled copy with other accessors can never collide with them.
 #include <atomic>
@@ -98,6 +98,6 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
 #define PYR_STATS_ADD(w, v) std::atomic_ref<std::uint32_t>(ctx.stats[w]).fetch_add((v), std::memory_order_relaxed)
 #define PYR_STATS_MAX(w, v) ::pyrseg::cpu::atomic_max(ctx.stats[w], (v))
 
-namespace pyrseg::cpu::kernels {
+namespace pyrseg::cpu::pixel {
 #include "shaders/pyr_passes.h"
-}  // namespace pyrseg::cpu::kernels
+}  // namespace pyrseg::cpu::pixel

@@ -1,0 +1,349 @@
+// The checks every GPU API's interop passes, once per adapter (device_frames.hpp): device-resident frames give the
+// host path's labels and segment count byte for byte (clouds with and without normals, both metrics, padded rows,
+// data from an offset into its buffer, depth images u16 and f32 with odd row steps and intrinsics that change
+// between frames), several queued back to back before any is read, host and device frames alternating on one
+// Segmenter; bad input is a pyrseg::Error that queues and writes nothing, after which the Segmenter still segments.
+#include "interop/device_frames.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "pyrseg/presets.hpp"
+#include "pyrseg/synthetic.hpp"
+#include "support/oracle.hpp"
+
+namespace pyrseg::test {
+
+Region put(Adapter& api, const void* data, std::size_t bytes, std::size_t at) {
+    const int buffer = api.allocate(at + bytes);
+    api.upload(buffer, at, data, bytes);
+    return {buffer, at};
+}
+
+std::vector<std::uint32_t> words(Adapter& api, int buffer, std::size_t offset, std::size_t count) {
+    const std::vector<unsigned char> bytes = api.download(buffer, offset, 4 * count);
+    std::vector<std::uint32_t> out(count);
+    std::memcpy(out.data(), bytes.data(), bytes.size());
+    return out;
+}
+
+std::vector<unsigned char> pitched(const void* packed, int width, int height, std::size_t item, std::size_t pitch) {
+    std::vector<unsigned char> out(pitch * std::size_t(height), 0xCD);
+    for (int y = 0; y < height; ++y) {
+        std::memcpy(out.data() + std::size_t(y) * pitch,
+                    static_cast<const unsigned char*>(packed) + std::size_t(y) * std::size_t(width) * item,
+                    std::size_t(width) * item);
+    }
+    return out;
+}
+
+std::vector<std::uint32_t> unpitch(const unsigned char* bytes, int width, int height, std::size_t pitch) {
+    std::vector<std::uint32_t> out(std::size_t(width) * std::size_t(height));
+    for (int y = 0; y < height; ++y) {
+        std::memcpy(out.data() + std::size_t(y) * std::size_t(width), bytes + std::size_t(y) * pitch,
+                    4 * std::size_t(width));
+    }
+    return out;
+}
+
+Wall::Wall() : points(3 * kPixels) {
+    for (std::size_t i = 0; i < kPixels; ++i) {
+        points[3 * i] = float(2 * int(i % kWidth) - kWidth);
+        points[3 * i + 1] = float(2 * int(i / kWidth) - kHeight);
+        points[3 * i + 2] = 1000.0f;
+    }
+}
+
+Refusals::Refusals(Adapter& adapter)
+    : api(adapter),
+      segmenter(api.make_segmenter(Wall::kWidth, Wall::kHeight, {})),
+      cloud{put(api, wall.points.data(), 4 * wall.points.size()), {}, 0},
+      depth{put(api, wall.depth.data(), 2 * wall.depth.size()), wall.view} {
+    out.labels = put(api, wall.sentinel.data(), 4 * wall.sentinel.size());
+    out.count = put(api, wall.sentinel.data(), 4);
+}
+
+void Refusals::expect(Segmenter& s, const Frame& frame, const std::string& words, ErrorCode code) {
+    const std::vector<Way> ways = api.ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        SCOPED_TRACE(ways[way].name);
+        expect_error([&] { api.run(s, std::span(&frame, 1), way); }, words, code);
+        expect_untouched();
+    }
+}
+
+void Refusals::expect_untouched() {
+    EXPECT_EQ(test::words(api, out.labels.buffer, 0, Wall::kPixels), wall.sentinel) << "the labels buffer was written";
+    EXPECT_EQ(test::words(api, out.count.buffer, 0, 1)[0], Wall::kSentinel) << "the count was written";
+}
+
+void Refusals::expect_still_segments() {
+    const std::vector<Way> ways = api.ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        SCOPED_TRACE(ways[way].name);
+        for (const Frame& f : {Frame{cloud, out}, Frame{depth, out}}) {
+            api.upload(out.count.buffer, 0, wall.sentinel.data(), 4);
+            api.run(segmenter, std::span(&f, 1), way);
+            EXPECT_EQ(test::words(api, out.count.buffer, 0, 1)[0], 1u) << "a flat wall at 1 m: one segment";
+        }
+    }
+}
+
+namespace {
+
+constexpr std::uint32_t kUntouched = 0xABABABABu;  // what the adapter's buffers hold before anything writes them
+
+struct Scene {
+    const char* what = "";
+    int width = 0;
+    int height = 0;
+    synthetic::Sensor sensor = synthetic::Sensor::structured_light;
+    bool normals = false;
+    Params params;
+    std::size_t cloud_pad = 0;   // extra bytes per row of points
+    std::size_t labels_pad = 0;  // extra bytes per row of labels
+};
+
+const Scene kScenes[] = {
+    {"paper metric, estimated normals, packed", 131, 97, synthetic::Sensor::structured_light, false, Params{}, 0, 0},
+    {"given normals, padded rows", 67, 45, synthetic::Sensor::structured_light, true, Params{}, 20, 12},
+    {"kinect-v1 preset (robust metric), padded", 101, 77, synthetic::Sensor::kinect_v1, false,
+     sensor_preset(SensorKind::kinect_v1), 4, 4},
+    {"a thin strip", 57, 9, synthetic::Sensor::structured_light, false, Params{}, 8, 0},
+};
+
+}  // namespace
+
+TEST_P(DeviceFrames, CloudFramesMatchTheHostPath) {
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        for (const Scene& s : kScenes) {
+            SCOPED_TRACE(ways[way].name + ": " + s.what);
+            synthetic::SceneOptions o;
+            o.width = s.width;
+            o.height = s.height;
+            o.sensor = s.sensor;
+            const synthetic::Scene scene = synthetic::generate(o);
+            CloudView view;
+            view.points = scene.points.data();
+            view.normals = s.normals ? scene.normals.data() : nullptr;
+            view.width = s.width;
+            view.height = s.height;
+            Segmenter cpu(s.width, s.height, s.params, "cpu");
+            const Result expected = cpu.segment(view);
+            ASSERT_GT(expected.segment_count, 0u);
+
+            const std::size_t cloud_pitch = 12 * std::size_t(s.width) + s.cloud_pad;
+            const std::size_t labels_pitch = 4 * std::size_t(s.width) + s.labels_pad;
+            const std::size_t labels_bytes = labels_pitch * std::size_t(s.height);
+            const auto points = pitched(scene.points.data(), s.width, s.height, 12, cloud_pitch);
+            const auto normals = pitched(scene.normals.data(), s.width, s.height, 12, cloud_pitch);
+            Segmenter segmenter = api().make_segmenter(s.width, s.height, s.params);
+            EXPECT_EQ(segmenter.backend_name(), api().backend_name());
+            CloudFrame in;
+            in.points = put(points.data(), points.size(), 16);  // data need not start at the buffer's start
+            if (s.normals) in.normals = put(normals.data(), normals.size());
+            in.row_step_bytes = s.cloud_pad == 0 ? 0 : cloud_pitch;
+
+            // Five frames into five label buffers from byte 8 on (K into the first and last), all queued before
+            // anything is read: the later ones reuse pyrseg's buffers after the earlier ones, in queue order, and
+            // a ring of pyrseg's command buffers comes round.
+            constexpr std::size_t kFrames = 5;
+            std::vector<Frame> frames;
+            std::vector<int> counts;
+            for (std::size_t f = 0; f < kFrames; ++f) {
+                LabelFrame out;
+                out.labels = {api().allocate(labels_bytes + 8), 8};
+                out.row_step_bytes = s.labels_pad == 0 ? 0 : labels_pitch;
+                counts.push_back(api().allocate(16));
+                if (f == 0 || f + 1 == kFrames) out.count = {counts.back(), 8};
+                frames.push_back({in, out});
+            }
+            api().run(segmenter, frames, way);
+            EXPECT_TRUE(segmenter.last_timings().empty());
+            for (std::size_t f = 0; f < kFrames; ++f) {
+                SCOPED_TRACE("frame " + std::to_string(f));
+                const int labels = frames[f].out.labels.buffer;
+                const auto bytes = api().download(labels, 0, labels_bytes + 8);
+                EXPECT_TRUE(same_bytes("labels", unpitch(bytes.data() + 8, s.width, s.height, labels_pitch),
+                                       expected.labels, s.width));
+                EXPECT_EQ(words(labels, 4, 1)[0], kUntouched) << "written before the offset";
+                if (s.labels_pad != 0) {
+                    EXPECT_EQ(words(labels, 8 + 4 * std::size_t(s.width), 1)[0], kUntouched)
+                        << "written in a row's padding";
+                }
+                const std::uint32_t count = words(counts[f], 8, 1)[0];
+                if (frames[f].out.count.buffer != Region::kNone) {
+                    EXPECT_EQ(count, expected.segment_count);
+                } else {
+                    EXPECT_EQ(count, kUntouched) << "K written without a count buffer";
+                }
+            }
+            // The same Segmenter's host path, on the application's queue, then a device frame again.
+            const Result host = segmenter.segment(view);
+            EXPECT_TRUE(same_bytes("host path labels", host.labels, expected.labels, s.width));
+            EXPECT_EQ(host.segment_count, expected.segment_count);
+            const std::vector<unsigned char> blank(labels_bytes + 8, 0xAB);
+            api().upload(frames[0].out.labels.buffer, 0, blank.data(), blank.size());
+            api().run(segmenter, std::span(frames).first(1), way);
+            const auto bytes = api().download(frames[0].out.labels.buffer, 8, labels_bytes);
+            EXPECT_TRUE(same_bytes("labels after a host frame", unpitch(bytes.data(), s.width, s.height, labels_pitch),
+                                   expected.labels, s.width));
+        }
+    }
+}
+
+TEST_P(DeviceFrames, DepthFramesMatchTheHostPath) {
+    synthetic::SceneOptions o;
+    o.width = 93;
+    o.height = 61;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const int w = o.width;
+    const int h = o.height;
+    std::vector<std::uint16_t> u16(std::size_t(w) * std::size_t(h));
+    std::vector<float> f32(u16.size());
+    for (std::size_t i = 0; i < u16.size(); ++i) {
+        const float z = scene.points[3 * i + 2];
+        u16[i] = std::isfinite(z) ? std::uint16_t(std::lround(z)) : 0;
+        f32[i] = i % 53 == 1 ? -z : z * 0.001f;  // metres; NaN and negative samples are missing data
+    }
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Segmenter cpu(w, h, params, "cpu");
+    struct Case {
+        const char* what;
+        const void* samples;
+        DepthFormat format;
+        std::size_t sample;
+        std::size_t pad;
+        std::size_t offset;
+        double metres_per_unit;
+        double fx_scale;
+        double cx_shift;
+    };
+    const Case cases[] = {
+        {"u16 mm, packed", u16.data(), DepthFormat::u16, 2, 0, 0, 0.001, 1.0, 0.3},
+        {"u16 mm, rows of 2W+6 bytes, from byte 6", u16.data(), DepthFormat::u16, 2, 6, 6, 0.001, 1.0, 0.3},
+        {"f32 m, rows of 4W+12 bytes, other intrinsics", f32.data(), DepthFormat::f32, 4, 12, 8, 1.0, 1.2, 0.3},
+        {"u16 mm again, first intrinsics", u16.data(), DepthFormat::u16, 2, 2, 2, 0.001, 1.0, 0.3},
+        {"u16 mm, third intrinsics", u16.data(), DepthFormat::u16, 2, 0, 4, 0.001, 0.9, 0.3},
+        {"u16 mm, rows of 2W+2 bytes, another cx", u16.data(), DepthFormat::u16, 2, 2, 2, 0.001, 1.0, -1.7},
+    };
+    // Every frame's buffers first; then, each way, every frame queued before any is read: each frame's ray table
+    // goes with its own frame, in queue order, while the frames before may still run.
+    std::vector<Frame> frames;
+    std::vector<Result> expected;
+    std::vector<std::vector<unsigned char>> host_samples;
+    for (const Case& c : cases) {
+        const std::size_t pitch = c.sample * std::size_t(w) + c.pad;
+        host_samples.push_back(pitched(c.samples, w, h, c.sample, pitch));
+        const std::vector<unsigned char>& bytes = host_samples.back();
+        const DepthView view{
+            bytes.data(),          c.format,      w, h, pitch, c.metres_per_unit, scene.fx * c.fx_scale, scene.fy,
+            scene.cx + c.cx_shift, scene.cy - 0.2};
+        expected.push_back(cpu.segment(view));
+        EXPECT_GT(expected.back().segment_count, 1u) << c.what;
+        DepthFrame in{put(bytes.data(), bytes.size(), c.offset), view};
+        in.view.depth = nullptr;
+        LabelFrame out;
+        out.labels = {api().allocate(4 * std::size_t(w) * std::size_t(h)), 0};
+        out.count = {api().allocate(4), 0};
+        frames.push_back({in, out});
+    }
+    const auto check = [&](const std::string& how, std::size_t i) {
+        SCOPED_TRACE(how + ": " + cases[i].what);
+        const LabelFrame& out = frames[i].out;
+        EXPECT_TRUE(
+            same_bytes("labels", words(out.labels.buffer, 0, expected[i].labels.size()), expected[i].labels, w));
+        EXPECT_EQ(words(out.count.buffer, 0, 1)[0], expected[i].segment_count);
+        const std::vector<unsigned char> blank(api().size(out.labels.buffer), 0xAB);
+        api().upload(out.labels.buffer, 0, blank.data(), blank.size());
+        api().upload(out.count.buffer, 0, blank.data(), 4);
+    };
+    Segmenter segmenter = api().make_segmenter(w, h, params);
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        api().run(segmenter, frames, way);
+        for (std::size_t i = 0; i < frames.size(); ++i) check(ways[way].name, i);
+        // Host frames and device frames alternate on one Segmenter.
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            SCOPED_TRACE(ways[way].name + ", alternating: " + cases[i].what);
+            DepthView view = std::get<DepthFrame>(frames[i].in).view;
+            view.depth = host_samples[i].data();
+            const Result host = segmenter.segment(view);
+            EXPECT_TRUE(same_bytes("host labels", host.labels, expected[i].labels, w));
+            api().run(segmenter, std::span(frames).subspan(i, 1), way);
+            check(ways[way].name + ", alternating", i);
+        }
+    }
+}
+
+TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
+    Refusals r(api());
+    constexpr int kW = Wall::kWidth;
+    const auto cloud_refused = [&](const CloudFrame& c, const LabelFrame& o, const std::string& words) {
+        r.expect({c, o}, words);
+    };
+    CloudFrame c = r.cloud;
+    c.points = {api().allocate(4 * r.wall.points.size() - 4), 0};
+    cloud_refused(c, r.out, "needs");  // one float short
+    c = r.cloud;
+    c.points.offset = 8;
+    cloud_refused(c, r.out, "needs");  // the offset leaves too little
+    c = r.cloud;
+    c.row_step_bytes = 12 * kW - 4;
+    cloud_refused(c, r.out, "smaller than a row");
+    c = r.cloud;
+    c.row_step_bytes = 12 * kW + 2;
+    cloud_refused(c, r.out, "multiples of 4");
+    c = r.cloud;
+    c.points = {};
+    cloud_refused(c, r.out, "points buffer is missing");
+    LabelFrame o = r.out;
+    o.row_step_bytes = 4 * kW + 4;  // rows that no longer fit the buffer
+    cloud_refused(r.cloud, o, "needs");
+    o = r.out;
+    o.row_step_bytes = 4 * kW + 2;
+    cloud_refused(r.cloud, o, "multiples of 4");
+    o = r.out;
+    o.labels = {};
+    cloud_refused(r.cloud, o, "labels buffer is missing");
+
+    DepthFrame d = r.depth;
+    for (const double m : {0.0, -0.001, std::nan(""), double(INFINITY)}) {
+        d = r.depth;
+        d.view.metres_per_unit = m;
+        r.expect({d, r.out}, "metres_per_unit", ErrorCode::invalid_parameter);
+    }
+    d = r.depth;
+    d.view.fx = 0;
+    r.expect({d, r.out}, "fx", ErrorCode::invalid_parameter);
+    d = r.depth;
+    d.view.fy = std::nan("");
+    r.expect({d, r.out}, "fy", ErrorCode::invalid_parameter);
+    d = r.depth;
+    d.view.cx = INFINITY;
+    r.expect({d, r.out}, "cx", ErrorCode::invalid_parameter);
+    d = r.depth;
+    d.view.depth = r.wall.depth.data();
+    r.expect({d, r.out}, "must be null");
+    d = r.depth;
+    d.view.row_step_bytes = 2 * kW + 1;
+    r.expect({d, r.out}, "multiples of 2");
+    d = r.depth;
+    d.view.width = kW - 1;
+    r.expect({d, r.out}, "31 x 24", ErrorCode::size_mismatch);
+
+    // A Segmenter on another API.
+    Segmenter cpu(Wall::kWidth, Wall::kHeight, {}, "cpu");
+    r.expect(cpu, {r.cloud, r.out}, "does not run on");
+    r.expect(cpu, {r.depth, r.out}, "does not run on");
+
+    r.expect_still_segments();
+}
+
+}  // namespace pyrseg::test

@@ -1,0 +1,182 @@
+#pragma once
+// The device-frame checks every GPU API's interop passes (device_frames.cpp), written once over an adapter that each
+// API implements in its own file (opencl_adapter.cpp, vulkan_adapter.cpp, cuda_adapter.cpp), as OpenMM shares its
+// test bodies across platforms. The adapter is the application's side: a context, queue and buffers it creates
+// itself, and the API's ways of handing pyrseg a frame. Checks only one API has stay in test_<api>_interop.cpp.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "pyrseg/error.hpp"
+#include "pyrseg/segmenter.hpp"
+
+namespace pyrseg::test {
+
+// Where a frame's data is: one of the adapter's buffers (its index; kNone: no buffer) and the offset into it.
+struct Region {
+    static constexpr int kNone = -1;
+    int buffer = kNone;
+    std::size_t offset = 0;
+};
+
+struct CloudFrame {
+    Region points;
+    Region normals;  // kNone: normals are estimated
+    std::size_t row_step_bytes = 0;
+};
+
+struct DepthFrame {
+    Region samples;
+    DepthView view;  // view.depth stays null: the samples are on the device
+};
+
+struct LabelFrame {
+    Region labels;
+    Region count;  // kNone: K is not written
+    std::size_t row_step_bytes = 0;
+};
+
+struct Frame {
+    std::variant<CloudFrame, DepthFrame> in;
+    LabelFrame out;
+};
+
+// One of the API's ways to hand pyrseg frames. A way for refusals only cannot run a frame that is accepted (a
+// Vulkan command buffer never begun: recording anything into it is an error of the caller's).
+struct Way {
+    std::string name;
+    bool refusals_only = false;
+};
+
+class Adapter {
+public:
+    Adapter() = default;
+    virtual ~Adapter() = default;
+    Adapter(const Adapter&) = delete;
+    Adapter& operator=(const Adapter&) = delete;
+
+    // Makes the application's context; why there is none on this machine (the test is skipped), else empty.
+    [[nodiscard]] virtual std::string open() = 0;
+    [[nodiscard]] virtual std::string backend_name() const = 0;
+    [[nodiscard]] virtual std::vector<Way> ways() const = 0;
+    [[nodiscard]] virtual Segmenter make_segmenter(int width, int height, const Params& params) = 0;
+
+    // A buffer of `bytes` on the application's context, every byte 0xAB; its index.
+    [[nodiscard]] virtual int allocate(std::size_t bytes) = 0;
+    [[nodiscard]] virtual std::size_t size(int buffer) const = 0;
+    virtual void upload(int buffer, std::size_t offset, const void* data, std::size_t bytes) = 0;
+    // Once everything queued on the application's queue is done.
+    [[nodiscard]] virtual std::vector<unsigned char> download(int buffer, std::size_t offset, std::size_t bytes) = 0;
+
+    // Hands pyrseg `frames` back to back in way `way` (an index into ways()), none waited for before the next is
+    // queued, and returns once all of them completed. A refused frame throws the pyrseg::Error, having queued
+    // nothing (what only the API can tell, a fence left unsignalled, the adapter checks itself).
+    virtual void run(Segmenter& segmenter, std::span<const Frame> frames, std::size_t way) = 0;
+};
+
+using AdapterFactory = std::unique_ptr<Adapter> (*)();
+
+// A new buffer holding `bytes` of `data` from byte `at` on (0xAB before), as a region from `at`.
+Region put(Adapter& api, const void* data, std::size_t bytes, std::size_t at = 0);
+// `count` 32-bit words of a buffer from byte `offset` on.
+std::vector<std::uint32_t> words(Adapter& api, int buffer, std::size_t offset, std::size_t count);
+
+// A test for each adapter: INSTANTIATE_TEST_SUITE_P(<Api>, DeviceFrames, ::testing::Values(&make_<api>_adapter)).
+class DeviceFrames : public ::testing::TestWithParam<AdapterFactory> {
+protected:
+    void SetUp() override {
+        adapter_ = GetParam()();
+        const std::string why = adapter_->open();
+        if (!why.empty()) GTEST_SKIP() << why;
+    }
+    // The adapter's own checks (the validation layer's messages) run as it closes, inside the test.
+    void TearDown() override { adapter_.reset(); }
+
+    [[nodiscard]] Adapter& api() { return *adapter_; }
+    Region put(const void* data, std::size_t bytes, std::size_t at = 0) { return test::put(api(), data, bytes, at); }
+    std::vector<std::uint32_t> words(int buffer, std::size_t offset, std::size_t count) {
+        return test::words(api(), buffer, offset, count);
+    }
+
+private:
+    std::unique_ptr<Adapter> adapter_;
+};
+
+// One API's own tests on the same adapter, outside the shared suite.
+template <class A>
+class ApiTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const std::string why = api_.emplace().open();
+        if (!why.empty()) GTEST_SKIP() << why;
+    }
+    void TearDown() override { api_.reset(); }
+    [[nodiscard]] A& api() { return *api_; }
+
+private:
+    std::optional<A> api_;
+};
+
+// Rows of `width` items of `item` bytes copied `pitch` bytes apart (the rest 0xCD), as an SDK pads them.
+std::vector<unsigned char> pitched(const void* packed, int width, int height, std::size_t item, std::size_t pitch);
+
+// The labels of a device frame's buffer, rows `pitch` bytes apart, packed again.
+std::vector<std::uint32_t> unpitch(const unsigned char* bytes, int width, int height, std::size_t pitch);
+
+// Expects `call` to throw a pyrseg::Error of `code` whose message names `words`.
+template <class Call>
+void expect_error(const Call& call, const std::string& words, ErrorCode code = ErrorCode::invalid_argument) {
+    SCOPED_TRACE(words);
+    try {
+        call();
+        ADD_FAILURE() << "no error; expected one naming " << words;
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        EXPECT_EQ(e.code(), code) << to_string(e.code()) << ": " << e.what();
+    }
+}
+
+// The frame the refusal checks start from: a flat wall 1 m away, 2 mm between pixels, one segment.
+struct Wall {
+    static constexpr int kWidth = 32;
+    static constexpr int kHeight = 24;
+    static constexpr std::size_t kPixels = std::size_t(kWidth) * kHeight;
+    static constexpr std::uint32_t kSentinel = 0xDEADBEEFu;
+    std::vector<float> points;
+    std::vector<std::uint16_t> depth = std::vector<std::uint16_t>(kPixels, 1000);
+    std::vector<std::uint32_t> sentinel = std::vector<std::uint32_t>(kPixels, kSentinel);
+    DepthView view{nullptr, DepthFormat::u16, kWidth, kHeight, 0, 0.001, 500, 500, 16, 12};  // depth on the device
+    Wall();
+};
+
+// The refusal checks on one adapter: a Segmenter for the wall, good frames of it in the adapter's buffers, labels
+// and count holding a sentinel that no refused frame may change.
+class Refusals {
+public:
+    explicit Refusals(Adapter& api);
+    // `frame` refused with an Error of `code` naming `words` in each of the adapter's ways, nothing written.
+    void expect(Segmenter& segmenter, const Frame& frame, const std::string& words,
+                ErrorCode code = ErrorCode::invalid_argument);
+    void expect(const Frame& frame, const std::string& words, ErrorCode code = ErrorCode::invalid_argument) {
+        expect(segmenter, frame, words, code);
+    }
+    void expect_untouched();
+    // After the refusals: both good frames in every way give the wall's one segment.
+    void expect_still_segments();
+
+    Adapter& api;
+    const Wall wall;
+    Segmenter segmenter;
+    CloudFrame cloud;
+    DepthFrame depth;
+    LabelFrame out;
+};
+
+}  // namespace pyrseg::test
