@@ -12,7 +12,7 @@ std::unique_ptr<Adapter> make_cuda_adapter() {
     return std::make_unique<CudaAdapter>();
 }
 
-INSTANTIATE_TEST_SUITE_P(Cuda, DeviceFrames, ::testing::Values(&make_cuda_adapter));
+INSTANTIATE_TEST_SUITE_P(Cuda, DeviceFrames, ::testing::Values(AdapterMaker{"cuda", &make_cuda_adapter}), adapter_name);
 
 // Why there is no CUDA device here, in pyrseg's words (`pyrseg backends`), else CUDA's; empty when there is one.
 std::string why_no_cuda_device() {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <span>
 #include <string>
 #include <variant>
@@ -81,18 +82,29 @@ public:
     virtual void run(Segmenter& segmenter, std::span<const Frame> frames, std::size_t way) = 0;
 };
 
-using AdapterFactory = std::unique_ptr<Adapter> (*)();
+// An API's adapter maker, named after the API in the tests' names.
+struct AdapterMaker {
+    const char* api;
+    std::unique_ptr<Adapter> (*make)();
+};
+inline void PrintTo(const AdapterMaker& maker, std::ostream* os) {
+    *os << maker.api;
+}
+inline std::string adapter_name(const ::testing::TestParamInfo<AdapterMaker>& info) {
+    return info.param.api;
+}
 
 // A new buffer holding `bytes` of `data` from byte `at` on (0xAB before), as a region from `at`.
 Region put(Adapter& api, const void* data, std::size_t bytes, std::size_t at = 0);
 // `count` 32-bit words of a buffer from byte `offset` on.
 std::vector<std::uint32_t> words(Adapter& api, int buffer, std::size_t offset, std::size_t count);
 
-// A test for each adapter: INSTANTIATE_TEST_SUITE_P(<Api>, DeviceFrames, ::testing::Values(&make_<api>_adapter)).
-class DeviceFrames : public ::testing::TestWithParam<AdapterFactory> {
+// A test for each adapter: INSTANTIATE_TEST_SUITE_P(<Api>, DeviceFrames,
+// ::testing::Values(AdapterMaker{"<api>", &make_<api>_adapter}), adapter_name).
+class DeviceFrames : public ::testing::TestWithParam<AdapterMaker> {
 protected:
     void SetUp() override {
-        adapter_ = GetParam()();
+        adapter_ = GetParam().make();
         const std::string why = adapter_->open();
         if (!why.empty()) GTEST_SKIP() << why;
     }

@@ -9,7 +9,8 @@ std::unique_ptr<Adapter> make_opencl_adapter() {
     return std::make_unique<OpenclAdapter>();
 }
 
-INSTANTIATE_TEST_SUITE_P(Opencl, DeviceFrames, ::testing::Values(&make_opencl_adapter));
+INSTANTIATE_TEST_SUITE_P(Opencl, DeviceFrames, ::testing::Values(AdapterMaker{"opencl", &make_opencl_adapter}),
+                         adapter_name);
 
 }  // namespace
 

@@ -13,7 +13,8 @@ std::unique_ptr<Adapter> make_vulkan_adapter() {
     return std::make_unique<VulkanAdapter>();
 }
 
-INSTANTIATE_TEST_SUITE_P(Vulkan, DeviceFrames, ::testing::Values(&make_vulkan_adapter));
+INSTANTIATE_TEST_SUITE_P(Vulkan, DeviceFrames, ::testing::Values(AdapterMaker{"vulkan", &make_vulkan_adapter}),
+                         adapter_name);
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
