@@ -41,6 +41,7 @@ constexpr const char* kEvalUsage =
     "Usage: pyrseg eval [--sensors NAME,...] [--distances MM,...] [--params preset|default] [--sizes WxH,...]\n"
     "                   [--seeds N] [--bridges W,...] [--noise MM] [--tune-seeds N] [--out-dir DIR] [--quick]\n"
     "       pyrseg eval --noise MM,... [--sizes WxH,...] [--seeds N] [--bridges W,...] [--out-dir DIR] [--quick]\n"
+    "       pyrseg eval --tabletop DIR [--presets NAME,...] [--out-dir DIR]   (real RGB-D frames: --tabletop --help)\n"
     "\n"
     "Measures segmentation quality against ground truth on seeded synthetic bin-picking scenes (boxes, cylinders\n"
     "and spheres touching each other in a bin; seeds 1..N), comparing three labellings:\n"
@@ -864,6 +865,9 @@ void sensor_sweep(const SensorSweep& sweep, const fs::path& out_dir, std::ostrin
 }  // namespace
 
 int cmd_eval(const std::vector<std::string>& argv) {
+    for (const std::string& a : argv) {
+        if (a == "--tabletop" || a.starts_with("--tabletop=")) return cmd_eval_tabletop(argv);
+    }
     std::set<std::string> values = {"sizes",   "seeds",     "noise",  "bridges",   "out-dir",
                                     "sensors", "distances", "params", "tune-seeds"};
     values.insert(kParameterValueOptions.begin(), kParameterValueOptions.end());

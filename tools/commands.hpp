@@ -19,6 +19,8 @@ int cmd_segment(const std::vector<std::string>& args);
 int cmd_backends(const std::vector<std::string>& args);
 int cmd_demo(const std::vector<std::string>& args);
 int cmd_eval(const std::vector<std::string>& args);
+// `pyrseg eval --tabletop DIR` (cmd_eval_tabletop.cpp), which cmd_eval hands over to.
+int cmd_eval_tabletop(const std::vector<std::string>& args);
 int cmd_bench_report(const std::vector<std::string>& args);
 
 // Parameters shared by the commands that segment: --ct --dt --unit-mm --bridge-levels --unjoinable-gap

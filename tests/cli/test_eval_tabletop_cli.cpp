@@ -1,0 +1,72 @@
+// `pyrseg eval --tabletop DIR`, run as a user runs it: on the shared real RealSense frames (skipped when absent) it
+// writes its tables and a picture per frame, the truth finds objects on every frame, and bad input is a usage error.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "cli/cli_runner.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using pyrseg::cli_test::CliRun;
+using pyrseg::cli_test::run;
+
+const fs::path kRealsense = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
+
+TEST(CliEvalTabletop, HelpSaysHowTheTruthIsMadeAndScored) {
+    const CliRun r = run("eval --tabletop x --help");
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* word : {"Usage", "NAME_depth.png", "camera.yml", "RANSAC", "convex hull", "300 pixels",
+                             "found whole", "in parts", "merged with the table", "IoU", "--presets", "--out-dir"}) {
+        EXPECT_NE(r.output.find(word), std::string::npos) << word << "\n" << r.output;
+    }
+    EXPECT_NE(run("eval --help").output.find("--tabletop"), std::string::npos);
+}
+
+TEST(CliEvalTabletop, BadInputIsAUsageError) {
+    CliRun r = run("eval --tabletop /nonexistent/pyrseg");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--tabletop"), std::string::npos) << r.output;
+    const fs::path empty = fs::temp_directory_path() / ("pyrseg_tabletop_empty_" + std::to_string(::getpid()));
+    fs::create_directories(empty);
+    r = run("eval --tabletop " + empty.string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("no NAME_depth.png"), std::string::npos) << r.output;
+    fs::remove_all(empty);
+    if (!fs::exists(kRealsense)) GTEST_SKIP() << "the shared RealSense frames are not in " << kRealsense;
+    r = run("eval --tabletop " + kRealsense.string() + " --presets realsense-d435,nonesuch");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("nonesuch"), std::string::npos) << r.output;
+    r = run("eval --tabletop " + kRealsense.string() + " --depth-scale 0");
+    EXPECT_EQ(r.status, 2) << r.output;
+}
+
+TEST(CliEvalTabletop, TheSharedRealsenseFramesGetTablesAndPictures) {
+    if (!fs::exists(kRealsense)) GTEST_SKIP() << "the shared RealSense frames are not in " << kRealsense;
+    const fs::path out = fs::temp_directory_path() / ("pyrseg_tabletop_" + std::to_string(::getpid()));
+    const CliRun r =
+        run("eval --tabletop " + kRealsense.string() + " --presets realsense-d435,default --out-dir " + out.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(out / "tabletop.md");
+    std::stringstream md;
+    md << in.rdbuf();
+    for (const char* name : {"wood_table_1", "wood_table_3", "low_table_5", "office_table_7"}) {
+        EXPECT_TRUE(fs::exists(out / (std::string("tabletop_") + name + ".png"))) << name;
+        EXPECT_NE(md.str().find(std::string("### ") + name), std::string::npos) << name;
+        // Every frame's truth has a table and at least one object on it.
+        const std::string line = r.output.substr(r.output.find(name));
+        EXPECT_EQ(line.find(": 640 x 480, 0 objects"), std::string::npos) << line.substr(0, 80);
+        EXPECT_EQ(line.substr(0, 100).find("no support plane"), std::string::npos) << line.substr(0, 80);
+    }
+    EXPECT_NE(md.str().find("| `realsense-d435` |"), std::string::npos) << md.str();
+    EXPECT_NE(md.str().find("| `default` |"), std::string::npos) << md.str();
+    fs::remove_all(out);
+}
+
+}  // namespace

@@ -1,0 +1,279 @@
+// `pyrseg eval --tabletop DIR`: pyrseg's presets on real tabletop RGB-D frames against a ground truth made from the
+// depth (tools/eval/tabletop_truth.hpp), with a picture per frame.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pyrseg/io.hpp"
+#include "pyrseg/presets.hpp"
+#include "pyrseg/segmenter.hpp"
+#include "tools/args.hpp"
+#include "tools/commands.hpp"
+#include "tools/eval/tabletop_scores.hpp"
+#include "tools/eval/tabletop_truth.hpp"
+#include "tools/figures.hpp"
+#include "tools/output_files.hpp"
+#include "tools/printable.hpp"
+
+namespace pyrseg::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using io::DepthImage;
+using io::Image;
+using io::Intrinsics;
+
+constexpr const char* kTabletopUsage =
+    "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--calib FILE] [--depth-scale M] [--out-dir DIR]\n"
+    "\n"
+    "Measures pyrseg on real tabletop RGB-D frames: every NAME_depth.png in DIR (16-bit, registered to the colour\n"
+    "camera; NAME_color.png beside it, when there is one, goes into the pictures), the camera from DIR/camera.yml\n"
+    "(or --calib FILE: fx, fy, cx, cy as `pyrseg segment --calib` reads them), depth in millimetres unless\n"
+    "--depth-scale says how many metres one unit is.\n"
+    "\n"
+    "The ground truth is made from the depth, the way the OCID dataset was annotated: the support plane (RANSAC,\n"
+    "refined by least squares; 10 mm tolerance); the table = the plane's inliers in their largest image component;\n"
+    "objects = the pixels 15-400 mm above the plane that project into the table's outline on it (the convex hull),\n"
+    "split into depth-continuous components of at least 300 pixels (touching objects stay one object).\n"
+    "\n"
+    "Per object: found whole (one segment has IoU >= 0.5 with it), found in parts (the union of the segments lying\n"
+    "at least 80% inside it has IoU >= 0.5; parts: those segments), merged with the table (at least 30% of its\n"
+    "pixels carry the table's label, the segment holding most of the table), its best IoU and its unlabelled\n"
+    "pixels. Per frame also the table's largest share in one segment and the time of a frame (CPU backend, the\n"
+    "median of 5). --presets: the sensor presets to compare (default: every one, then the defaults as `default`).\n"
+    "\n"
+    "Writes DIR/tabletop.md (the tables) and DIR/tabletop_NAME.png (colour | ground truth | each preset) into\n"
+    "--out-dir (default pyrseg-eval-tabletop).\n";
+
+// printf into a string (the tables' cells and head).
+template <class... Values>
+std::string printed(const char* fmt, Values... values) {
+    char buffer[512];
+    std::snprintf(buffer, sizeof buffer, fmt, values...);
+    return buffer;
+}
+
+struct Method {
+    std::string name;
+    Params params;
+};
+
+struct Frame {
+    std::string name;
+    DepthImage depth;
+    std::vector<float> metres;
+    eval::TabletopTruth truth;
+    RgbImage color;  // empty without NAME_color.png
+};
+
+std::vector<Method> parse_methods(const std::optional<std::string>& list) {
+    std::vector<Method> out;
+    const auto add = [&out](const std::string& name) {
+        if (name == "default") {
+            out.push_back({name, Params{}});
+            return;
+        }
+        const std::optional<SensorKind> kind = sensor_kind_from_name(name);
+        if (!kind) throw UsageError{"--presets: no sensor preset named '" + printable(name) + "'"};
+        out.push_back({name, sensor_preset(*kind)});
+    };
+    if (!list) {
+        for (const SensorKind k : sensor_kinds()) add(sensor_kind_name(k));
+        add("default");
+        return out;
+    }
+    std::stringstream ss(*list);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        if (item.empty()) throw UsageError{"--presets has an empty name"};
+        add(item);
+    }
+    if (out.empty()) throw UsageError{"--presets is empty"};
+    return out;
+}
+
+RgbImage read_color(const fs::path& path, int width, int height) {
+    if (!fs::exists(path)) return {};
+    const Image png = io::read_png(path);
+    if (png.width != width || png.height != height || png.bit_depth != 8 || png.channels < 3) {
+        std::fprintf(stderr, "pyrseg eval: %s is not an 8-bit colour image of the depth's size; left out\n",
+                     printable(path.string()).c_str());
+        return {};
+    }
+    RgbImage out{width, height, {}};
+    out.rgb.resize(std::size_t(width) * std::size_t(height) * 3);
+    for (std::size_t i = 0; i < std::size_t(width) * std::size_t(height); ++i) {
+        for (std::size_t c = 0; c < 3; ++c) out.rgb[3 * i + c] = png.data[std::size_t(png.channels) * i + c];
+    }
+    return out;
+}
+
+std::vector<fs::path> depth_files(const fs::path& dir) {
+    std::vector<fs::path> depths;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        if (e.is_regular_file() && name.size() > 10 && name.ends_with("_depth.png")) depths.push_back(e.path());
+    }
+    std::sort(depths.begin(), depths.end());
+    if (depths.empty()) throw UsageError{"--tabletop: no NAME_depth.png in " + printable(dir.string())};
+    return depths;
+}
+
+std::vector<Frame> read_frames(const std::vector<fs::path>& depths, double metres_per_unit, const Intrinsics& k) {
+    std::vector<Frame> frames;
+    for (const fs::path& p : depths) {
+        Frame f;
+        const std::string file = p.filename().string();
+        f.name = file.substr(0, file.size() - std::string("_depth.png").size());
+        f.depth = io::read_depth_image(p);
+        f.metres.resize(f.depth.depth.size());
+        for (std::size_t i = 0; i < f.metres.size(); ++i) {
+            const float v = f.depth.depth[i];
+            f.metres[i] = v > 0 ? float(v * metres_per_unit) : 0.0f;
+        }
+        f.truth = eval::make_tabletop_truth(f.depth.width, f.depth.height, f.metres, {k.fx, k.fy, k.cx, k.cy});
+        f.color = read_color(p.parent_path() / (f.name + "_color.png"), f.depth.width, f.depth.height);
+        frames.push_back(std::move(f));
+    }
+    return frames;
+}
+
+// The ground truth as a picture: the table grey, objects in the label colours, no truth black.
+RgbImage truth_picture(const eval::TabletopTruth& truth, int width, int height) {
+    std::vector<std::uint32_t> shown = truth.labels;
+    RgbImage out = colorize(shown, width, height);
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+        if (shown[i] == eval::kTruthTable) {
+            for (std::size_t c = 0; c < 3; ++c) out.rgb[3 * i + c] = 110;
+        }
+    }
+    return out;
+}
+
+struct Totals {
+    std::uint32_t objects = 0, whole = 0, in_parts = 0, parts = 0, merged = 0;
+    double iou_sum = 0, table_share_sum = 0, ms_sum = 0;
+    std::uint64_t object_pixels = 0, unlabelled = 0;
+    std::uint32_t frames = 0;
+    void add(const eval::TabletopScores& s, double ms) {
+        objects += std::uint32_t(s.objects.size());
+        whole += s.whole();
+        in_parts += s.in_parts();
+        merged += s.merged_with_table();
+        for (const eval::TabletopObjectScore& o : s.objects) {
+            parts += o.parts;
+            iou_sum += o.best_iou;
+            object_pixels += o.pixels;
+            unlabelled += o.unlabelled;
+        }
+        table_share_sum += s.table_share;
+        ms_sum += ms;
+        ++frames;
+    }
+};
+
+std::string row(const std::string& first, const Totals& t) {
+    const auto share = [](double a, double b) { return b == 0 ? std::string("-") : printed("%.0f%%", 100 * a / b); };
+    return "| " + first + " | " + std::to_string(t.objects) + " | " + std::to_string(t.whole) + " (" +
+           share(t.whole, t.objects) + ") | " + std::to_string(t.in_parts) + " (" + share(t.in_parts, t.objects) +
+           ") | " + (t.objects == 0 ? std::string("-") : printed("%.1f", double(t.parts) / t.objects)) + " | " +
+           std::to_string(t.merged) + " | " +
+           (t.objects == 0 ? std::string("-") : printed("%.2f", t.iou_sum / t.objects)) + " | " +
+           share(t.table_share_sum, t.frames) + " | " + share(double(t.unlabelled), double(t.object_pixels)) + " | " +
+           (t.frames == 0 ? std::string("-") : printed("%.2f", t.ms_sum / t.frames)) + " |\n";
+}
+
+constexpr const char* kTableHead =
+    "| %s | objects | whole | in parts | parts per object | merged with table | mean best IoU | table in one "
+    "segment | object pixels unlabelled | ms per frame |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+
+double median_ms(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+}  // namespace
+
+int cmd_eval_tabletop(const std::vector<std::string>& argv) {
+    const Args args(argv, {"tabletop", "presets", "calib", "depth-scale", "out-dir"}, {"help"});
+    if (args.flag("help")) {
+        std::fputs(kTabletopUsage, stdout);
+        return 0;
+    }
+    if (!args.positional().empty()) throw UsageError{"--tabletop takes no positional arguments"};
+    const fs::path dir = args.value("tabletop").value_or("");
+    if (dir.empty() || !fs::is_directory(dir)) {
+        throw UsageError{"--tabletop expects a folder of NAME_depth.png frames, got '" + printable(dir.string()) + "'"};
+    }
+    const double metres_per_unit = args.number("depth-scale").value_or(0.001);
+    if (!(metres_per_unit > 0) || metres_per_unit > 1) throw UsageError{"--depth-scale must be in (0, 1] metres"};
+    const std::vector<fs::path> depths = depth_files(dir);
+    const fs::path calib = args.value("calib").value_or((dir / "camera.yml").string());
+    if (!args.value("calib") && !fs::exists(calib)) {
+        throw UsageError{"--tabletop: no camera.yml in " + printable(dir.string()) +
+                         "; give the camera with --calib FILE (fx, fy, cx, cy)"};
+    }
+    const Intrinsics k = io::read_intrinsics(calib);
+    const std::vector<Method> methods = parse_methods(args.value("presets"));
+    const fs::path out_dir = args.value("out-dir").value_or("pyrseg-eval-tabletop");
+    fs::create_directories(out_dir);
+
+    const std::vector<Frame> frames = read_frames(depths, metres_per_unit, k);
+    std::vector<Totals> totals(methods.size());
+    std::ostringstream per_frame;
+    per_frame << "## Per frame\n\n";
+    for (const Frame& f : frames) {
+        const int w = f.depth.width;
+        const int h = f.depth.height;
+        std::printf("%s: %d x %d, %u objects in the ground truth%s\n", f.name.c_str(), w, h, f.truth.objects,
+                    f.truth.found_plane ? "" : " (no support plane found)");
+        per_frame << "### " << f.name << "\n\n" << printed(kTableHead, "method");
+        std::vector<Panel> panels;
+        if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
+        panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
+        for (std::size_t m = 0; m < methods.size(); ++m) {
+            Segmenter segmenter(w, h, methods[m].params, "cpu");
+            const DepthView view = io::depth_view(f.depth, k, metres_per_unit);
+            Result result = segmenter.segment(view);
+            std::vector<double> ms;
+            for (int run = 0; run < 5; ++run) {
+                const auto start = std::chrono::steady_clock::now();
+                result = segmenter.segment(view);
+                ms.push_back(
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+            }
+            const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, result.labels);
+            Totals one;
+            one.add(s, median_ms(ms));
+            totals[m].add(s, median_ms(ms));
+            per_frame << row("`" + methods[m].name + "`", one);
+            panels.push_back({methods[m].name, colorize(result.labels, w, h)});
+        }
+        per_frame << "\n![" << f.name << "](tabletop_" << f.name << ".png)\n\n";
+        write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));
+    }
+
+    std::string command = "pyrseg eval";
+    for (const std::string& a : argv) command += " " + a;
+    std::ostringstream md;
+    md << "# pyrseg eval: real tabletop frames\n\n`" << command << "`: " << frames.size() << " frame"
+       << (frames.size() == 1 ? "" : "s") << " from " << dir.string() << ", CPU backend, "
+       << std::thread::hardware_concurrency() << " hardware threads. Ground truth made from the depth "
+       << "(`pyrseg eval --tabletop --help`).\n\n## In sum\n\n"
+       << printed(kTableHead, "method");
+    for (std::size_t m = 0; m < methods.size(); ++m) md << row("`" + methods[m].name + "`", totals[m]);
+    md << "\n" << per_frame.str();
+    const fs::path report = out_dir / "tabletop.md";
+    write_text_file(report, md.str());
+    std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);
+    std::printf("wrote %s and %zu pictures\n", report.string().c_str(), frames.size());
+    return 0;
+}
+
+}  // namespace pyrseg::cli
