@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -19,6 +20,7 @@
 #include "tools/eval/tabletop_truth.hpp"
 #include "tools/figures.hpp"
 #include "tools/output_files.hpp"
+#include "tools/pcl_peer.hpp"
 #include "tools/printable.hpp"
 
 namespace pyrseg::cli {
@@ -30,7 +32,8 @@ using io::Image;
 using io::Intrinsics;
 
 constexpr const char* kTabletopUsage =
-    "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--calib FILE] [--depth-scale M] [--out-dir DIR]\n"
+    "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--pcl-sensor NAME|none] [--calib FILE]\n"
+    "                   [--depth-scale M] [--out-dir DIR]\n"
     "\n"
     "Measures pyrseg on real tabletop RGB-D frames: every NAME_depth.png in DIR (16-bit, registered to the colour\n"
     "camera; NAME_color.png beside it, when there is one, goes into the pictures), the camera from DIR/camera.yml\n"
@@ -47,6 +50,9 @@ constexpr const char* kTabletopUsage =
     "pixels carry the table's label, the segment holding most of the table), its best IoU and its unlabelled\n"
     "pixels. Per frame also the table's largest share in one segment and the time of a frame (CPU backend, the\n"
     "median of 5). --presets: the sensor presets to compare (default: every one, then the defaults as `default`).\n"
+    "Beside them, when pyrseg is built with PCL: PCL's organized segmentation of the same frame (its cloud in mm),\n"
+    "OrganizedConnectedComponentSegmentation with EdgeAwarePlaneComparator, with the settings `pyrseg eval` tuned\n"
+    "for the sensor model --pcl-sensor names (default realsense-d435; none leaves PCL out), timed once.\n"
     "\n"
     "Writes DIR/tabletop.md (the tables) and DIR/tabletop_NAME.png (colour | ground truth | each preset) into\n"
     "--out-dir (default pyrseg-eval-tabletop).\n";
@@ -62,6 +68,7 @@ std::string printed(const char* fmt, Values... values) {
 struct Method {
     std::string name;
     Params params;
+    std::optional<SensorKind> pcl;  // set: PCL's organized segmentation with the settings tuned for that model
 };
 
 struct Frame {
@@ -76,12 +83,12 @@ std::vector<Method> parse_methods(const std::optional<std::string>& list) {
     std::vector<Method> out;
     const auto add = [&out](const std::string& name) {
         if (name == "default") {
-            out.push_back({name, Params{}});
+            out.push_back({name, Params{}, std::nullopt});
             return;
         }
         const std::optional<SensorKind> kind = sensor_kind_from_name(name);
         if (!kind) throw UsageError{"--presets: no sensor preset named '" + printable(name) + "'"};
-        out.push_back({name, sensor_preset(*kind)});
+        out.push_back({name, sensor_preset(*kind), std::nullopt});
     };
     if (!list) {
         for (const SensorKind k : sensor_kinds()) add(sensor_kind_name(k));
@@ -201,7 +208,7 @@ double median_ms(std::vector<double> v) {
 }  // namespace
 
 int cmd_eval_tabletop(const std::vector<std::string>& argv) {
-    const Args args(argv, {"tabletop", "presets", "calib", "depth-scale", "out-dir"}, {"help"});
+    const Args args(argv, {"tabletop", "presets", "pcl-sensor", "calib", "depth-scale", "out-dir"}, {"help"});
     if (args.flag("help")) {
         std::fputs(kTabletopUsage, stdout);
         return 0;
@@ -220,7 +227,17 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
                          "; give the camera with --calib FILE (fx, fy, cx, cy)"};
     }
     const Intrinsics k = io::read_intrinsics(calib);
-    const std::vector<Method> methods = parse_methods(args.value("presets"));
+    std::vector<Method> methods = parse_methods(args.value("presets"));
+    const std::string pcl_sensor = args.value("pcl-sensor").value_or("realsense-d435");
+    if (pcl_sensor != "none") {
+        const std::optional<SensorKind> kind = sensor_kind_from_name(pcl_sensor);
+        if (!kind) throw UsageError{"--pcl-sensor: no sensor model named '" + printable(pcl_sensor) + "'"};
+        if (const std::string missing = pcl_peer_missing(); missing.empty()) {
+            methods.push_back({"PCL organized (" + pcl_sensor + " settings)", Params{}, kind});
+        } else {
+            std::fprintf(stderr, "pyrseg eval: PCL left out: %s\n", missing.c_str());
+        }
+    }
     const fs::path out_dir = args.value("out-dir").value_or("pyrseg-eval-tabletop");
     fs::create_directories(out_dir);
 
@@ -238,22 +255,33 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
         if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
         panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
         for (std::size_t m = 0; m < methods.size(); ++m) {
-            Segmenter segmenter(w, h, methods[m].params, "cpu");
-            const DepthView view = io::depth_view(f.depth, k, metres_per_unit);
-            Result result = segmenter.segment(view);
-            std::vector<double> ms;
-            for (int run = 0; run < 5; ++run) {
+            std::vector<std::uint32_t> labels;
+            double ms = 0;
+            if (methods[m].pcl) {
+                const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
                 const auto start = std::chrono::steady_clock::now();
-                result = segmenter.segment(view);
-                ms.push_back(
-                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                labels = pcl_segment(cloud, 1.0, methods[m].pcl).labels;
+                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            } else {
+                Segmenter segmenter(w, h, methods[m].params, "cpu");
+                const DepthView view = io::depth_view(f.depth, k, metres_per_unit);
+                Result result = segmenter.segment(view);
+                std::vector<double> times;
+                for (int run = 0; run < 5; ++run) {
+                    const auto start = std::chrono::steady_clock::now();
+                    result = segmenter.segment(view);
+                    times.push_back(
+                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                }
+                labels = std::move(result.labels);
+                ms = median_ms(times);
             }
-            const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, result.labels);
+            const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
             Totals one;
-            one.add(s, median_ms(ms));
-            totals[m].add(s, median_ms(ms));
+            one.add(s, ms);
+            totals[m].add(s, ms);
             per_frame << row("`" + methods[m].name + "`", one);
-            panels.push_back({methods[m].name, colorize(result.labels, w, h)});
+            panels.push_back({methods[m].name, colorize(labels, w, h)});
         }
         per_frame << "\n![" << f.name << "](tabletop_" << f.name << ".png)\n\n";
         write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));

@@ -22,8 +22,9 @@ const fs::path kRealsense = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
 TEST(CliEvalTabletop, HelpSaysHowTheTruthIsMadeAndScored) {
     const CliRun r = run("eval --tabletop x --help");
     EXPECT_EQ(r.status, 0) << r.output;
-    for (const char* word : {"Usage", "NAME_depth.png", "camera.yml", "RANSAC", "convex hull", "300 pixels",
-                             "found whole", "in parts", "merged with the table", "IoU", "--presets", "--out-dir"}) {
+    for (const char* word :
+         {"Usage", "NAME_depth.png", "camera.yml", "RANSAC", "convex hull", "300 pixels", "found whole", "in parts",
+          "merged with the table", "IoU", "--presets", "--pcl-sensor", "--out-dir"}) {
         EXPECT_NE(r.output.find(word), std::string::npos) << word << "\n" << r.output;
     }
     EXPECT_NE(run("eval --help").output.find("--tabletop"), std::string::npos);
@@ -43,6 +44,9 @@ TEST(CliEvalTabletop, BadInputIsAUsageError) {
     r = run("eval --tabletop " + kRealsense.string() + " --presets realsense-d435,nonesuch");
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("nonesuch"), std::string::npos) << r.output;
+    r = run("eval --tabletop " + kRealsense.string() + " --pcl-sensor nonesuch");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--pcl-sensor"), std::string::npos) << r.output;
     r = run("eval --tabletop " + kRealsense.string() + " --depth-scale 0");
     EXPECT_EQ(r.status, 2) << r.output;
 }
