@@ -105,24 +105,25 @@ Points back_project(int width, int height, std::span<const float> depth, const T
     return p;
 }
 
-// The plane through the points, oriented towards the camera at the origin (offset > 0); nullopt-like: a zero normal.
-SupportPlane plane_through(const Vec3& a, const Vec3& b, const Vec3& c) {
-    Vec3 n = cross(sub(b, a), sub(c, a));
-    const double length = norm(n);
-    SupportPlane plane;
-    if (length < 1e-12) {
-        plane.normal = {0, 0, 0};
-        return plane;
-    }
-    n = scaled(n, 1 / length);
-    double d = -dot(n, a);
+// The plane with unit normal n through `point`, oriented towards the camera at the origin (offset >= 0).
+SupportPlane oriented_plane(Vec3 n, const Vec3& point) {
+    double d = -dot(n, point);
     if (d < 0) {
         n = scaled(n, -1);
         d = -d;
     }
+    SupportPlane plane;
     plane.normal = n;
     plane.offset = d;
     return plane;
+}
+
+// The plane through the points, oriented towards the camera (oriented_plane); a zero normal when they are collinear.
+SupportPlane plane_through(const Vec3& a, const Vec3& b, const Vec3& c) {
+    Vec3 n = cross(sub(b, a), sub(c, a));
+    const double length = norm(n);
+    if (length < 1e-12) return SupportPlane{{0, 0, 0}, 0, 0};
+    return oriented_plane(scaled(n, 1 / length), a);
 }
 
 double height_above(const SupportPlane& plane, const Vec3& p) {
@@ -148,16 +149,8 @@ SupportPlane refine(const SupportPlane& plane, const Points& p, double tolerance
             for (std::size_t c = 0; c < 3; ++c) cov[r][c] += q[r] * q[c];
         }
     }
-    SupportPlane out;
-    Vec3 n = smallest_eigenvector(cov);
-    n = scaled(n, 1 / norm(n));
-    double d = -dot(n, centroid);
-    if (d < 0) {
-        n = scaled(n, -1);
-        d = -d;
-    }
-    out.normal = n;
-    out.offset = d;
+    const Vec3 n = smallest_eigenvector(cov);
+    SupportPlane out = oriented_plane(scaled(n, 1 / norm(n)), centroid);
     for (const std::size_t i : p.valid_pixels) out.inliers += std::abs(height_above(out, p.xyz[i])) <= tolerance;
     return out;
 }
