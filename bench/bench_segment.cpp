@@ -1,6 +1,7 @@
 // pyrseg per backend: the whole pipeline (and, as pipeline_depth, from a uint16 depth image back-projected on the
 // device) (with the paper's metric, and as pipeline_robust with the robust metric of
-// the kinect-v1 preset on the same frames, so that its cost shows per pass) (points, with estimated or given normals,
+// the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
+// pipeline_robust_merge with the preset's merge) (points, with estimated or given normals,
 // to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame size,
 // next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers, carry
 // between machines.
@@ -112,9 +113,17 @@ int register_all() {
                         ->Unit(benchmark::kMillisecond)
                         ->UseRealTime();
                 }
-                const Params robust = sensor_preset(SensorKind::kinect_v1);
+                // The robust metric alone (the preset without its merge), then the preset as it is.
+                Params robust = sensor_preset(SensorKind::kinect_v1);
+                robust.merge = false;
                 benchmark::RegisterBenchmark(("pipeline_robust/" + b.name + "/" + suffix).c_str(),
                                              [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, robust); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // The same robust frames with the merge (step 6d): the difference to pipeline_robust is its cost.
+                const Params merged = sensor_preset(SensorKind::kinect_v1);
+                benchmark::RegisterBenchmark(("pipeline_robust_merge/" + b.name + "/" + suffix).c_str(),
+                                             [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
             }

@@ -53,6 +53,9 @@ public:
     [[nodiscard]] virtual bool fuses_edges_into_final_fill() const { return false; }
     virtual void final_fill_with_edges(int /*level*/) {}
     virtual void label_edges() = 0;  // step 6c
+    // Step 6d (Params::merge; docs/algorithm.md section 5b): level N's segments that meet along a convex or flat
+    // boundary take the smallest label of the group they join. Runs on a cloud or depth frame, never on a mask.
+    virtual void merge_segments() = 0;
     // Step 7 marks the labels present at level N, counts them (the segment count K, reported by read_back) and,
     // when apply, renumbers them. compact does all of it, unless the backend returns true here: its label_edges
     // then marks them as well (each row while it is in cache), the pipeline calls mark_labels where label_edges does

@@ -68,17 +68,20 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
         });
         clock.run("fill", [&] { ex.fill_to_fixed_point(n - 1, plan.old_label_max); });  // step 4
         const bool edges = plan.params.label_edges;
+        const bool merge = plan.params.merge;  // a mask frame is refused before (core/segmenter.cpp)
         if (edges && ex.fuses_edges_into_final_fill()) {
             clock.run("final_fill", [&] { ex.final_fill_with_edges(n); });  // steps 5, 6 a, b, c
             // Every label of level N comes from level N - 1 (step 5 copies each one to the four children of its
             // texel, and steps 6 only copy labels): marking that level's labels marks the same set from a quarter
             // of the texels.
-            if (marks) clock.run("edges", [&] { ex.mark_labels(n - 1); });
+            if (marks && !merge) clock.run("edges", [&] { ex.mark_labels(n - 1); });
         } else {
             clock.run("final_fill", [&] { ex.final_fill(n); });        // steps 5, 6 a, b
             if (edges) clock.run("edges", [&] { ex.label_edges(); });  // step 6 c (and the marks, with marks)
         }
-        marked = marks && edges;
+        // The merge changes labels after the edges marked them: the marks are made again after it.
+        if (merge) clock.run("merge", [&] { ex.merge_segments(); });  // step 6d
+        marked = marks && edges && !merge;
     }
     if (marks && !marked) clock.run("compact", [&] { ex.mark_labels(n); });
     clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7

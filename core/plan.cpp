@@ -66,6 +66,37 @@ void check_metric_parameters(const Params& p) {
     }
 }
 
+void check_merge_parameters(const Params& p, Thresholds& t) {
+    if (p.merge_reach < 1 || p.merge_reach > kMaxMergeReach) {
+        bad_parameter("merge_reach must be in 1.." + std::to_string(kMaxMergeReach) + " pixels, got " +
+                      std::to_string(p.merge_reach));
+    }
+    if (!std::isfinite(p.merge_tolerance_mm) || p.merge_tolerance_mm < 0.0) {
+        bad_parameter("merge_tolerance_mm must be a finite number of millimetres >= 0, got " +
+                      std::to_string(p.merge_tolerance_mm));
+    }
+    if (!std::isfinite(p.merge_tolerance_per_m2) || p.merge_tolerance_per_m2 < 0.0) {
+        bad_parameter("merge_tolerance_per_m2 must be a finite number of millimetres per square metre >= 0, got " +
+                      std::to_string(p.merge_tolerance_per_m2));
+    }
+    if (p.merge_min_crossings < 1) {
+        bad_parameter("merge_min_crossings must be >= 1, got " + std::to_string(p.merge_min_crossings));
+    }
+    if (!(p.merge_max_bad_share >= 0.0 && p.merge_max_bad_share <= 1.0)) {
+        bad_parameter("merge_max_bad_share must be a share in 0..1, got " + std::to_string(p.merge_max_bad_share));
+    }
+    const int e = stats_point_shift(p.unit_mm);
+    t.merge_point_scale = std::ldexp(1.0f, e);
+    const double unit = std::ldexp(1.0, e + 13);  // tolerance units per input unit
+    t.merge_tolerance_base = static_cast<float>((p.merge_tolerance_mm / p.unit_mm) * unit);
+    t.merge_tolerance_growth = static_cast<float>(((p.merge_tolerance_per_m2 * 1e-6) * p.unit_mm) * unit);
+    t.merge_share = static_cast<std::uint32_t>(std::nearbyint(p.merge_max_bad_share * 256.0));
+    if (!std::isfinite(t.merge_tolerance_base) || !std::isfinite(t.merge_tolerance_growth)) {
+        bad_parameter("merge_tolerance_mm or merge_tolerance_per_m2 is too large for unit_mm " +
+                      std::to_string(p.unit_mm) + ": the tolerance overflows float32");
+    }
+}
+
 }  // namespace
 
 void check_unit_mm(double unit_mm) {
@@ -110,6 +141,7 @@ Thresholds compute_thresholds(const Params& params) {
                           std::to_string(params.dt_per_m2));
         }
     }
+    check_merge_parameters(params, t);
     return t;
 }
 
@@ -181,6 +213,19 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         plan.unjoinable_level = u;
         plan.old_label_max = std::uint32_t(offsets[std::size_t(u) + 1]);
         plan.max_label = std::uint32_t(offsets[std::size_t(m) + 1]);  // fits: total_texels does
+    }
+    if (params.merge && !plan.small_image) {
+        // Every label's pixels are 4-connected (steps 1 to 6 only copy labels to 4-neighbours, and a texel that
+        // inherits a label has all four children fillable), so the pairs of labels that touch are the edges of a
+        // planar graph on the K <= w_M * h_M segments: at most 3 K of them.
+        const PyrLevel& lm = plan.level(plan.bridge_level);
+        const std::uint64_t pairs = 3 * std::uint64_t(lm.width) * lm.height + 3;
+        const std::uint64_t slots = std::uint64_t(1) << ceil_log2(2 * pairs + 1);
+        if (slots > (kMax32 - plan.max_label) / 4) {
+            throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                        " is too large for the merge's 32-bit pair table");
+        }
+        plan.merge_slots = std::uint32_t(slots);
     }
     plan.keep_normals = outputs.normals;
     if (outputs.segment_stats) {

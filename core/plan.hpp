@@ -19,6 +19,12 @@ struct Thresholds {
     float curvature_growth = 0;
     float depth_growth = 0;
     float point_scale = 1;
+    // The merge (section 5b): its points' fixed point 2^e, its tolerance base + growth * z^2 (units of 2^-(e + 13)
+    // input units) and the bad share it allows, in 256ths.
+    float merge_point_scale = 1;
+    float merge_tolerance_base = 0;
+    float merge_tolerance_growth = 0;
+    std::uint32_t merge_share = 0;
 };
 
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.
@@ -45,6 +51,9 @@ struct Plan {
     // and the fixed point of the point sums, 2^stats_point_shift steps per input unit.
     std::uint32_t stats_slots = 0;
     int stats_point_shift = 0;
+    // The merge's pair table on GPUs (shaders/pyr_merge_table.h): a power of two above twice the pairs a frame can
+    // have; 0 without the merge.
+    std::uint32_t merge_slots = 0;
     // Outputs::normals: the frame returns the normals the metric used, so a backend must keep them per pixel.
     bool keep_normals = false;
 

@@ -204,6 +204,11 @@ Result Segmenter::segment(const CloudView& cloud) {
 void Segmenter::segment_mask(const MaskView& mask, Result& out) {
     Impl& impl = live(impl_);
     if (mask.fillable == nullptr) throw Error(ErrorCode::invalid_argument, "mask.fillable is null");
+    if (impl.plan.params.merge) {
+        throw Error(ErrorCode::invalid_parameter,
+                    "merge measures the boundaries on points and normals: a mask has none (segment a cloud or a "
+                    "depth image, or turn merge off)");
+    }
     check_frame_size("the mask", mask.width, mask.height, impl.plan);
     check_layout("the mask's", mask.row_stride, 1, mask.width, mask.height);
     run_frame(

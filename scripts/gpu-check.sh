@@ -318,7 +318,7 @@ run_bench() {  # run_bench NAME BACKEND_REGEX SIZE_REGEX MIN_TIME LIMIT_S [VAR=V
     return
   fi
   env "$@" PYRSEG_BENCH_MASKS="$work/masks" timeout "$limit" "$bundle/bin/pyrseg_bench" \
-    --benchmark_filter="^(pipeline|pipeline_robust|pipeline_depth|pipeline_device|pipeline_depth_device|stage|fills/maze|fills/spiral)/($backends)/($sizes)" --benchmark_min_time="$min_time" \
+    --benchmark_filter="^(pipeline|pipeline_robust|pipeline_robust_merge|pipeline_depth|pipeline_device|pipeline_depth_device|stage|fills/maze|fills/spiral)/($backends)/($sizes)" --benchmark_min_time="$min_time" \
     --benchmark_out="$report/$name.json" --benchmark_out_format=json || rc=$?
   say "bench $name: $((SECONDS - start)) s, exit $rc"
 }

@@ -75,6 +75,8 @@ __device__ __forceinline__ unsigned pyr_linear_id() {
 #define PYR_UF_LOAD(i) (*static_cast<volatile unsigned*>(&pyr_ctx.fill[i]))
 #define PYR_UF_STORE(i, v) (pyr_ctx.fill[i] = (v))
 #define PYR_UF_MIN(i, v) pyr_cuda_atomic_min(&pyr_ctx.fill[i], (v))
+#define PYR_UF_CAS(i, e, v) pyr_cuda_atomic_cas(&pyr_ctx.fill[i], (e), (v))
+#define PYR_UF_ADD(i, v) pyr_cuda_atomic_add(&pyr_ctx.fill[i], (v))
 #define PYR_ENTRY_ALL 1
 
 #include "pyr_entries.h"

@@ -11,13 +11,15 @@
  *  - PYR_BUF(name): a buffer of the buffer table (shaders/pyr_buffers.h) as an array; PYR_POINT(k) and
  *    PYR_NORMAL(k) (float k of the xyz arrays), PYR_STORE_POINT(k, v), PYR_STORE_NORMAL(k, v), PYR_STORE_MASK(i, v)
  *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer); PYR_UF_LOAD, PYR_UF_STORE
- *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h);
+ *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h), and PYR_UF_CAS and PYR_UF_ADD there for the
+ *    merge (shaders/pyr_merge_table.h);
  *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
  * The host side of every dispatch is core/gpu/gpu_executor.cpp; the argument words of each kernel are listed
  * above it. */
 #ifndef PYR_ENTRIES_H
 #define PYR_ENTRIES_H
 #include "pyr_kernels.h"
+#include "pyr_merge_table.h"
 #include "pyr_uf.h"
 
 #define PYR_SCAN_NONE 0xffffffffu /* no event yet (a barrier is an event of value 0) */
@@ -359,6 +361,57 @@ PYR_KERNEL_2D(edges) {
         PYR_BUF(labels)[i] = l;
         if (round < PYR_ARG(3)) PYR_STORE_MASK(i, PYR_MASK(i) | (round << PYR_MASK_EDGE_SHIFT));
     }
+}
+#endif
+
+/* Step 6d, the merge (shaders/pyr_merge_table.h), five dispatches over the fill scratch buffer. merge_clear (1D,
+ * words): words, lut_size. Label l's parent is l, every slot free. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MERGE_CLEAR)
+PYR_KERNEL_1D(merge_clear) {
+    pyr_u32 k = PYR_I;
+    if (k >= PYR_ARG(0)) return;
+    PYR_UF_STORE(k, k < PYR_ARG(1) ? k : 0u);
+}
+#endif
+
+/* merge_count (2D, w x h): h, offset of level N, reach, point scale (float), tolerance base and growth (floats),
+ * the table's first word, slots - 1. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MERGE_COUNT)
+PYR_KERNEL_2D(merge_count) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= PYR_ARG(0)) return;
+    pyr_merge_count(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, PYR_ARG(2), PYR_ARG_F32(3),
+                    PYR_ARG_F32(4), PYR_ARG_F32(5), PYR_ARG(6), PYR_ARG(7));
+}
+#endif
+
+/* merge_link (1D, slots): the table's first word, slots, minimum crossings, bad share (256ths). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MERGE_LINK)
+PYR_KERNEL_1D(merge_link) {
+    pyr_u32 s = PYR_I;
+    if (s >= PYR_ARG(1)) return;
+    pyr_merge_link(PYR_ENTRY_CTX, PYR_ARG(0), s, PYR_ARG(2), PYR_ARG(3));
+}
+#endif
+
+/* merge_flatten (1D, lut_size): lut_size. Every label points at its root, the smallest label of its group (the
+ * forest no longer changes: a concurrent reader sees the old parent or the root, both ancestors). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MERGE_FLATTEN)
+PYR_KERNEL_1D(merge_flatten) {
+    pyr_u32 l = PYR_I;
+    if (l >= PYR_ARG(0)) return;
+    PYR_UF_STORE(l, pyr_uf_root(PYR_ENTRY_CTX, l));
+}
+#endif
+
+/* merge_apply (1D, pixels): pixels, offset of level N. Each label becomes its group's. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_MERGE_APPLY)
+PYR_KERNEL_1D(merge_apply) {
+    pyr_u32 k = PYR_I;
+    if (k >= PYR_ARG(0)) return;
+    pyr_u32 i = PYR_ARG(1) + k;
+    PYR_BUF(labels)[i] = PYR_UF_LOAD(PYR_BUF(labels)[i]);
 }
 #endif
 

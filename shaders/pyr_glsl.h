@@ -116,5 +116,7 @@ void pyr_store_normal(uint k, float v) {
 #define PYR_UF_LOAD(i) pyr_buf_fill[i]
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
 #define PYR_UF_MIN(i, v) atomicMin(pyr_buf_fill[i], (v))
+#define PYR_UF_CAS(i, e, v) atomicCompSwap(pyr_buf_fill[i], (e), (v))
+#define PYR_UF_ADD(i, v) atomicAdd(pyr_buf_fill[i], (v))
 
 #endif /* PYR_GLSL_H */

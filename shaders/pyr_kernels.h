@@ -31,6 +31,11 @@
     K(uf_gather, UF_GATHER, 1)           \
     K(final_lines, FINAL_LINES, 3)       \
     K(edges, EDGES, 2)                   \
+    K(merge_clear, MERGE_CLEAR, 1)       \
+    K(merge_count, MERGE_COUNT, 2)       \
+    K(merge_link, MERGE_LINK, 1)         \
+    K(merge_flatten, MERGE_FLATTEN, 1)   \
+    K(merge_apply, MERGE_APPLY, 1)       \
     K(lut_mark, LUT_MARK, 1)             \
     K(scan_count, SCAN_COUNT, 1)         \
     K(scan_sums, SCAN_SUMS, 1)           \

@@ -11,16 +11,16 @@
 #define PYR_CTX_PARAM PYR_BUFFER_TABLE(PYR_CL_BUFFER_PARAM) uint pyr_w
 #define PYR_CTX_ARG PYR_BUFFER_TABLE(PYR_CL_BUFFER_ARG) pyr_w
 #define PYR_BUF(name) pyr_buf_##name
-#define PYR_PT(x, y, c) pyr_buf_points[((y) * pyr_w + (x)) * 3u + (c)]
+#define PYR_PT(x, y, c) pyr_buf_points[((y)*pyr_w + (x)) * 3u + (c)]
 #define PYR_TEXEL_WORD(i) pyr_buf_texels[i]
 #define PYR_STORE_TEXEL_WORD(i, v) (pyr_buf_texels[i] = (v))
-#define PYR_Q_VALID(i) (pyr_buf_quant[(i) * 2u + 1u] >> 16u)
-#define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i) * 2u + ((uint)(c) >> 1u)] >> (((uint)(c) & 1u) * 16u))
-#define PYR_QZ(i) pyr_buf_points[(i) * 3u + 2u]
+#define PYR_Q_VALID(i) (pyr_buf_quant[(i)*2u + 1u] >> 16u)
+#define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i)*2u + ((uint)(c) >> 1u)] >> (((uint)(c)&1u) * 16u))
+#define PYR_QZ(i) pyr_buf_points[(i)*3u + 2u]
 #define PYR_MASK(i) ((uint)pyr_buf_mask[i])
 #define PYR_LABEL(i) pyr_buf_labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
-#define PYR_VALID(p) (pyr_buf_quant[(p) * 2u + 1u] >> 16u)
+#define PYR_VALID(p) (pyr_buf_quant[(p)*2u + 1u] >> 16u)
 #define PYR_LUT(l) pyr_buf_lut[l]
 #define PYR_STORE_LUT(l, v) (pyr_buf_lut[l] = (v))
 /* The statistics words follow the label table in its buffer (the host passes where they start). */
@@ -55,10 +55,12 @@ typedef struct PyrArgs {
 #define PYR_NORMAL(k) pyr_buf_normals[k]
 #define PYR_STORE_NORMAL(k, v) (pyr_buf_normals[k] = (v))
 #define PYR_STORE_POINT(k, v) (pyr_buf_points[k] = (v))
-#define PYR_MASK_INPUT(i) (((__global const uint *)pyr_buf_points)[i])
-#define PYR_UF_LOAD(i) (((volatile __global uint *)pyr_buf_fill)[i])
+#define PYR_MASK_INPUT(i) (((__global const uint*)pyr_buf_points)[i])
+#define PYR_UF_LOAD(i) (((volatile __global uint*)pyr_buf_fill)[i])
 #define PYR_UF_STORE(i, v) (pyr_buf_fill[i] = (v))
 #define PYR_UF_MIN(i, v) atomic_min(&pyr_buf_fill[i], (v))
+#define PYR_UF_CAS(i, e, v) atomic_cmpxchg(&pyr_buf_fill[i], (e), (v))
+#define PYR_UF_ADD(i, v) atomic_add(&pyr_buf_fill[i], (v))
 #define PYR_ENTRY_ALL 1
 
 #include "pyr_entries.h"

@@ -10,6 +10,7 @@
 #include "pyr_edges.h"
 #include "pyr_fill.h"
 #include "pyr_labels.h"
+#include "pyr_merge.h"
 #include "pyr_metric.h"
 #include "pyr_mip.h"
 #include "pyr_normals.h"

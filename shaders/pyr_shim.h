@@ -77,17 +77,23 @@
 #define pyr_cuda_atomic_add(p, v) atomicAdd((p), (v))
 #define pyr_cuda_atomic_max(p, v) atomicMax((p), (v))
 #define pyr_cuda_atomic_min(p, v) atomicMin((p), (v))
+#define pyr_cuda_atomic_cas(p, e, v) atomicCAS((p), (e), (v))
 #else
 #include <atomic>
 #define pyr_cuda_atomic_add(p, v) std::atomic_ref<unsigned int>(*(p)).fetch_add((v))
 #define pyr_cuda_atomic_max(p, v) pyr_cuda_host_atomic_max((p), (v))
 #define pyr_cuda_atomic_min(p, v) pyr_cuda_host_atomic_min((p), (v))
+#define pyr_cuda_atomic_cas(p, e, v) pyr_cuda_host_atomic_cas((p), (e), (v))
 static inline unsigned int pyr_cuda_host_atomic_max(unsigned int* p, unsigned int v) {
     std::atomic_ref<unsigned int> a(*p);
     unsigned int old = a.load();
     while (old < v && !a.compare_exchange_weak(old, v)) {
     }
     return old;
+}
+static inline unsigned int pyr_cuda_host_atomic_cas(unsigned int* p, unsigned int expected, unsigned int v) {
+    std::atomic_ref<unsigned int>(*p).compare_exchange_strong(expected, v);
+    return expected;
 }
 static inline unsigned int pyr_cuda_host_atomic_min(unsigned int* p, unsigned int v) {
     std::atomic_ref<unsigned int> a(*p);

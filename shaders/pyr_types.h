@@ -101,6 +101,9 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 #define PYR_STATS_POINT_SUM 6u   /* x, y, z: 6 words, sums of rint(p * 2^point_shift) */
 #define PYR_STATS_NORMAL_SUM 12u /* x, y, z: 6 words, sums of qn */
 #define PYR_STATS_WORDS 18u
+
+/* The merge's pair table on GPUs (shaders/pyr_merge_table.h): words per slot. */
+#define PYR_MERGE_SLOT_WORDS 4u
 /* The statistics pass walks rows in runs of this many pixels, one invocation per run. */
 #define PYR_STATS_RUN 32u
 /* Points are clamped to +-(2^31 - 128), the largest float magnitude below 2^31, before rounding to int32. */

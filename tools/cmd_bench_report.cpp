@@ -439,7 +439,9 @@ Report build_report(const nlohmann::json& doc, const std::string& source, const 
     // What the robust metric costs: the same frames with the kinect-v1 preset, pass by pass.
     md +=
         "## The robust metric's cost\n\nThe same frames, normals estimated, with the paper's metric (pipeline/) and "
-        "with the robust metric of the kinect-v1 preset (pipeline_robust/: window normals R = 3, curvature stride 6). "
+        "with the robust metric of the kinect-v1 preset, its merge off (pipeline_robust/: window normals R = 3, "
+        "curvature "
+        "stride 6). "
         "Ratio: robust ÷ paper (above 1: the robust metric is slower). Points to mask: normals, quantize and metric "
         "(the CPU runs them fused into one pass with the paper metric; separately with the robust one).\n\n";
     md += header({"frame", "backend", "paper", "robust", "robust ÷ paper", "points to mask: paper",
@@ -455,6 +457,35 @@ Report build_report(const nlohmann::json& doc, const std::string& source, const 
         }
     }
     md += "\n";
+
+    // What the merge (step 6d) costs on those robust frames.
+    md +=
+        "## The merge's cost\n\nThe robust frames above with the preset's merge on (pipeline_robust_merge/; "
+        "docs/algorithm.md section 5b). Share: the merge pass's time in the robust frame without it (the target is "
+        "at most 15% on the CPU).\n\n";
+    std::string merge_rows;
+    for (const Size& s : sizes) {
+        for (const std::string& b : backends) {
+            const Entry* robust = find(entries, "pipeline_robust/" + b + "/" + s.name + "/estimated_normals");
+            const Entry* merged = find(entries, "pipeline_robust_merge/" + b + "/" + s.name + "/estimated_normals");
+            if (merged == nullptr) continue;
+            const auto pass = merged->counters.find("merge_ms");
+            std::string share = "—";
+            if (pass != merged->counters.end() && robust != nullptr && std::isfinite(robust->ms) && robust->ms > 0) {
+                char text[32];
+                std::snprintf(text, sizeof text, "%.1f%%", 100.0 * pass->second / robust->ms);
+                share = text;
+            }
+            merge_rows +=
+                table_row({s.name, b, ms_cell(robust), ms_cell(merged), pass_cell(merged, "merge_ms"), share});
+        }
+    }
+    if (merge_rows.empty()) {
+        md += "No pipeline_robust_merge/ rows in this run (runs before the merge had none).\n\n";
+    } else {
+        md += header({"frame", "backend", "robust", "robust + merge", "merge pass", "merge pass ÷ robust"}) +
+              merge_rows + "\n";
+    }
 
     // The fills' worst cases.
     md +=

@@ -276,6 +276,16 @@ void evaluate_scene(const synthetic::SceneOptions& options, const std::vector<do
     const std::vector<eval::BridgeSite> sites =
         eval::find_bridge_sites(scene.object_id, from_cloud.fillable_mask, scene.width, scene.height);
     Result pyramid;
+    // Bridges are drawn into the mask, and a mask frame has no points for the merge: with the merge on, the bridged
+    // masks are labelled without it (the bridges' test is the pyramid's, which the merge only follows), and bridge
+    // width 0 takes the cloud's own labels, merge included.
+    const bool merge = segmenter.params().merge;
+    std::optional<Segmenter> unmerged;
+    if (merge) {
+        Params p = segmenter.params();
+        p.merge = false;
+        unmerged.emplace(scene.width, scene.height, p, "cpu");
+    }
     for (std::size_t b = 0; b < bridges.size(); ++b) {
         const int width = int(bridges[b]);
         std::vector<std::uint8_t> mask = from_cloud.fillable_mask;
@@ -286,8 +296,16 @@ void evaluate_scene(const synthetic::SceneOptions& options, const std::vector<do
         mask_view.valid = mask_valid.data();
         mask_view.width = scene.width;
         mask_view.height = scene.height;
-        segmenter.segment_mask(mask_view, pyramid);
-        if (width == 0 && pyramid.labels != from_cloud.labels) {
+        if (merge) {
+            if (width == 0) {
+                pyramid.labels = from_cloud.labels;
+            } else {
+                unmerged->segment_mask(mask_view, pyramid);
+            }
+        } else {
+            segmenter.segment_mask(mask_view, pyramid);
+        }
+        if (!merge && width == 0 && pyramid.labels != from_cloud.labels) {
             throw Error(ErrorCode::internal,
                         "eval: the pyramid on the cloud's own mask differs from segmenting the "
                         "cloud (seed " +
@@ -871,7 +889,9 @@ int cmd_eval(const std::vector<std::string>& argv) {
     std::set<std::string> values = {"sizes",   "seeds",     "noise",  "bridges",   "out-dir",
                                     "sensors", "distances", "params", "tune-seeds"};
     values.insert(kParameterValueOptions.begin(), kParameterValueOptions.end());
-    const Args args(argv, values, {"help", "quick"});
+    std::set<std::string> flags = kParameterFlagOptions;
+    flags.insert({"help", "quick"});
+    const Args args(argv, values, flags);
     if (args.flag("help")) {
         std::fputs(kEvalUsage, stdout);
         return 0;

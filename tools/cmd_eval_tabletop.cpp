@@ -33,7 +33,7 @@ using io::Intrinsics;
 
 constexpr const char* kTabletopUsage =
     "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--pcl-sensor NAME|none] [--calib FILE]\n"
-    "                   [--depth-scale M] [--out-dir DIR]\n"
+    "                   [--depth-scale M] [--out-dir DIR] [parameters]\n"
     "\n"
     "Measures pyrseg on real tabletop RGB-D frames: every NAME_depth.png in DIR (16-bit, registered to the colour\n"
     "camera; NAME_color.png beside it, when there is one, goes into the pictures), the camera from DIR/camera.yml\n"
@@ -49,7 +49,9 @@ constexpr const char* kTabletopUsage =
     "at least 80% inside it has IoU >= 0.5; parts: those segments), merged with the table (at least 30% of its\n"
     "pixels carry the table's label, the segment holding most of the table), its best IoU and its unlabelled\n"
     "pixels. Per frame also the table's largest share in one segment and the time of a frame (CPU backend, the\n"
-    "median of 5). --presets: the sensor presets to compare (default: every one, then the defaults as `default`).\n"
+    "median of 5). --presets: the sensor presets to compare (default: every one, then the defaults as `default`);\n"
+    "NAME+merge turns the merge on (docs/algorithm.md section 5b), NAME+nomerge off. The segment parameter options\n"
+    "(`pyrseg segment --help`: --merge-reach, --ct, ...) override every preset's values.\n"
     "Beside them, when pyrseg is built with PCL: PCL's organized segmentation of the same frame (its cloud in mm),\n"
     "OrganizedConnectedComponentSegmentation with EdgeAwarePlaneComparator, with the settings `pyrseg eval` tuned\n"
     "for the sensor model --pcl-sensor names (default realsense-d435; none leaves PCL out), timed once.\n"
@@ -79,17 +81,24 @@ struct Frame {
     RgbImage color;  // empty without NAME_color.png
 };
 
-std::vector<Method> parse_methods(const std::optional<std::string>& list) {
+// Each name a preset (or `default`), NAME+merge with the merge on, NAME+nomerge with it off; the segment parameter
+// options override them all.
+std::vector<Method> parse_methods(const Args& args) {
     std::vector<Method> out;
-    const auto add = [&out](const std::string& name) {
-        if (name == "default") {
-            out.push_back({name, Params{}, std::nullopt});
-            return;
+    const auto add = [&](const std::string& item) {
+        const bool merge = item.ends_with("+merge");
+        const bool no_merge = item.ends_with("+nomerge");
+        const std::string name = item.substr(0, item.size() - (merge ? 6 : no_merge ? 8 : 0));
+        std::optional<SensorKind> kind;
+        if (name != "default") {
+            kind = sensor_kind_from_name(name);
+            if (!kind) throw UsageError{"--presets: no sensor preset named '" + printable(name) + "'"};
         }
-        const std::optional<SensorKind> kind = sensor_kind_from_name(name);
-        if (!kind) throw UsageError{"--presets: no sensor preset named '" + printable(name) + "'"};
-        out.push_back({name, sensor_preset(*kind), std::nullopt});
+        Params p = kind ? parse_params(args, kind) : parse_params(args, std::nullopt);
+        if (merge || no_merge) p.merge = merge;
+        out.push_back({item, p, std::nullopt});
     };
+    const std::optional<std::string> list = args.value("presets");
     if (!list) {
         for (const SensorKind k : sensor_kinds()) add(sensor_kind_name(k));
         add("default");
@@ -208,7 +217,11 @@ double median_ms(std::vector<double> v) {
 }  // namespace
 
 int cmd_eval_tabletop(const std::vector<std::string>& argv) {
-    const Args args(argv, {"tabletop", "presets", "pcl-sensor", "calib", "depth-scale", "out-dir"}, {"help"});
+    std::set<std::string> values = kParameterValueOptions;
+    values.insert({"tabletop", "presets", "pcl-sensor", "calib", "depth-scale", "out-dir"});
+    std::set<std::string> flags = kParameterFlagOptions;
+    flags.insert("help");
+    const Args args(argv, values, flags);
     if (args.flag("help")) {
         std::fputs(kTabletopUsage, stdout);
         return 0;
@@ -227,7 +240,7 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
                          "; give the camera with --calib FILE (fx, fy, cx, cy)"};
     }
     const Intrinsics k = io::read_intrinsics(calib);
-    std::vector<Method> methods = parse_methods(args.value("presets"));
+    std::vector<Method> methods = parse_methods(args);
     const std::string pcl_sensor = args.value("pcl-sensor").value_or("realsense-d435");
     if (pcl_sensor != "none") {
         const std::optional<SensorKind> kind = sensor_kind_from_name(pcl_sensor);

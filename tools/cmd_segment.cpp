@@ -154,9 +154,16 @@ struct FrameReport {
 
 // What the run says: --quiet leaves stderr to warnings and errors, and a batch of clouds in metres needs one note,
 // not one per frame.
+// The samples measure_frame_noise needs before it judges a sensor (presets.hpp).
+constexpr std::size_t kMinNoiseSamples = 1000;
+
 struct RunNotes {
     bool quiet = false;
     bool metres_read = false;
+    // --sensor auto chooses once, on the first frame with enough depth to judge, and keeps it for the batch (one
+    // camera's frames do not change sensor; a batch that switched presets frame by frame would not compare).
+    std::optional<SensorKind> auto_sensor;
+    bool hinted = false;  // the hint to name a preset is given once per run
 };
 
 // .npy (uint32) or, when every label fits, a 16-bit PNG that image viewers and OpenCV read directly.
@@ -277,14 +284,28 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     Params params = frame_params;
     std::optional<SensorKind> kind;  // the sensor the parameters are for, when one is named or chosen
     if (sensor && !sensor->automatic) kind = sensor->kind;
-    if (!sensor || sensor->automatic) {
-        const FrameNoise noise = measure_frame_noise(view, frame_params.unit_mm);
+    if (sensor && sensor->automatic && notes.auto_sensor) {
+        kind = *notes.auto_sensor;
+        params = parse_params(args, kind);
+        params.unit_mm = frame_params.unit_mm;
+        sensor_note = std::string(", sensor auto: ") + sensor_kind_name(*kind);
+    } else if (!sensor || sensor->automatic) {
+        const FrameNoise noise = loaded.depth ? measure_frame_noise(loaded.depth->view(cloud.width, cloud.height))
+                                              : measure_frame_noise(view, frame_params.unit_mm);
         if (sensor) {
             kind = noise.suggested;
             params = parse_params(args, noise.suggested);
             params.unit_mm = frame_params.unit_mm;
             sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
-        } else if (noise.suggested != SensorKind::structured_light && !notes.quiet) {
+            if (noise.samples >= kMinNoiseSamples) {
+                notes.auto_sensor = noise.suggested;
+                if (!notes.quiet) {
+                    std::fprintf(stderr, "pyrseg: sensor auto: %s for this run, from %s: %s\n",
+                                 sensor_kind_name(noise.suggested), printable(input).c_str(), noise.reason.c_str());
+                }
+            }
+        } else if (noise.suggested != SensorKind::structured_light && !notes.quiet && !notes.hinted) {
+            notes.hinted = true;
             std::fprintf(stderr,
                          "pyrseg: hint: %s: %s; the default parameters suit low-noise scanners. Try --sensor %s (or "
                          "--sensor auto, or the preset of your camera: --help lists them)\n",

@@ -13,7 +13,8 @@ const char* const kParameterHelp =
     "                          kinect-v1         Kinect v1, Xtion, Orbbec Astra (disparity-stepped depth)\n"
     "                          realsense-d435    RealSense D4xx and other active stereo cameras\n"
     "                          azure-kinect      Azure Kinect, Kinect v2 and other time-of-flight cameras\n"
-    "                          auto              choose per frame from the frame's own depth noise\n"
+    "                          auto              choose from the first frame's depth (its noise, whole-millimetre\n"
+    "                                            depth, disparity steps, stereo shadows), once for the run\n"
     "                        Without --sensor the defaults apply, and pyrseg says when a frame looks noisier than\n"
     "                        they suit. docs/quality.md has each preset's values and measurements.\n"
     "  --ct RADIANS          curvature threshold: neighbouring normals more than this angle apart (on average)\n"
@@ -38,13 +39,22 @@ const char* const kParameterHelp =
     "  --edge-rounds E       label edge pixels up to E steps from a segment (1..63, default 1: the contract's one\n"
     "                        layer); the robust presets use more, to share out their wider edge bands.\n"
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
+    "  --merge               after the pyramid, join segments that meet along a convex or flat boundary (an\n"
+    "                        object's faces and parts), never across a concave crease or a depth step (an object\n"
+    "                        and the table under it). Needs a cloud or depth image, not a mask.\n"
+    "  --no-merge            leave the segments as the pyramid made them (undoes a preset's --merge).\n"
+    "  --merge-reach R       measure each boundary crossing up to R pixels into both sides (1..16, default 2).\n"
+    "  --merge-tolerance MM  how far each side may lie above the other's tangent plane and still count as convex\n"
+    "                        or flat (default 1 mm), plus --merge-tolerance-per-m2 MM per square metre of depth.\n"
+    "  --merge-min-crossings C   a boundary shorter than C crossings never joins (default 16).\n"
+    "  --merge-max-bad S     the share of a boundary's crossings that may be concave or steps (0..1, default 0.05).\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const std::set<std::string> kParameterValueOptions = {
-    "ct",         "dt",     "unit-mm",       "bridge-levels",    "unjoinable-gap", "normal-radius",
-    "metric",     "sensor", "normal-window", "curvature-stride", "dt-per-m2",      "ct-growth",
-    "edge-rounds"};
-const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw"};
+    "ct",          "dt",          "unit-mm",         "bridge-levels",          "unjoinable-gap",      "normal-radius",
+    "metric",      "sensor",      "normal-window",   "curvature-stride",       "dt-per-m2",           "ct-growth",
+    "edge-rounds", "merge-reach", "merge-tolerance", "merge-tolerance-per-m2", "merge-min-crossings", "merge-max-bad"};
+const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw", "merge", "no-merge"};
 
 std::optional<SensorChoice> parse_sensor(const Args& args) {
     const std::optional<std::string> name = args.value("sensor");
@@ -82,6 +92,16 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("dt-per-m2")) p.dt_per_m2 = *v;
     if (auto v = args.number("ct-growth")) p.ct_growth_per_m2 = *v;
     if (auto v = args.integer("edge-rounds")) p.edge_rounds = *v;
+    if (args.flag("merge") && args.flag("no-merge")) {
+        throw Error(ErrorCode::invalid_argument, "--merge and --no-merge contradict each other");
+    }
+    if (args.flag("merge")) p.merge = true;
+    if (args.flag("no-merge")) p.merge = false;
+    if (auto v = args.integer("merge-reach")) p.merge_reach = *v;
+    if (auto v = args.number("merge-tolerance")) p.merge_tolerance_mm = *v;
+    if (auto v = args.number("merge-tolerance-per-m2")) p.merge_tolerance_per_m2 = *v;
+    if (auto v = args.integer("merge-min-crossings")) p.merge_min_crossings = *v;
+    if (auto v = args.number("merge-max-bad")) p.merge_max_bad_share = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

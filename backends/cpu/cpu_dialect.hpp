@@ -69,6 +69,7 @@ struct PassContext {
     const std::uint32_t* lut = nullptr;
     std::uint32_t* stats = nullptr;   // the statistics words, PYR_STATS_WORDS per slot
     RobustTexelPlanes robust_texels;  // the robust normals' texels of the frame
+    std::uint32_t* merge = nullptr;   // the merge's words (backends/cpu/cpu_merge.cpp)
 };
 
 inline void atomic_max(std::uint32_t& word, std::uint32_t v) {

@@ -53,6 +53,7 @@ public:
     }
     void final_fill_with_edges(int level) override;
     void label_edges() override;
+    void merge_segments() override;  // cpu_merge.cpp
     // label_edges marks each row once its labels are final: one pass over the image fewer.
     [[nodiscard]] bool marks_labels_before_compact() const override { return true; }
     void mark_labels(int level) override;
@@ -128,8 +129,9 @@ private:
     // final_fill_rows, per row: whether marked pixels remain after the band pass, and whether the upward crossing
     // changed it (bits of cpu_final_fill.cpp).
     std::vector<std::uint8_t> pending_;
-    std::vector<std::uint32_t> candidates_;  // final_fill_rows: three rows of edge candidates a band
-    std::vector<std::uint32_t> stats_;       // per-segment statistics words, when asked for
+    std::vector<std::uint32_t> candidates_;   // final_fill_rows: three rows of edge candidates a band
+    std::vector<std::uint32_t> stats_;        // per-segment statistics words, when asked for
+    std::vector<std::uint32_t> merge_words_;  // the merge's label parents and pair table (shaders/pyr_merge_table.h)
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::VectorRows* simd_;

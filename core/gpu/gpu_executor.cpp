@@ -222,6 +222,21 @@ public:
         }
     }
 
+    void merge_segments() override {
+        const core::Thresholds& t = plan_.thresholds;
+        const uint32_t labels = plan_.lut_size();
+        const uint32_t slots = plan_.merge_slots;
+        const uint32_t words = labels + PYR_MERGE_SLOT_WORDS * slots;
+        dispatch(Kernel::merge_clear, words, 1, args({words, labels}));
+        dispatch(Kernel::merge_count, width(), height(),
+                 args({height(), plan_.full().offset, uint32_t(plan_.params.merge_reach), bits(t.merge_point_scale),
+                       bits(t.merge_tolerance_base), bits(t.merge_tolerance_growth), labels, slots - 1}));
+        dispatch(Kernel::merge_link, slots, 1,
+                 args({labels, slots, uint32_t(plan_.params.merge_min_crossings), t.merge_share}));
+        dispatch(Kernel::merge_flatten, labels, 1, args({labels}));
+        dispatch(Kernel::merge_apply, pixels(), 1, args({pixels(), plan_.full().offset}));
+    }
+
     void compact(bool apply) override {
         const uint32_t count = plan_.lut_size();
         const uint32_t chunks = plan_.scan_chunks();
@@ -405,8 +420,10 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
             return 4 * (size_t(plan.scan_chunks()) + 1 + size_t(plan.width) + size_t(plan.height));
         case Buffer::fill: {
             // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
+            // The merge's label parents and pair table (shaders/pyr_merge_table.h) reuse it after the fills.
             const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
-            return size_t(8) * fill_level.width * fill_level.height;
+            const size_t merge = size_t(plan.lut_size()) + size_t(PYR_MERGE_SLOT_WORDS) * plan.merge_slots;
+            return 4 * std::max(size_t(2) * fill_level.width * fill_level.height, plan.merge_slots != 0 ? merge : 0);
         }
         case Buffer::out:
             return 4 * px;

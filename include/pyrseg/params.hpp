@@ -15,6 +15,7 @@ inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: pa
 inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
 inline constexpr int kMaxEdgeRounds = 63;
+inline constexpr int kMaxMergeReach = 16;
 
 // Which fillable test (docs/algorithm.md): the paper's (section 2, the contract) for low-noise scanners, or the
 // robust one (sections 2b and 8b) for depth cameras whose noise grows with the square of the depth.
@@ -33,6 +34,16 @@ struct Params {
     // further round labels the next layer of an edge band from the layer before, so that wide bands (the robust
     // metric's) are shared out among the segments on either side.
     int edge_rounds = 1;
+    // Step 6d, the merge (docs/algorithm.md section 5b): segments that meet along a convex or flat boundary join
+    // (an object's faces and parts), never across a concave crease or a depth step (an object and its support).
+    bool merge = false;
+    int merge_reach = 2;  // 1..16: a crossing of a boundary is measured up to this many pixels into each side
+    // How far each side of a crossing may lie above the other's tangent plane and still count as convex or flat:
+    // merge_tolerance_mm + merge_tolerance_per_m2 * z_m^2 millimetres.
+    double merge_tolerance_mm = 1.0;
+    double merge_tolerance_per_m2 = 0.0;
+    int merge_min_crossings = 16;              // a shorter boundary never joins
+    double merge_max_bad_share = 0.05;         // 0..1: the share of its crossings a joining boundary may have bad
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
     Metric metric = Metric::paper;

@@ -107,6 +107,18 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.dt_per_m2 = number(kInit, name, v);
     } else if (key == "ct_growth_per_m2") {
         p.ct_growth_per_m2 = number(kInit, name, v);
+    } else if (key == "merge") {
+        p.merge = boolean(kInit, name, v);
+    } else if (key == "merge_reach") {
+        p.merge_reach = whole();
+    } else if (key == "merge_tolerance_mm") {
+        p.merge_tolerance_mm = number(kInit, name, v);
+    } else if (key == "merge_tolerance_per_m2") {
+        p.merge_tolerance_per_m2 = number(kInit, name, v);
+    } else if (key == "merge_min_crossings") {
+        p.merge_min_crossings = whole();
+    } else if (key == "merge_max_bad_share") {
+        p.merge_max_bad_share = number(kInit, name, v);
     } else {
         return false;
     }
@@ -159,7 +171,9 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
             throw py::type_error("Segmenter() got an unexpected keyword argument '" + key +
                                  "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
                                  "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
-                                 "dt_per_m2, ct_growth_per_m2; and preset, outputs, cuda_stream");
+                                 "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
+                                 "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share; and preset, "
+                                 "outputs, cuda_stream");
         }
     }
     return p;
@@ -442,6 +456,20 @@ py::list backends() {
     return l;
 }
 
+py::dict frame_noise_dict(const FrameNoise& n) {
+    py::dict d;
+    d["samples"] = n.samples;
+    d["median_depth_mm"] = n.median_depth_mm;
+    d["second_difference_mm"] = n.second_difference_mm;
+    d["whole_mm_share"] = n.whole_mm_share;
+    d["level_step_mm_per_m2"] = n.level_step_mm_per_m2;
+    d["shadow_holes"] = n.shadow_holes;
+    d["left_shadow_share"] = n.left_shadow_share;
+    d["suggested"] = sensor_kind_name(n.suggested);
+    d["reason"] = n.reason;
+    return d;
+}
+
 }  // namespace
 
 void bind_segmenter(py::module_& m) {
@@ -479,7 +507,9 @@ Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=N
 backend: @BACKENDS@"auto", or None for $PYRSEG_BACKEND (else "auto").
 preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it.
 params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
-metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2 (docs/algorithm.md).
+metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
+that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
+merge_min_crossings, merge_max_bad_share (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
@@ -574,13 +604,24 @@ float64 converted, any other integer dtype converted to uint16 when its values a
                      const py::gil_scoped_release nogil;
                      n = measure_frame_noise(input.view(scratch), unit_mm);
                  }
-                 py::dict d;
-                 d["samples"] = n.samples;
-                 d["median_depth_mm"] = n.median_depth_mm;
-                 d["second_difference_mm"] = n.second_difference_mm;
-                 d["suggested"] = sensor_kind_name(n.suggested);
-                 d["reason"] = n.reason;
-                 return d;
+                 return frame_noise_dict(n);
+             });
+    static constexpr Param kDepthNoise[] = {{"depth"}, {"metres_per_unit"}};
+    def_args(m, "measure_depth_noise", kDepthNoise,
+             "measure_frame_noise for a depth image (H x W uint16 or float32 samples, metres_per_unit as in "
+             "Segmenter.segment_depth): which preset it suggests, and why.",
+             [](const py::args& args, const py::kwargs& kwargs) {
+                 const Args a("measure_depth_noise()", kDepthNoise, args, kwargs);
+                 const DepthInput input(a.object(0));
+                 Scratch scratch;
+                 DepthView view = input.view(scratch);
+                 view.metres_per_unit = a.number(1);
+                 FrameNoise n;
+                 {
+                     const py::gil_scoped_release nogil;
+                     n = measure_frame_noise(view);
+                 }
+                 return frame_noise_dict(n);
              });
 }
 
@@ -649,6 +690,12 @@ py::dict params_to_dict(const Params& p) {
     d["curvature_stride"] = p.curvature_stride;
     d["dt_per_m2"] = p.dt_per_m2;
     d["ct_growth_per_m2"] = p.ct_growth_per_m2;
+    d["merge"] = p.merge;
+    d["merge_reach"] = p.merge_reach;
+    d["merge_tolerance_mm"] = p.merge_tolerance_mm;
+    d["merge_tolerance_per_m2"] = p.merge_tolerance_per_m2;
+    d["merge_min_crossings"] = p.merge_min_crossings;
+    d["merge_max_bad_share"] = p.merge_max_bad_share;
     return d;
 }
 

@@ -379,6 +379,70 @@ TEST(Cli, MugScanWithStereoPresetTableIsOneSegmentAndTheMugItsOwn) {
                             {{390, 340}}});
 }
 
+// The real RealSense tabletop frames (shared/data/realsense): --sensor auto chooses realsense-d435 once for the
+// batch, says why, and every frame runs with it; without --sensor the hint names that preset.
+TEST(Cli, RealSenseFramesAutoChoosesTheStereoPresetOncePerBatch) {
+    const fs::path data = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
+    if (!fs::exists(data / "wood_table_1_depth.png")) GTEST_SKIP() << "RealSense frames not present: " << data;
+    const fs::path dir = temp_dir();
+    const std::string calib = " --calib " + (data / "camera.yml").string();
+    CliRun r = run("segment \"" + (data / "*_depth.png").string() + "\"" + calib + " --sensor auto --out-dir " +
+                   (dir / "out").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::size_t chosen = 0;
+    for (std::size_t at = r.output.find("sensor auto: realsense-d435 for this run"); at != std::string::npos;
+         at = r.output.find("sensor auto: realsense-d435 for this run", at + 1)) {
+        ++chosen;
+    }
+    EXPECT_EQ(chosen, 1u) << r.output;
+    EXPECT_NE(r.output.find("stereo shadows"), std::string::npos) << r.output;
+    std::size_t frames = 0;
+    for (std::size_t at = r.output.find(", sensor auto: realsense-d435\n"); at != std::string::npos;
+         at = r.output.find(", sensor auto: realsense-d435\n", at + 1)) {
+        ++frames;
+    }
+    EXPECT_EQ(frames, 4u) << r.output;
+    EXPECT_EQ(r.output.find("structured-light"), std::string::npos) << r.output;
+    r = run("segment " + (data / "wood_table_3_depth.png").string() + calib);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("Try --sensor realsense-d435"), std::string::npos) << r.output;
+    fs::remove_all(dir);
+}
+
+// The cracker box of wood_table_1 with the realsense-d435 preset: its front and top faces are one segment (the
+// merge joins them across their convex edge), which stays within the box and apart from the table.
+TEST(Cli, RealSenseBoxIsOneSegmentApartFromTheTable) {
+    const fs::path data = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
+    if (!fs::exists(data / "wood_table_1_depth.png")) GTEST_SKIP() << "RealSense frames not present: " << data;
+    const fs::path dir = temp_dir();
+    const fs::path labels_path = dir / "labels.npy";
+    const CliRun r = run("segment " + (data / "wood_table_1_depth.png").string() + " --calib " +
+                         (data / "camera.yml").string() + " --sensor realsense-d435 --labels " + labels_path.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
+    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
+    std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
+    const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
+    const std::uint32_t box = at(490, 330);  // the front face
+    ASSERT_NE(box, 0u);
+    EXPECT_EQ(at(470, 240), box) << "the top face";
+    EXPECT_EQ(at(400, 350), box);
+    const std::uint32_t table = at(540, 400);
+    EXPECT_NE(table, 0u);
+    EXPECT_NE(table, box);
+    EXPECT_EQ(at(600, 300), table);
+    std::size_t inside = 0, outside = 0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != box) continue;
+        const int x = int(i % 640), y = int(i / 640);
+        (x >= 375 && x <= 580 && y >= 215 && y <= 420 ? inside : outside) += 1;
+    }
+    EXPECT_EQ(outside, 0u) << inside << " inside";
+    EXPECT_GT(inside, 20000u);
+    fs::remove_all(dir);
+}
+
 TEST(Cli, CapeDepthImageWithKinectPresetEachWallIsOneSegment) {
     // A corner: the near wall on the left, the far wall on the right of the diagonal crease.
     const fs::path data(PYRSEG_SHARED_DATA_DIR);
@@ -412,11 +476,12 @@ TEST(Cli, SensorHintAutoAndUnknownNames) {
         r = run("segment " + mug_scan().string() + " --unit-mm 1000 --labels " + (dir / "m.npy").string());
         ASSERT_EQ(r.status, 0) << r.output;
         EXPECT_NE(r.output.find("hint:"), std::string::npos) << r.output;
-        EXPECT_NE(r.output.find("Try --sensor kinect-v1"), std::string::npos) << r.output;
+        // A stereo scan: its holes lie on the left of near surfaces.
+        EXPECT_NE(r.output.find("Try --sensor realsense-d435"), std::string::npos) << r.output;
         r = run("segment " + mug_scan().string() + " --unit-mm 1000 --sensor auto --labels " +
                 (dir / "m.npy").string());
         ASSERT_EQ(r.status, 0) << r.output;
-        EXPECT_NE(r.output.find("sensor auto: kinect-v1"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("sensor auto: realsense-d435"), std::string::npos) << r.output;
         EXPECT_EQ(r.output.find("hint:"), std::string::npos) << r.output;
     }
     fs::remove_all(dir);

@@ -1,7 +1,9 @@
 #include "conformance/cases.hpp"
 
 #include <cstdint>
+#include <iterator>
 #include <limits>
+#include <string>
 
 #include "pyrseg/presets.hpp"
 
@@ -133,7 +135,39 @@ std::vector<ConformanceCase> build_robust_cases() {
     return cases;
 }
 
+constexpr int kMergeCaseCount = 32;
+
+// The robust scenes with the merge on (docs/algorithm.md section 5b), its parameters over their ranges: a stream of
+// its own, so that the robust cases stay what they were.
+std::vector<ConformanceCase> build_merge_cases() {
+    std::vector<ConformanceCase> cases;
+    CaseRng rng(20261203);
+    const int fixed[][2] = {{9, 9}, {33, 17}, {640, 480}, {2064, 1544}, {200, 150}, {64, 1}};
+    for (int i = 0; i < kMergeCaseCount; ++i) {
+        const bool sized = i < int(std::size(fixed));
+        const int w = sized ? fixed[i][0] : rng.range(9, 200);
+        const int h = sized ? fixed[i][1] : rng.range(9, 150);
+        ConformanceCase c = make_robust_case(1000 + i, w, h, rng);
+        c.params.merge = true;
+        if (rng.chance(60)) {
+            c.params.merge_reach = rng.pick({1, 2, 3, 5, kMaxMergeReach});
+            c.params.merge_tolerance_mm = rng.pick({0.0, 0.5, 1.5, 4.0, 50.0});
+            c.params.merge_tolerance_per_m2 = rng.pick({0.0, 0.0, 2.0, 1e4});
+            c.params.merge_min_crossings = rng.pick({1, 4, 16, 200});
+            c.params.merge_max_bad_share = rng.pick({0.0, 0.05, 0.2, 0.5, 1.0});
+        }
+        c.name = "merge" + c.name.substr(std::string("robust").size());
+        cases.push_back(c);
+    }
+    return cases;
+}
+
 }  // namespace
+
+const std::vector<ConformanceCase>& merge_conformance_cases() {
+    static const std::vector<ConformanceCase> cases = build_merge_cases();
+    return cases;
+}
 
 const std::vector<ConformanceCase>& robust_conformance_cases() {
     static const std::vector<ConformanceCase> cases = build_robust_cases();

@@ -19,5 +19,7 @@ struct ConformanceCase {
 [[nodiscard]] const std::vector<ConformanceCase>& conformance_cases();
 // The robust metric (docs/algorithm.md sections 2b and 8b) and every sensor preset, on scenes of every sensor model.
 [[nodiscard]] const std::vector<ConformanceCase>& robust_conformance_cases();
+// Robust scenes with the merge (docs/algorithm.md section 5b) on, its parameters varied.
+[[nodiscard]] const std::vector<ConformanceCase>& merge_conformance_cases();
 
 }  // namespace pyrseg::test

@@ -94,6 +94,25 @@ INSTANTIATE_TEST_SUITE_P(Backends, RobustScenes,
                                     robust_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
                          });
 
+class MergeScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(MergeScenes, MatchesReference) {
+    const auto& [backend, index] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const ConformanceCase& c = merge_conformance_cases()[std::size_t(index)];
+    const synthetic::Scene scene = synthetic::generate(c.scene);
+    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr, scene.width,
+                       scene.height, c.params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, MergeScenes,
+                         ::testing::Combine(::testing::ValuesIn(available_backend_names()),
+                                            ::testing::Range(0, int(merge_conformance_cases().size()))),
+                         [](const ::testing::TestParamInfo<MergeScenes::ParamType>& param_info) {
+                             return std::get<0>(param_info.param) + "_" +
+                                    merge_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
+                         });
+
 // Depths in the subnormal range: validity (z > 0) and the metric's float depth differences must follow IEEE on
 // every backend, whatever a device's denormal mode (contract section 2; docs/algorithm.md section 9).
 class TinyDepths : public ::testing::TestWithParam<std::string> {};
@@ -311,6 +330,29 @@ TEST_P(RealDepthImages, MatchesReference) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, RealDepthImages, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
+// The real RealSense tabletop frames with the realsense-d435 preset and the merge: the frames the merge was made for.
+class RealTabletops : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RealTabletops, MatchTheReferenceWithTheMerge) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    const std::filesystem::path dir = std::filesystem::path(shared_data_dir()) / "realsense";
+    if (!std::filesystem::exists(dir / "wood_table_1_depth.png")) {
+        GTEST_SKIP() << "real RealSense frames not present: " << dir.string();
+    }
+    const auto k = io::read_intrinsics(dir / "camera.yml");
+    for (const char* name : {"wood_table_1", "office_table_7"}) {
+        const io::PointCloud cloud =
+            io::depth_to_cloud(io::read_depth_image(dir / (std::string(name) + "_depth.png")), k, 0.001);
+        Params params = sensor_preset(SensorKind::realsense_d435);
+        params.merge = true;
+        SCOPED_TRACE(name);
+        expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RealTabletops, ::testing::ValuesIn(available_backend_names()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 }  // namespace

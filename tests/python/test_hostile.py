@@ -173,6 +173,12 @@ SEGMENTER_KEYWORDS = {
     "curvature_stride": ("1", "integer"),
     "dt_per_m2": ("x", "number"),
     "ct_growth_per_m2": ({}, "number"),
+    "merge": ("yes", "True or False"),
+    "merge_reach": (2.5, "integer"),
+    "merge_tolerance_mm": ("1", "number"),
+    "merge_tolerance_per_m2": ([], "number"),
+    "merge_min_crossings": ("8", "integer"),
+    "merge_max_bad_share": ("x", "number"),
     "preset": (3, "str"),
     "outputs": ([1], "str"),
 }

@@ -1,11 +1,17 @@
 """The Python API over pyrseg::Segmenter: inputs in place or converted, results, outputs, errors, threads."""
 
+import os
+import pathlib
 import threading
 import time
 
 import numpy as np
 import pyrseg
 import pytest
+
+
+# The workplace's real sample data (read-only, beside the repository); tests that use it skip without it.
+SHARED = pathlib.Path(os.environ.get("PYRSEG_SHARED_DATA_DIR", pathlib.Path(__file__).resolve().parents[3] / "shared" / "data"))
 
 
 def reference(scene, **kw):
@@ -211,10 +217,49 @@ def test_mask_frames():
         seg.segment_mask(mask.astype(np.float32))
 
 
+def test_merge_joins_segments_and_refuses_masks():
+    # A noisy frame under the contract's defaults: many small surfaces, some of which meet along flat boundaries.
+    s = pyrseg.synthetic.generate(320, 240, seed=3, sensor="kinect-v1")
+    h, w, _ = s.points.shape
+    out = ("raw_labels",)
+    seg = pyrseg.Segmenter(w, h, "cpu", merge=True, merge_reach=3, merge_max_bad_share=0.1, outputs=out)
+    assert seg.params["merge"] and seg.params["merge_reach"] == 3 and seg.params["merge_max_bad_share"] == 0.1
+    merged = seg.segment(s.points)
+    plain = pyrseg.Segmenter(w, h, "cpu", outputs=out).segment(s.points)
+    # Every merged segment is a union of whole plain ones: the merge only joins.
+    for label in np.unique(plain.raw_labels[plain.raw_labels > 0]):
+        assert len(np.unique(merged.raw_labels[plain.raw_labels == label])) == 1
+    assert merged.segment_count < plain.segment_count
+    with pytest.raises(pyrseg.Error) as e:
+        seg.segment_mask(np.ones((h, w), bool))
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "merge" in e.value.message
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(w, h, "cpu", merge=True, merge_reach=17)
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "merge_reach" in e.value.message
+
+
 def test_frame_noise_suggests_a_preset():
     s = pyrseg.synthetic.generate(160, 120, sensor="kinect-v1")
     n = pyrseg.measure_frame_noise(s.points)
     assert n["suggested"] in pyrseg.presets() and n["samples"] > 1000 and n["reason"]
+    # The same frame as a depth image in millimetres: the same depths, the same measurement and suggestion.
+    z = s.points[..., 2]
+    depth = np.where(np.isfinite(z), np.round(z), 0).astype(np.uint16)
+    d = pyrseg.measure_depth_noise(depth, metres_per_unit=0.001)
+    c = pyrseg.measure_frame_noise(np.dstack([np.zeros_like(z), np.zeros_like(z), depth.astype(np.float32)]))
+    assert d == c and d["suggested"] == "kinect-v1", d
+    assert 0 <= d["whole_mm_share"] <= 1 and d["level_step_mm_per_m2"] > 2.2
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.measure_depth_noise(depth, metres_per_unit=0)
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter
+
+
+@pytest.mark.skipif(not (SHARED / "realsense" / "wood_table_3_depth.png").exists(), reason="RealSense frames absent")
+def test_realsense_depth_frames_suggest_the_stereo_preset():
+    for name in ("wood_table_1", "wood_table_3", "low_table_5", "office_table_7"):
+        depth = np.asarray(pyrseg.io.read_depth_image(str(SHARED / "realsense" / (name + "_depth.png"))))
+        n = pyrseg.measure_depth_noise(depth, metres_per_unit=0.001)
+        assert n["suggested"] == "realsense-d435", (name, n["reason"])
 
 
 def test_gil_is_released_while_segmenting():

@@ -1,7 +1,8 @@
 // The oracle, written from shared/spec/algorithm-contract.md and docs/algorithm.md only. It favours the most literal
 // reading of the text over speed: one std::vector per pyramid level, BFS for the fixed points of steps 2 and 4 (by
-// their definition, not by iterating the propagation rule), literal sequential sweeps for step 6. Every algorithm is
-// linear in the pixel count (up to a log factor in compaction), so full camera frames stay cheap.
+// their definition, not by iterating the propagation rule), literal sequential sweeps for step 6, std::map and a
+// union-find over labels for the merge (step 6d). Every algorithm is linear in the pixel count (up to a log factor in
+// compaction and the merge), so full camera frames stay cheap.
 #include "reference/reference.hpp"
 
 #include <algorithm>
@@ -93,6 +94,46 @@ std::string check_metric_params(const Params& p) {
     return {};
 }
 
+int point_shift(double unit_mm);
+
+// Section 5b's host constants, computed in double in the order written and converted to float32 once.
+struct MergeConstants {
+    int e = 0;           // the exponent of section 10, also G's (section 8b)
+    float t0 = 0.0f;     // T0
+    float t2 = 0.0f;     // T2
+    std::int64_t s = 0;  // S = rint(f * 256), 0..256
+};
+
+MergeConstants merge_constants(const Params& p) {
+    MergeConstants k;
+    k.e = point_shift(p.unit_mm);
+    const double u = std::ldexp(1.0, k.e + 13);  // u = 2^(e + 13), exact in double (e + 13 <= 140)
+    k.t0 = static_cast<float>((p.merge_tolerance_mm / p.unit_mm) * u);
+    k.t2 = static_cast<float>(((p.merge_tolerance_per_m2 * 1e-6) * p.unit_mm) * u);
+    k.s = static_cast<std::int64_t>(std::nearbyint(p.merge_max_bad_share * 256.0));  // round half to even
+    return k;
+}
+
+// Section 5b's parameters, checked whether or not merge is on (unit_mm has been checked before).
+std::string check_merge_params(const Params& p) {
+    if (p.merge_reach < 1 || p.merge_reach > 16) return "merge_reach must be in 1..16";
+    if (!std::isfinite(p.merge_tolerance_mm) || p.merge_tolerance_mm < 0.0) {
+        return "merge_tolerance_mm must be finite and >= 0";
+    }
+    if (!std::isfinite(p.merge_tolerance_per_m2) || p.merge_tolerance_per_m2 < 0.0) {
+        return "merge_tolerance_per_m2 must be finite and >= 0";
+    }
+    if (p.merge_min_crossings < 1) return "merge_min_crossings must be >= 1";
+    // Written so that NaN fails too.
+    if (!(p.merge_max_bad_share >= 0.0 && p.merge_max_bad_share <= 1.0)) {
+        return "merge_max_bad_share must be in [0, 1]";
+    }
+    const MergeConstants k = merge_constants(p);
+    if (!std::isfinite(k.t0)) return "merge_tolerance_mm is too large: T0 overflows float32";
+    if (!std::isfinite(k.t2)) return "merge_tolerance_per_m2 is too large: T2 overflows float32";
+    return {};
+}
+
 std::string check_params(int width, int height, const Params& p) {
     if (width < 1 || height < 1) return "width and height must be >= 1";
     if (!std::isfinite(p.ct) || p.ct < 0.0) return "ct must be finite and >= 0";
@@ -101,6 +142,7 @@ std::string check_params(int width, int height, const Params& p) {
     if (p.bridge_levels < 1) return "bridge_levels must be >= 1";
     if (p.unjoinable_gap < 1) return "unjoinable_gap must be >= 1";
     if (std::string why = check_metric_params(p); !why.empty()) return why;
+    if (std::string why = check_merge_params(p); !why.empty()) return why;
     const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
     if (pixels > kMaxU32) return "image too large: W*H does not fit in 32 bits";
     return {};
@@ -767,6 +809,130 @@ std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& filla
     return lab;
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// The merge (docs/algorithm.md section 5b, step 6d).
+
+// The tolerance at depth z: t = T0, or T0 + T2 * (z * z) in float32 when T2 != 0; tol = 2^30 if t >= 2^30, else
+// floor(t). Each float operation is its own statement, so no contraction is possible even without -ffp-contract=off.
+std::int64_t merge_tolerance(const MergeConstants& k, float z) {
+    const float two30 = 1073741824.0f;
+    float t = k.t0;
+    if (k.t2 != 0.0f) {
+        const float zz = z * z;
+        const float grow = k.t2 * zz;
+        t = k.t0 + grow;
+    }
+    if (t >= two30) return std::int64_t{1} << 30;
+    return static_cast<std::int64_t>(std::floor(t));
+}
+
+// qn turned toward the camera: negated when qn . F(P) > 0 (F of section 8).
+Vec3i toward_camera(const std::array<std::int64_t, 3>& qn, const float* p) {
+    const Vec3i w = fixed_point(Vec3f{p[0], p[1], p[2]});
+    Vec3i n{qn[0], qn[1], qn[2]};
+    if (n[0] * w[0] + n[1] * w[1] + n[2] * w[2] > 0) {
+        for (std::int64_t& c : n) c = -c;
+    }
+    return n;
+}
+
+// One crossing from pa (on the a side) to pb (on the b side): good or bad.
+bool good_crossing(const float* points, const QuantizedNormals& qn, const MergeConstants& k, std::size_t pa,
+                   std::size_t pb) {
+    const float* a = points + 3 * pa;
+    const float* b = points + 3 * pb;
+    const float scale = std::ldexp(1.0f, k.e);
+    Vec3i d{};
+    for (std::size_t c = 0; c < 3; ++c) {
+        d[c] = fixed_coordinate(b[c], scale) - fixed_coordinate(a[c], scale);
+        if ((d[c] < 0 ? -d[c] : d[c]) > (std::int64_t{1} << 16)) return false;
+    }
+    const Vec3i na = toward_camera(qn[pa], a);
+    const Vec3i nb = toward_camera(qn[pb], b);
+    const std::int64_t ha = na[0] * d[0] + na[1] * d[1] + na[2] * d[2];
+    const std::int64_t hb = -(nb[0] * d[0] + nb[1] * d[1] + nb[2] * d[2]);
+    const std::int64_t tol = merge_tolerance(k, std::min(a[2], b[2]));
+    return ha <= tol && hb <= tol;
+}
+
+// Step 6d on level N's labels: count every pair's good and bad crossings, join the pairs that pass, and give every
+// labelled pixel the smallest label of its group. Every labelled pixel is valid, so its point and qn are defined.
+void merge_labels(std::vector<std::uint32_t>& lab, const float* points, const QuantizedNormals& qn, std::int64_t width,
+                  std::int64_t height, const Params& p) {
+    const MergeConstants k = merge_constants(p);
+    const std::int64_t r = p.merge_reach;
+    struct Counts {
+        std::uint32_t good = 0;
+        std::uint32_t bad = 0;
+    };
+    std::map<std::pair<std::uint32_t, std::uint32_t>, Counts> pairs;  // keyed (smaller label, larger label)
+    const auto label_at = [&](std::int64_t x, std::int64_t y) { return lab[static_cast<std::size_t>(y * width + x)]; };
+    const std::int64_t dirs[2][2] = {{1, 0}, {0, 1}};
+    for (std::int64_t y = 0; y < height; ++y) {
+        for (std::int64_t x = 0; x < width; ++x) {
+            const std::uint32_t a = label_at(x, y);
+            if (a == 0) continue;
+            for (const auto& dir : dirs) {
+                const std::int64_t dx = dir[0];
+                const std::int64_t dy = dir[1];
+                const std::int64_t qx = x + dx;
+                const std::int64_t qy = y + dy;
+                if (qx >= width || qy >= height) continue;
+                const std::uint32_t b = label_at(qx, qy);
+                if (b == 0 || b == a) continue;
+                // The largest k in 0..r-1 with the k pixels beyond the side's own pixel all existing and carrying
+                // its label; `step` is -1 for the a side (back from p), +1 for the b side (on from q).
+                const auto reach = [&](std::int64_t sx, std::int64_t sy, std::int64_t step, std::uint32_t l) {
+                    std::int64_t kk = 0;
+                    while (kk < r - 1) {
+                        const std::int64_t nx = sx + step * (kk + 1) * dx;
+                        const std::int64_t ny = sy + step * (kk + 1) * dy;
+                        if (nx < 0 || ny < 0 || nx >= width || ny >= height || label_at(nx, ny) != l) break;
+                        ++kk;
+                    }
+                    return static_cast<std::size_t>((sy + step * kk * dy) * width + (sx + step * kk * dx));
+                };
+                const std::size_t pa = reach(x, y, -1, a);
+                const std::size_t pb = reach(qx, qy, +1, b);
+                Counts& counts = pairs[{std::min(a, b), std::max(a, b)}];
+                if (good_crossing(points, qn, k, pa, pb)) {
+                    ++counts.good;
+                } else {
+                    ++counts.bad;
+                }
+            }
+        }
+    }
+
+    // Union-find over the labels of the pairs that join; a root is always the smallest label of its group.
+    std::map<std::uint32_t, std::uint32_t> parent;
+    const auto find = [&parent](std::uint32_t l) {
+        std::uint32_t root = l;
+        while (parent.at(root) != root) root = parent.at(root);
+        while (parent.at(l) != root) l = std::exchange(parent.at(l), root);  // path compression
+        return root;
+    };
+    for (const auto& [key, counts] : pairs) {
+        const std::uint64_t total = std::uint64_t{counts.good} + std::uint64_t{counts.bad};
+        const bool joins = total >= static_cast<std::uint64_t>(p.merge_min_crossings) &&
+                           std::uint64_t{counts.bad} * 256 <= static_cast<std::uint64_t>(k.s) * total;
+        if (!joins) continue;
+        parent.try_emplace(key.first, key.first);
+        parent.try_emplace(key.second, key.second);
+        const std::uint32_t ra = find(key.first);
+        const std::uint32_t rb = find(key.second);
+        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    if (parent.empty()) return;
+    std::map<std::uint32_t, std::uint32_t> group_of;
+    for (const auto& entry : parent) group_of[entry.first] = find(entry.first);
+    for (std::uint32_t& l : lab) {
+        if (l == 0) continue;
+        const auto it = group_of.find(l);
+        if (it != group_of.end()) l = it->second;
+    }
+}
+
 // Step 7 and the output fields shared by segment() and segment_mask().
 void finish(std::vector<std::uint32_t> raw, const Params& p, Output& out) {
     std::vector<std::uint32_t> distinct;
@@ -926,12 +1092,16 @@ DepthPoints depth_to_points(const DepthInput& depth, double unit_mm) {
 
 namespace {
 
+// points and normals are what the merge (step 6d) reads; null for a mask, which segment_mask() refuses to merge.
 Output label_from_mask(std::vector<std::uint8_t> fillable, const std::vector<std::uint8_t>& valid, int width,
-                       int height, const Params& p, const Plan& plan) {
+                       int height, const Params& p, const Plan& plan, const float* points = nullptr,
+                       const float* normals = nullptr) {
     Output out;
     std::vector<std::uint32_t> raw = plan.fallback
                                          ? fallback_labels(fillable, width, height)
                                          : pyramid_labels(fillable, valid, plan, p.label_edges, p.edge_rounds);
+    // Step 6d, after 6c (or 6b) and before compaction; not in the small-image fallback.
+    if (p.merge && !plan.fallback) merge_labels(raw, points, quantize_normals(normals, valid), width, height, p);
     out.fillable = std::move(fillable);
     finish(std::move(raw), p, out);
     return out;
@@ -986,7 +1156,7 @@ Output segment(const float* points, const float* normals, int width, int height,
     }
     std::vector<std::uint8_t> fillable = robust ? robust_metric(points, used.data(), valid, width, height, params)
                                                 : metric(points, used.data(), valid, width, height, params);
-    Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan);
+    Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan, points, used.data());
     out.segments = segment_statistics(out, points, used.data(), width, params);
     out.normals = std::move(used);
     return out;
@@ -995,6 +1165,8 @@ Output segment(const float* points, const float* normals, int width, int height,
 Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int width, int height,
                     const Params& params) {
     if (std::string why = check_params(width, height, params); !why.empty()) return failure(std::move(why));
+    // Section 5b: the merge needs points and normals, which a mask does not have.
+    if (params.merge) return failure("merge needs points and normals: a mask cannot be merged");
     Plan plan;
     if (std::string why = make_plan(width, height, params, plan); !why.empty()) return failure(std::move(why));
 

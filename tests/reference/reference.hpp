@@ -1,8 +1,8 @@
 #pragma once
 // The independent oracle for pyrseg: a plain, slow-but-linear implementation of the algorithm contract
 // (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals),
-// 8 (the normals pass) and 1b (depth images), written from that text only. The conformance suite compares every backend
-// with it bit for bit.
+// 8 (the normals pass), 1b (depth images) and 5b (the merge), written from that text only. The conformance suite
+// compares every backend with it bit for bit.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -34,6 +34,15 @@ struct Params {
     int curvature_stride = 4;       // s, 1..64: the curvature term compares the pairs of pixels s before and after
     double dt_per_m2 = 0.0;         // millimetres added to dt per square metre of depth; finite, >= 0
     double ct_growth_per_m2 = 0.0;  // growth of the curvature limit per square metre of depth; finite, >= 0
+    // Section 5b: the merge (step 6d) of segments whose shared boundary is convex or flat. Needs points and normals
+    // (segment_mask with merge on gives ok = false); not run in the small-image fallback. The five numbers below are
+    // checked against their ranges whether or not merge is on.
+    bool merge = false;
+    int merge_reach = 2;                  // r, 1..16: each side looks up to r - 1 pixels back from the boundary
+    double merge_tolerance_mm = 1.0;      // t0, finite, >= 0: how far a side may lie above the other's tangent plane
+    double merge_tolerance_per_m2 = 0.0;  // t2, finite, >= 0: millimetres added to t0 per square metre of depth
+    int merge_min_crossings = 16;         // C >= 1: crossings a pair needs to join
+    double merge_max_bad_share = 0.05;    // f in [0, 1]: the largest share of bad crossings a joining pair may have
 };
 
 // One segment's statistics (docs/algorithm.md section 10), in compacted order: exact integer sums.

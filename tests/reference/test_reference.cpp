@@ -3,6 +3,7 @@
 // oracle, so a mistake in the oracle cannot hide behind itself.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -2119,9 +2120,13 @@ TEST(ReferenceDepth, SegmentDepthIsSegmentOfThePoints) {
     in.cy = 14.5;
     Params metres;
     metres.unit_mm = 1000.0;
-    for (const Params& params : {Params{}, robust_params(), metres}) {
+    // The merge (section 5b) reads the back-projected points, and keeps the box apart from the plane behind it.
+    Params merge = metres;
+    merge.merge = true;
+    for (const Params& params : {Params{}, robust_params(), metres, merge}) {
         SCOPED_TRACE("unit_mm " + std::to_string(params.unit_mm) +
-                     (params.metric == pyrseg_ref::Metric::robust ? " robust" : " paper"));
+                     (params.metric == pyrseg_ref::Metric::robust ? " robust" : " paper") +
+                     (params.merge ? " merge" : ""));
         const DepthPoints p = pyrseg_ref::depth_to_points(in, params.unit_mm);
         ASSERT_TRUE(p.ok) << p.error;
         EXPECT_TRUE(no_data(p, w, 3, 3));
@@ -2159,6 +2164,449 @@ TEST(ReferenceDepth, SegmentDepthIsSegmentOfThePoints) {
     bad_params = Params{};
     bad_params.normal_radius = 0;
     EXPECT_FALSE(pyrseg_ref::segment_depth(in, w, h, bad_params).ok);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The merge (docs/algorithm.md section 5b, step 6d).
+
+// The merge on, with the tolerance these tests' numbers are worked out for (1.5 mm, whatever the default).
+Params merged(Params p = Params{}) {
+    p.merge = true;
+    p.merge_tolerance_mm = 1.5;
+    return p;
+}
+
+// A crease along the image's middle column line, in millimetres: pixel (px, py) is at x = (px - 15.5) * 2,
+// y = (py - 15.5) * 2 (so pixels 15 and 16 are 1 mm either side of it) and z = z0 + sign * |x| + tilt * py. sign = +1
+// is a convex ridge (the crease nearest the camera, the faces sloping away at 45 degrees), sign = -1 a concave valley.
+// The given normals are the faces' unit normals turned toward the camera, (-sign, 0, -1) / sqrt 2 on the left
+// (px < 16) and (sign, 0, -1) / sqrt 2 on the right, quantized to (-+sign 5793, 0, -5793) (0.70710677 * 8192 =
+// 5792.62). tilt moves the rows away without changing the normals (the merge reads the normals as given).
+struct Scene {
+    std::vector<float> points;
+    std::vector<float> normals;
+};
+
+Scene crease(float z0, float sign, float tilt = 0.0f) {
+    Scene s;
+    const float c = 1.0f / std::sqrt(2.0f);
+    for (int py = 0; py < 32; ++py) {
+        for (int px = 0; px < 32; ++px) {
+            const float x = (static_cast<float>(px) - 15.5f) * 2.0f;
+            const float y = (static_cast<float>(py) - 15.5f) * 2.0f;
+            const float z = z0 + sign * std::fabs(x) + tilt * static_cast<float>(py);
+            s.points.insert(s.points.end(), {x, y, z});
+            const float side = px < 16 ? -1.0f : 1.0f;
+            s.normals.insert(s.normals.end(), {sign * side * c, 0.0f, -c});
+        }
+    }
+    return s;
+}
+
+// The crease scenes without the merge, derived as in ReferenceEndToEnd.TwoPlanesWithDepthStep: the faces meet at 90
+// degrees, so columns 15 and 16 (3 of their 8 neighbours across the crease, mean cos 5/8 < cos 0.25) are edges and
+// every other pixel is fillable (|dz| is 2 mm to every neighbour). Level 3 (4 x 4) has fillable columns 0 and 3,
+// whose first labels are 6 and 9; no label is old (levels 1 and 2 have no fillable texel); edge labelling gives
+// column 15 label 6 and column 16 label 9.
+std::vector<std::uint32_t> crease_labels(std::uint32_t left, std::uint32_t right) {
+    std::vector<std::uint32_t> out;
+    for (int py = 0; py < 32; ++py) {
+        for (int px = 0; px < 32; ++px) out.push_back(px < 16 ? left : right);
+    }
+    return out;
+}
+
+TEST(ReferenceMerge, ConvexRidgeBecomesOneSegment) {
+    // Every row is one crossing of {6, 9}, from p = (15, y) to q = (16, y); with r = 2 the sides reach back one pixel,
+    // pa = (14, y) at (-3, y, 903) and pb = (17, y) at (3, y, 903). e = 4 (2^4 >= 16 * 1 mm), so
+    // D = G(pb) - G(pa) = (96, 0, 0). Both normals already face the camera (qn . F(P) < 0, P's z dominates):
+    // h_a = (-5793, 0, -5793) . D = -556128 and h_b = -((5793, 0, -5793) . D) = -556128, both below
+    // tol = floor(1.5 * 2^17) = 196608: 32 good crossings, none bad, 32 >= C = 16 -> {6, 9} joins and every pixel
+    // takes 6.
+    const Scene s = crease(900.0f, 1.0f);
+    const Output off = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, Params{});
+    ASSERT_TRUE(off.ok) << off.error;
+    EXPECT_EQ(off.segment_count, 2u);
+    EXPECT_LABELS(off.raw_labels, crease_labels(6, 9), 32);
+
+    for (int reach : {1, 2, 3, 16}) {
+        SCOPED_TRACE("merge_reach " + std::to_string(reach));
+        Params p = merged();
+        p.merge_reach = reach;
+        const Output on = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, p);
+        ASSERT_TRUE(on.ok) << on.error;
+        EXPECT_EQ(on.segment_count, 1u);
+        EXPECT_LABELS(on.raw_labels, crease_labels(6, 6), 32);
+        EXPECT_LABELS(on.labels, crease_labels(1, 1), 32);
+        EXPECT_EQ(on.fillable, off.fillable);  // the merge changes labels only
+        // Section 10's statistics are of the merged labels.
+        ASSERT_EQ(on.segments.size(), 1u);
+        EXPECT_EQ(on.segments[0].pixel_count, 1024u);
+        EXPECT_EQ(on.segments[0].label, 1u);
+    }
+    // The pair has 32 crossings: C = 32 joins, C = 33 does not.
+    Params c32 = merged();
+    c32.merge_min_crossings = 32;
+    EXPECT_EQ(pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, c32).segment_count, 1u);
+    Params c33 = merged();
+    c33.merge_min_crossings = 33;
+    const Output not_enough = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, c33);
+    EXPECT_EQ(not_enough.segment_count, 2u);
+    EXPECT_LABELS(not_enough.raw_labels, crease_labels(6, 9), 32);
+
+    // Normals given facing away from the camera are turned toward it (qn . F(P) > 0 -> -qn) before h is computed:
+    // negating every normal changes neither the metric (its dot products are the same) nor the merge.
+    Scene away = s;
+    for (float& v : away.normals) v = -v;
+    const Output flipped = pyrseg_ref::segment(away.points.data(), away.normals.data(), 32, 32, merged());
+    ASSERT_TRUE(flipped.ok) << flipped.error;
+    EXPECT_LABELS(flipped.raw_labels, crease_labels(6, 6), 32);
+
+    // Estimated normals (section 8, and the robust ones of section 8b with edge rounds that close the robust
+    // metric's wide edge band, without which the two segments do not touch): two segments without the merge, one
+    // with it.
+    Params robust = robust_params();
+    robust.normal_radius = 2;
+    robust.edge_rounds = 10;
+    for (const Params& base : {Params{}, robust}) {
+        SCOPED_TRACE(base.metric == pyrseg_ref::Metric::robust ? "robust, estimated" : "paper, estimated");
+        const Output est_off = pyrseg_ref::segment(s.points.data(), nullptr, 32, 32, base);
+        const Output est_on = pyrseg_ref::segment(s.points.data(), nullptr, 32, 32, merged(base));
+        ASSERT_TRUE(est_off.ok) << est_off.error;
+        ASSERT_TRUE(est_on.ok) << est_on.error;
+        EXPECT_EQ(est_off.segment_count, 2u);
+        EXPECT_EQ(est_on.segment_count, 1u);
+    }
+}
+
+TEST(ReferenceMerge, ConcaveValleyStaysTwoSegments) {
+    // The ridge turned inside out: pa = (14, y) at (-3, y, 927), pb = (17, y) at (3, y, 927), D = (96, 0, 0) again,
+    // but the normals are (5793, 0, -5793) and (-5793, 0, -5793): h_a = h_b = 5793 * 96 = 556128 (each side 4.24 mm
+    // in front of the other's tangent plane) > 196608: 32 bad crossings, no join.
+    const Scene s = crease(930.0f, -1.0f);
+    const Output off = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, Params{});
+    const Output on = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, merged());
+    ASSERT_TRUE(off.ok) << off.error;
+    ASSERT_TRUE(on.ok) << on.error;
+    EXPECT_EQ(off.segment_count, 2u);
+    EXPECT_LABELS(off.raw_labels, crease_labels(6, 9), 32);
+    EXPECT_EQ(on.segment_count, 2u);
+    EXPECT_LABELS(on.raw_labels, crease_labels(6, 9), 32);
+
+    // The tolerance is inclusive: T0 = 556128 (t0 = 556128 / 2^17 mm, exact) joins, one unit less does not.
+    Params at = merged();
+    at.merge_tolerance_mm = 556128.0 / 131072.0;
+    EXPECT_EQ(pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, at).segment_count, 1u);
+    Params below = merged();
+    below.merge_tolerance_mm = 556127.0 / 131072.0;
+    EXPECT_EQ(pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, below).segment_count, 2u);
+
+    // With r = 1 the sides do not reach back: pa = (15, y), pb = (16, y), D = (32, 0, 0), h = 5793 * 32 = 185376
+    // <= 196608 (each side 1.41 mm in front of the other), so a crease this sharp joins at reach 1; at reach 3,
+    // D = (160, 0, 0) and h = 926880: no join.
+    Params r1 = merged();
+    r1.merge_reach = 1;
+    const Output near = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, r1);
+    EXPECT_EQ(near.segment_count, 1u);
+    EXPECT_LABELS(near.raw_labels, crease_labels(6, 6), 32);
+    Params r3 = merged();
+    r3.merge_reach = 3;
+    EXPECT_EQ(pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, r3).segment_count, 2u);
+
+    // Normals facing away from the camera: turned toward it, so still no join.
+    Scene away = s;
+    for (float& v : away.normals) v = -v;
+    const Output flipped = pyrseg_ref::segment(away.points.data(), away.normals.data(), 32, 32, merged());
+    ASSERT_TRUE(flipped.ok) << flipped.error;
+    EXPECT_LABELS(flipped.raw_labels, crease_labels(6, 9), 32);
+
+    // Estimated normals: two segments either way.
+    Params robust = robust_params();
+    robust.normal_radius = 2;
+    robust.edge_rounds = 10;
+    for (const Params& base : {Params{}, robust}) {
+        SCOPED_TRACE(base.metric == pyrseg_ref::Metric::robust ? "robust, estimated" : "paper, estimated");
+        const Output est_off = pyrseg_ref::segment(s.points.data(), nullptr, 32, 32, base);
+        const Output est_on = pyrseg_ref::segment(s.points.data(), nullptr, 32, 32, merged(base));
+        ASSERT_TRUE(est_off.ok) << est_off.error;
+        ASSERT_TRUE(est_on.ok) << est_on.error;
+        EXPECT_EQ(est_off.segment_count, 2u);
+        EXPECT_EQ(est_on.segment_count, 2u);
+        EXPECT_EQ(est_on.raw_labels, est_off.raw_labels);
+    }
+}
+
+TEST(ReferenceMerge, EachSideReachesBackOnItsOwnSide) {
+    // A 45 degree concave crease between a sloping face and a frontal one, x as in crease(). Slope on the left:
+    // z = 930 + min(x, 0), normals (1, 0, -1) / sqrt 2 (qn (5793, 0, -5793)) for x < 0 and (0, 0, -1) (qn
+    // (0, 0, -8192)) for x > 0. Columns 15 and 16 are edges (mean cos (5 + 3 * 0.707) / 8 = 0.89 < cos 0.25), the
+    // labels those of crease_labels(6, 9). Each row's crossing, with r = 2: pa = (14, y) at x = -3, z = 927 and
+    // pb = (17, y) at x = 3, z = 930, D = (96, 0, 48): h_a = 5793 * (96 - 48) = 278064 (pb 2.1 mm in front of the
+    // slope's plane) and h_b = 8192 * 48 = 393216 (pa 3 mm in front of the frontal plane). With r = 1, pa = (15, y)
+    // at x = -1, z = 929 and pb = (16, y) at x = 1, z = 930: D = (32, 0, 16), h_a = 5793 * 16 = 92688,
+    // h_b = 8192 * 16 = 131072. With T0 = 300000 (t0 = 300000 / 2^17 mm, exact) reach 1 joins, reach 2 does not; a
+    // reach that stopped at p on the a side would give h_b = 131072 and join. The mirror image (slope on the right,
+    // z = 930 - max(x, 0), qn (-5793, 0, -5793)) swaps the two h, and so tests the b side's reach.
+    const float c = 1.0f / std::sqrt(2.0f);
+    for (const bool slope_left : {true, false}) {
+        SCOPED_TRACE(slope_left ? "slope on the left" : "slope on the right");
+        std::vector<float> pts;
+        std::vector<float> nrm;
+        for (int py = 0; py < 32; ++py) {
+            for (int px = 0; px < 32; ++px) {
+                const float x = (static_cast<float>(px) - 15.5f) * 2.0f;
+                const float y = (static_cast<float>(py) - 15.5f) * 2.0f;
+                const bool sloped = slope_left ? x < 0.0f : x > 0.0f;
+                const float z = 930.0f - (sloped ? std::fabs(x) : 0.0f);
+                pts.insert(pts.end(), {x, y, z});
+                if (sloped) {
+                    nrm.insert(nrm.end(), {slope_left ? c : -c, 0.0f, -c});
+                } else {
+                    nrm.insert(nrm.end(), {0.0f, 0.0f, -1.0f});
+                }
+            }
+        }
+        Params p = merged();
+        p.merge_tolerance_mm = 300000.0 / 131072.0;
+        const Output off = pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, Params{});
+        ASSERT_TRUE(off.ok) << off.error;
+        EXPECT_LABELS(off.raw_labels, crease_labels(6, 9), 32);
+        p.merge_reach = 2;
+        const Output r2 = pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, p);
+        EXPECT_LABELS(r2.raw_labels, crease_labels(6, 9), 32);
+        p.merge_reach = 1;
+        const Output r1 = pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, p);
+        EXPECT_LABELS(r1.raw_labels, crease_labels(6, 6), 32);
+        // At reach 2 the larger h is 393216: the tolerance just at it joins.
+        p.merge_reach = 2;
+        p.merge_tolerance_mm = 393216.0 / 131072.0;
+        EXPECT_EQ(pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, p).segment_count, 1u);
+    }
+}
+
+TEST(ReferenceMerge, BadShareIsComparedWithRintOfFTimes256) {
+    // The valley with rows moving 2 mm away per row (depth differences to every neighbour stay <= 4 mm, so the
+    // segmentation is as before) and the tolerance growing with depth only: t0 = 0, t2 = 4.905 mm / m^2, so
+    // T2 = (float)(4.905e-6 * 2^17) = 0.642908 and row y's crossing (pa, pb at z = 927 + 2y, D = (96, 0, 0) and
+    // h = 556128 as before) has tol = floor(T2 * z^2): 554856 for y = 1 (z^2 = 863041) and 557247 for y = 2
+    // (z^2 = 866761). So rows 0 and 1 are bad, rows 2..31 good: g = 30, n_bad = 2, 512 <= S * 32 iff S >= 16.
+    const Scene s = crease(930.0f, -1.0f, 2.0f);
+    Params base = merged();
+    base.merge_tolerance_mm = 0.0;
+    base.merge_tolerance_per_m2 = 4.905;
+    const auto count_with = [&](double share, int min_crossings) {
+        Params p = base;
+        p.merge_max_bad_share = share;
+        p.merge_min_crossings = min_crossings;
+        const Output o = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, p);
+        EXPECT_TRUE(o.ok) << o.error;
+        return o.segment_count;
+    };
+    Params off = base;
+    off.merge = false;
+    const Output unmerged = pyrseg_ref::segment(s.points.data(), s.normals.data(), 32, 32, off);
+    EXPECT_EQ(unmerged.segment_count, 2u);
+    EXPECT_LABELS(unmerged.raw_labels, crease_labels(6, 9), 32);
+    EXPECT_EQ(count_with(0.0625, 16), 1u);  // S = 16: 512 <= 512, inclusive
+    EXPECT_EQ(count_with(0.061, 16), 1u);   // S = rint(15.616) = 16, although 0.061 < 2 / 32
+    EXPECT_EQ(count_with(0.06, 16), 2u);    // S = rint(15.36) = 15
+    EXPECT_EQ(count_with(0.05, 16), 2u);    // the default, S = 13
+    EXPECT_EQ(count_with(0.0, 16), 2u);
+    // Bad crossings count toward C: 32 crossings in all.
+    EXPECT_EQ(count_with(1.0, 32), 1u);
+    EXPECT_EQ(count_with(1.0, 33), 2u);
+    // Without the growth every crossing is bad; f = 1 (S = 256) still joins them, f just below 1 does not.
+    base.merge_tolerance_per_m2 = 0.0;
+    EXPECT_EQ(count_with(1.0, 16), 1u);
+    EXPECT_EQ(count_with(0.99, 16), 2u);
+}
+
+TEST(ReferenceMerge, BoxStandingOnAPlaneStaysApartFromIt) {
+    // 64 x 64, 2 mm pixels, x = (px - 32) * 2, y = (py - 32) * 2. A floor at z = 1000 (normal (0, 0, -1)) with a box
+    // on it over rows 16..47: its top at z = 950 over columns 12..35 (a 50 mm depth step to the floor at column
+    // 11/12 and at rows 15/16 and 47/48), then its side sloping away from the top's edge, z = 950 + 2 (x - 6), normal
+    // (2, 0, -1) / sqrt 5, over columns 36..47 (z 950..998), which meets the floor at column 48 in a concave crease.
+    // Without the merge: floor, top and side are three segments (raw labels 22, 48 and 176: the first labels of level
+    // 4's texels (0, 0) and (2, 3) and of level 5's texel (10, 5)). With it, top and side (a convex crease) join and
+    // take 48; the floor meets the top at a depth step and the side at a concave crease, where every crossing is bad
+    // (the nearer side lies far in front of the farther one's tangent plane), and keeps 22.
+    const int w = 64;
+    const int h = 64;
+    const float s5 = 1.0f / std::sqrt(5.0f);
+    std::vector<float> pts;
+    std::vector<float> nrm;
+    for (int py = 0; py < h; ++py) {
+        for (int px = 0; px < w; ++px) {
+            const float x = static_cast<float>(px - 32) * 2.0f;
+            const float y = static_cast<float>(py - 32) * 2.0f;
+            const bool box_rows = py >= 16 && py < 48;
+            float z = 1000.0f;
+            std::vector<float> n = {0.0f, 0.0f, -1.0f};
+            if (box_rows && px >= 12 && px < 36) {
+                z = 950.0f;
+            } else if (box_rows && px >= 36 && px < 48) {
+                z = 950.0f + 2.0f * (x - 6.0f);
+                n = {2.0f * s5, 0.0f, -s5};
+            }
+            pts.insert(pts.end(), {x, y, z});
+            nrm.insert(nrm.end(), n.begin(), n.end());
+        }
+    }
+    const auto at = [&](const Output& o, int px, int py) {
+        return o.raw_labels[static_cast<std::size_t>(py * w + px)];
+    };
+    const Output off = pyrseg_ref::segment(pts.data(), nrm.data(), w, h, Params{});
+    const Output on = pyrseg_ref::segment(pts.data(), nrm.data(), w, h, merged());
+    ASSERT_TRUE(off.ok) << off.error;
+    ASSERT_TRUE(on.ok) << on.error;
+    EXPECT_EQ(off.segment_count, 3u);
+    EXPECT_EQ(at(off, 0, 0), 22u);     // floor
+    EXPECT_EQ(at(off, 20, 30), 48u);   // top
+    EXPECT_EQ(at(off, 42, 30), 176u);  // side
+    EXPECT_EQ(on.segment_count, 2u);
+    EXPECT_EQ(at(on, 0, 0), 22u);
+    EXPECT_EQ(at(on, 20, 30), 48u);
+    EXPECT_EQ(at(on, 42, 30), 48u);
+    // Every pixel: the floor's label where it was, the box's two faces now one.
+    for (std::size_t i = 0; i < off.raw_labels.size(); ++i) {
+        const std::uint32_t was = off.raw_labels[i];
+        EXPECT_EQ(on.raw_labels[i], was == 176u ? 48u : was) << "pixel " << i;
+    }
+    // Whatever share of bad crossings is allowed short of all of them, the floor stays apart: it has no good one.
+    Params lax = merged();
+    lax.merge_max_bad_share = 0.99;
+    lax.merge_min_crossings = 1;
+    EXPECT_EQ(pyrseg_ref::segment(pts.data(), nrm.data(), w, h, lax).segment_count, 2u);
+}
+
+TEST(ReferenceMerge, DifferenceBeyondTwoToTheSixteenIsBad) {
+    // Two frontal planes (normal (0, 0, -1)), x < 8 at z = 1000 and x >= 8 at z = 1000 + 4096 (D_z = 4096 * 16 = 2^16)
+    // or 1000 + 4096.0625 (D_z = 2^16 + 1). The tolerance is huge (t0 = 10^6 mm: T0 = 1.3e11 >= 2^30, tol = 2^30),
+    // so h_b = 8192 * 2^16 = 2^29 passes and only |D_c| > 2^16 can make the crossings bad.
+    Params p = merged();
+    p.merge_tolerance_mm = 1e6;
+    for (const float far : {5096.0f, 5096.0625f}) {
+        const std::vector<float> pts = grid_points(16, 16, [far](int x, int) { return x < 8 ? 1000.0f : far; });
+        const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+        const Output off = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, Params{});
+        const Output on = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+        ASSERT_TRUE(off.ok) << off.error;
+        ASSERT_TRUE(on.ok) << on.error;
+        EXPECT_EQ(off.segment_count, 2u);
+        EXPECT_EQ(on.segment_count, far == 5096.0f ? 1u : 2u) << far;
+    }
+}
+
+TEST(ReferenceMerge, GroupsJoinTransitivelyAndTakeTheirSmallestLabel) {
+    // A flat top between two 45 degree slopes (a prism seen from its ridge side), x as in crease(): z = 900 +
+    // max(0, |x| - 10), normals (0, 0, -1) on the top (|x| < 10) and (-+1, 0, -1) / sqrt 2 on the slopes. Columns 10,
+    // 11, 20 and 21 are edges (3 of 8 neighbours at 45 degrees: mean cos 0.89 < cos 0.25). Without the merge: the
+    // slopes take level 3's labels 6 and 9 (texels 0 and 3), the top level 4's label 25 (texel (3, 0), columns 12..15;
+    // level 3's texels 1 and 2 contain edge columns). Both creases are convex, so {6, 25} and {9, 25} join; 6 and 9
+    // never touch, yet all three are one group and take its smallest label, 6.
+    std::vector<float> pts;
+    std::vector<float> nrm;
+    const float c = 1.0f / std::sqrt(2.0f);
+    std::vector<std::uint32_t> unmerged;
+    for (int py = 0; py < 32; ++py) {
+        for (int px = 0; px < 32; ++px) {
+            const float x = (static_cast<float>(px) - 15.5f) * 2.0f;
+            const float y = (static_cast<float>(py) - 15.5f) * 2.0f;
+            const float ax = std::fabs(x);
+            pts.insert(pts.end(), {x, y, 900.0f + std::max(0.0f, ax - 10.0f)});
+            if (ax < 10.0f) {
+                nrm.insert(nrm.end(), {0.0f, 0.0f, -1.0f});
+            } else {
+                nrm.insert(nrm.end(), {x < 0.0f ? -c : c, 0.0f, -c});
+            }
+            unmerged.push_back(px <= 10 ? 6u : px <= 20 ? 25u : 9u);
+        }
+    }
+    const Output off = pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, Params{});
+    const Output on = pyrseg_ref::segment(pts.data(), nrm.data(), 32, 32, merged());
+    ASSERT_TRUE(off.ok) << off.error;
+    ASSERT_TRUE(on.ok) << on.error;
+    EXPECT_EQ(off.segment_count, 3u);
+    EXPECT_LABELS(off.raw_labels, unmerged, 32);
+    EXPECT_EQ(on.segment_count, 1u);
+    EXPECT_LABELS(on.raw_labels, (std::vector<std::uint32_t>(1024, 6u)), 32);
+}
+
+TEST(ReferenceMerge, ParameterErrors) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const auto with = [](Params p, auto change) {
+        change(p);
+        return p;
+    };
+    // Out of range: rejected by every entry point, merge on or off, with a message naming the parameter.
+    const auto rejected_for = [&](Params p, const std::string& name) {
+        for (bool merge : {false, true}) {
+            p.merge = merge;
+            const Output a = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+            const Output b = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+            const Output c = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+            for (const Output* o : {&a, &b, &c}) {
+                if (o->ok || o->error.find(name) == std::string::npos) return false;
+            }
+        }
+        return true;
+    };
+    const auto accepted = [&](const Params& p) {
+        return pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok &&
+               pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p).ok;
+    };
+    const Params on = merged();
+    EXPECT_TRUE(accepted(on));
+    EXPECT_TRUE(rejected_for(with(on, [](Params& p) { p.merge_reach = 0; }), "merge_reach"));
+    EXPECT_TRUE(rejected_for(with(on, [](Params& p) { p.merge_reach = 17; }), "merge_reach"));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_reach = 1; })));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_reach = 16; })));
+    for (double bad : {-1.0, nan, inf, -inf}) {
+        EXPECT_TRUE(rejected_for(with(on, [&](Params& p) { p.merge_tolerance_mm = bad; }), "merge_tolerance_mm"))
+            << bad;
+        EXPECT_TRUE(
+            rejected_for(with(on, [&](Params& p) { p.merge_tolerance_per_m2 = bad; }), "merge_tolerance_per_m2"))
+            << bad;
+    }
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_tolerance_mm = 0.0; })));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_tolerance_per_m2 = 1e6; })));
+    EXPECT_TRUE(rejected_for(with(on, [](Params& p) { p.merge_min_crossings = 0; }), "merge_min_crossings"));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_min_crossings = 1; })));
+    for (double bad : {-0.01, 1.01, nan, inf}) {
+        EXPECT_TRUE(rejected_for(with(on, [&](Params& p) { p.merge_max_bad_share = bad; }), "merge_max_bad_share"))
+            << bad;
+    }
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_max_bad_share = 0.0; })));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_max_bad_share = 1.0; })));
+    // T0 = (float)(t0 * 2^17) and T2 = (float)((t2 * 1e-6) * 2^17) in millimetres must be finite float32s (the
+    // largest is 3.4028e38): t0 = 2e33 gives 2.6e38, 3e33 gives 3.9e38.
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_tolerance_mm = 2e33; })));
+    EXPECT_TRUE(rejected_for(with(on, [](Params& p) { p.merge_tolerance_mm = 3e33; }), "merge_tolerance_mm"));
+    EXPECT_TRUE(accepted(with(on, [](Params& p) { p.merge_tolerance_per_m2 = 2e39; })));
+    EXPECT_TRUE(rejected_for(with(on, [](Params& p) { p.merge_tolerance_per_m2 = 3e39; }), "merge_tolerance_per_m2"));
+    // In metres (unit_mm = 1000, e = 14, u = 2^27): T0 = (t0 / 1000) * 2^27, T2 = (t2 * 1e-6 * 1000) * 2^27.
+    Params metres = on;
+    metres.unit_mm = 1000.0;
+    // (t0 = 2e33 and 3e33 give 2.7e38 and 4.0e38; t2 = 2e33 and 3e33 likewise.)
+    EXPECT_TRUE(accepted(with(metres, [](Params& p) { p.merge_tolerance_mm = 2e33; })));
+    EXPECT_TRUE(rejected_for(with(metres, [](Params& p) { p.merge_tolerance_mm = 3e33; }), "merge_tolerance_mm"));
+    EXPECT_TRUE(accepted(with(metres, [](Params& p) { p.merge_tolerance_per_m2 = 2e33; })));
+    EXPECT_TRUE(
+        rejected_for(with(metres, [](Params& p) { p.merge_tolerance_per_m2 = 3e33; }), "merge_tolerance_per_m2"));
+    // Merge on is accepted for the small-image fallback (8 x 8), where it does not run. (It would have nothing to
+    // do there anyway: the fallback's labels are the components of B, so no two different labels are 4-adjacent.)
+    EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 8, 8, on).ok);
+
+    // A mask has no points or normals to merge with: refused with merge on, whatever the image size.
+    const Output refused = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, on);
+    EXPECT_FALSE(refused.ok);
+    EXPECT_NE(refused.error.find("merge"), std::string::npos) << refused.error;
+    EXPECT_FALSE(pyrseg_ref::segment_mask(mask.data(), nullptr, 4, 4, on).ok);
+    EXPECT_TRUE(pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, Params{}).ok);
 }
 
 }  // namespace

@@ -44,6 +44,12 @@ inline pyrseg_ref::Params to_reference(const Params& p) {
     r.curvature_stride = p.curvature_stride;
     r.dt_per_m2 = p.dt_per_m2;
     r.ct_growth_per_m2 = p.ct_growth_per_m2;
+    r.merge = p.merge;
+    r.merge_reach = p.merge_reach;
+    r.merge_tolerance_mm = p.merge_tolerance_mm;
+    r.merge_tolerance_per_m2 = p.merge_tolerance_per_m2;
+    r.merge_min_crossings = p.merge_min_crossings;
+    r.merge_max_bad_share = p.merge_max_bad_share;
     return r;
 }
 

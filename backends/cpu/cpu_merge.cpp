@@ -1,0 +1,81 @@
+// Step 6d, the merge (docs/algorithm.md section 5b), with the GPUs' functions (shaders/pyr_merge_table.h) over a
+// table sized once per Segmenter: every row's crossings counted into the pair table at once, then the pairs that
+// join united and every label of level N given its group's smallest label.
+#include <algorithm>
+#include <atomic>
+
+#include "backends/cpu/cpu_executor.hpp"
+
+namespace pyrseg::cpu {
+namespace {
+
+std::uint32_t atomic_word_cas(std::uint32_t& word, std::uint32_t expected, std::uint32_t v) {
+    std::atomic_ref<std::uint32_t>(word).compare_exchange_strong(expected, v, std::memory_order_relaxed);
+    return expected;  // the old value
+}
+
+std::uint32_t atomic_word_min(std::uint32_t& word, std::uint32_t v) {
+    std::atomic_ref<std::uint32_t> a(word);
+    std::uint32_t old = a.load(std::memory_order_relaxed);
+    while (old > v && !a.compare_exchange_weak(old, v, std::memory_order_relaxed)) {
+    }
+    return old;
+}
+
+}  // namespace
+}  // namespace pyrseg::cpu
+
+#define PYR_UF_LOAD(i) std::atomic_ref<std::uint32_t>(ctx.merge[i]).load(std::memory_order_relaxed)
+#define PYR_UF_STORE(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).store((v), std::memory_order_relaxed)
+#define PYR_UF_MIN(i, v) ::pyrseg::cpu::atomic_word_min(ctx.merge[i], (v))
+#define PYR_UF_CAS(i, e, v) ::pyrseg::cpu::atomic_word_cas(ctx.merge[i], (e), (v))
+#define PYR_UF_ADD(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).fetch_add((v), std::memory_order_relaxed)
+
+namespace pyrseg::cpu::pixel {
+using std::min;  // pyr_uf.h's GPU spelling
+#include "shaders/pyr_merge_table.h"
+}  // namespace pyrseg::cpu::pixel
+
+namespace pyrseg::cpu {
+
+using std::size_t;
+using std::uint32_t;
+
+void CpuExecutor::merge_segments() {
+    const PyrLevel lv = plan_.full();
+    const core::Thresholds& t = plan_.thresholds;
+    const uint32_t labels = plan_.lut_size();
+    const uint32_t slots = plan_.merge_slots;
+    merge_words_.resize(size_t(labels) + size_t(PYR_MERGE_SLOT_WORDS) * slots);  // once per Segmenter
+    for (uint32_t l = 0; l < labels; ++l) merge_words_[l] = l;
+    std::fill(merge_words_.begin() + labels, merge_words_.end(), 0u);
+    PassContext c = context();
+    c.merge = merge_words_.data();
+    const auto reach = uint32_t(plan_.params.merge_reach);
+    rows(lv.height, [&](size_t y) {
+        const uint32_t* row = labels_.data() + lv.offset + y * lv.width;
+        const uint32_t* below = y + 1 < lv.height ? row + lv.width : row;  // the last row: no pixel below
+        for (uint32_t x = 0; x < lv.width; ++x) {
+            // Most pixels cross no boundary: only those that may go to the shared function.
+            const uint32_t right = x + 1 < lv.width ? row[x + 1] : row[x];
+            if (row[x] == 0 || (right == row[x] && below[x] == row[x])) continue;
+            pixel::pyr_merge_count(c, lv, x, uint32_t(y), reach, t.merge_point_scale, t.merge_tolerance_base,
+                                   t.merge_tolerance_growth, labels, slots - 1);
+        }
+    });
+    const auto min_crossings = uint32_t(plan_.params.merge_min_crossings);
+    for (uint32_t s = 0; s < slots; ++s) pixel::pyr_merge_link(c, labels, s, min_crossings, t.merge_share);
+    // Parents are smaller labels, so in increasing order each parent is already its root.
+    bool joined = false;
+    for (uint32_t l = 0; l < labels; ++l) {
+        merge_words_[l] = merge_words_[merge_words_[l]];
+        joined = joined || merge_words_[l] != l;
+    }
+    if (!joined) return;
+    rows(lv.height, [&](size_t y) {
+        uint32_t* row = labels_.data() + lv.offset + y * lv.width;
+        for (size_t x = 0; x < lv.width; ++x) row[x] = merge_words_[row[x]];
+    });
+}
+
+}  // namespace pyrseg::cpu
