@@ -32,7 +32,8 @@ using io::Image;
 using io::Intrinsics;
 
 constexpr const char* kTabletopUsage =
-    "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--pcl-sensor NAME|none] [--calib FILE]\n"
+    "Usage: pyrseg eval --tabletop DIR [--presets NAME,...] [--pcl-sensor NAME|none] [--lccp grid|none]\n"
+    "                   [--calib FILE]\n"
     "                   [--depth-scale M] [--out-dir DIR] [parameters]\n"
     "\n"
     "Measures pyrseg on real tabletop RGB-D frames: every NAME_depth.png in DIR (16-bit, registered to the colour\n"
@@ -54,7 +55,10 @@ constexpr const char* kTabletopUsage =
     "(`pyrseg segment --help`: --merge-reach, --ct, ...) override every preset's values.\n"
     "Beside them, when pyrseg is built with PCL: PCL's organized segmentation of the same frame (its cloud in mm),\n"
     "OrganizedConnectedComponentSegmentation with EdgeAwarePlaneComparator, with the settings `pyrseg eval` tuned\n"
-    "for the sensor model --pcl-sensor names (default realsense-d435; none leaves PCL out), timed once.\n"
+    "for the sensor model --pcl-sensor names (default realsense-d435; none leaves PCL out), timed once; and PCL's\n"
+    "supervoxels + LCCP (Stein et al. 2014) with the colour image, tuned over a small grid on these frames (seed\n"
+    "20, 30 mm x concavity 10, 20 degrees x colour importance 0, 0.2; the most objects whole, then the fewest\n"
+    "merged; --lccp none leaves it out).\n"
     "\n"
     "Writes DIR/tabletop.md (the tables) and DIR/tabletop_NAME.png (colour | ground truth | each preset) into\n"
     "--out-dir (default pyrseg-eval-tabletop).\n";
@@ -71,6 +75,7 @@ struct Method {
     std::string name;
     Params params;
     std::optional<SensorKind> pcl;  // set: PCL's organized segmentation with the settings tuned for that model
+    std::optional<peers::LccpSettings> lccp;  // set: PCL's supervoxels + LCCP with these settings
 };
 
 struct Frame {
@@ -96,7 +101,7 @@ std::vector<Method> parse_methods(const Args& args) {
         }
         Params p = kind ? parse_params(args, kind) : parse_params(args, std::nullopt);
         if (merge || no_merge) p.merge = merge;
-        out.push_back({item, p, std::nullopt});
+        out.push_back({item, p, std::nullopt, std::nullopt});
     };
     const std::optional<std::string> list = args.value("presets");
     if (!list) {
@@ -209,6 +214,34 @@ constexpr const char* kTableHead =
     "| %s | objects | whole | in parts | parts per object | merged with table | mean best IoU | table in one "
     "segment | object pixels unlabelled | ms per frame |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
 
+// LCCP's settings from lccp_grid() that do best on the frames: the most objects whole, then the fewest merged with
+// the table, then the highest mean best IoU. Prints each setting's totals.
+peers::LccpSettings tune_lccp(const std::vector<Frame>& frames, const Intrinsics& k, double metres_per_unit) {
+    const std::vector<peers::LccpSettings> grid = lccp_grid();
+    std::optional<std::size_t> best;
+    Totals best_totals;
+    for (std::size_t g = 0; g < grid.size(); ++g) {
+        Totals t;
+        for (const Frame& f : frames) {
+            const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
+            const PclRun run = lccp_segment(cloud, f.color.rgb.empty() ? nullptr : f.color.rgb.data(), grid[g]);
+            t.add(eval::score_tabletop(f.truth.labels, run.labels), 0.0);
+        }
+        std::printf("LCCP tuning %zu/%zu: %s: %u of %u whole, %u merged with the table, mean best IoU %.2f\n", g + 1,
+                    grid.size(), peers::describe(grid[g]).c_str(), t.whole, t.objects, t.merged,
+                    t.objects == 0 ? 0.0 : t.iou_sum / t.objects);
+        const bool better =
+            !best || t.whole > best_totals.whole ||
+            (t.whole == best_totals.whole &&
+             (t.merged < best_totals.merged || (t.merged == best_totals.merged && t.iou_sum > best_totals.iou_sum)));
+        if (better) {
+            best = g;
+            best_totals = t;
+        }
+    }
+    return grid[*best];
+}
+
 double median_ms(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
@@ -218,7 +251,7 @@ double median_ms(std::vector<double> v) {
 
 int cmd_eval_tabletop(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
-    values.insert({"tabletop", "presets", "pcl-sensor", "calib", "depth-scale", "out-dir"});
+    values.insert({"tabletop", "presets", "pcl-sensor", "lccp", "calib", "depth-scale", "out-dir"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert("help");
     const Args args(argv, values, flags);
@@ -246,15 +279,27 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
         const std::optional<SensorKind> kind = sensor_kind_from_name(pcl_sensor);
         if (!kind) throw UsageError{"--pcl-sensor: no sensor model named '" + printable(pcl_sensor) + "'"};
         if (const std::string missing = pcl_peer_missing(); missing.empty()) {
-            methods.push_back({"PCL organized (" + pcl_sensor + " settings)", Params{}, kind});
+            methods.push_back({"PCL organized (" + pcl_sensor + " settings)", Params{}, kind, std::nullopt});
         } else {
             std::fprintf(stderr, "pyrseg eval: PCL left out: %s\n", missing.c_str());
         }
     }
+    const std::string lccp = args.value("lccp").value_or("grid");
+    if (lccp != "grid" && lccp != "none")
+        throw UsageError{"--lccp must be grid or none, got '" + printable(lccp) + "'"};
     const fs::path out_dir = args.value("out-dir").value_or("pyrseg-eval-tabletop");
     fs::create_directories(out_dir);
 
     const std::vector<Frame> frames = read_frames(depths, metres_per_unit, k);
+    if (lccp == "grid") {
+        if (const std::string missing = pcl_peer_missing(); missing.empty()) {
+            const peers::LccpSettings chosen = tune_lccp(frames, k, metres_per_unit);
+            methods.push_back(
+                {"PCL supervoxels + LCCP (tuned: " + peers::describe(chosen) + ")", Params{}, std::nullopt, chosen});
+        } else {
+            std::fprintf(stderr, "pyrseg eval: LCCP left out: %s\n", missing.c_str());
+        }
+    }
     std::vector<Totals> totals(methods.size());
     std::ostringstream per_frame;
     per_frame << "## Per frame\n\n";
@@ -270,7 +315,13 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
         for (std::size_t m = 0; m < methods.size(); ++m) {
             std::vector<std::uint32_t> labels;
             double ms = 0;
-            if (methods[m].pcl) {
+            if (methods[m].lccp) {
+                const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
+                const auto start = std::chrono::steady_clock::now();
+                labels =
+                    lccp_segment(cloud, f.color.rgb.empty() ? nullptr : f.color.rgb.data(), *methods[m].lccp).labels;
+                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            } else if (methods[m].pcl) {
                 const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
                 const auto start = std::chrono::steady_clock::now();
                 labels = pcl_segment(cloud, 1.0, methods[m].pcl).labels;

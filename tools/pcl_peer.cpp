@@ -1,11 +1,29 @@
 #include "tools/pcl_peer.hpp"
 
+#include <algorithm>
+
 #include "pyrseg/error.hpp"
 #ifdef PYRSEG_HAVE_PCL_PEER
 #include "peers/pcl_segmentation.hpp"
 #endif
 
 namespace pyrseg::cli {
+
+std::vector<peers::LccpSettings> lccp_grid() {
+    std::vector<peers::LccpSettings> grid;
+    for (const float seed : {0.02f, 0.03f}) {
+        for (const float concavity : {10.0f, 20.0f}) {
+            for (const float colour : {0.0f, 0.2f}) {
+                peers::LccpSettings s;
+                s.seed_resolution_m = seed;
+                s.concavity_tolerance_deg = concavity;
+                s.color_importance = colour;
+                grid.push_back(s);
+            }
+        }
+    }
+    return grid;
+}
 
 #ifdef PYRSEG_HAVE_PCL_PEER
 namespace {
@@ -56,7 +74,20 @@ PclRun pcl_segment(const io::PointCloud& cloud, double unit_mm, std::optional<Se
                    (kind ? std::string(" (tuned for ") + sensor_kind_name(*kind) + ")" : " (PCL's defaults)");
     return run;
 }
+
+PclRun lccp_segment(const io::PointCloud& cloud_mm, const std::uint8_t* rgb, const peers::LccpSettings& settings) {
+    PclRun run;
+    run.labels = peers::lccp_segment(cloud_mm.points.data(), rgb, cloud_mm.width, cloud_mm.height, settings);
+    for (const std::uint32_t l : run.labels) run.regions = std::max(run.regions, l);
+    run.settings = std::string("PCL ") + peers::pcl_version() + " supervoxels + LCCP, " + peers::describe(settings);
+    return run;
+}
 #else
+PclRun lccp_segment(const io::PointCloud& /*cloud_mm*/, const std::uint8_t* /*rgb*/,
+                    const peers::LccpSettings& /*settings*/) {
+    throw Error(ErrorCode::invalid_argument, "LCCP: " + pcl_peer_missing());
+}
+
 std::string pcl_peer_missing() {
     return "this build has no PCL peer (pyrseg is built with it when libpcl-dev is installed)";
 }

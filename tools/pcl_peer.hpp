@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "peers/pcl_lccp.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/presets.hpp"
 
@@ -24,5 +25,14 @@ struct PclRun {
 // Segments `cloud` (in units of unit_mm millimetres) with PCL: the settings tuned for `kind`, or PCL's defaults.
 // Throws pyrseg::Error when this build has no PCL peer.
 [[nodiscard]] PclRun pcl_segment(const io::PointCloud& cloud, double unit_mm, std::optional<SensorKind> kind);
+
+// PCL's supervoxels + LCCP (peers/pcl_lccp.hpp) of a cloud in millimetres with its colour (packed RGB8 per pixel,
+// or null); the settings in words in `settings`. Throws pyrseg::Error when this build has no PCL peer.
+[[nodiscard]] PclRun lccp_segment(const io::PointCloud& cloud_mm, const std::uint8_t* rgb,
+                                  const peers::LccpSettings& settings);
+// The small grid `pyrseg eval --tabletop` tunes LCCP over: seed resolution 20 and 30 mm x concavity tolerance 10 and
+// 20 degrees x colour importance 0 and 0.2, the rest PCL's LCCP example's (voxels of 7.5 mm, spatial importance 1,
+// normal importance 4, smoothness check 0.1, sanity check, one camera's transform).
+[[nodiscard]] std::vector<peers::LccpSettings> lccp_grid();
 
 }  // namespace pyrseg::cli
