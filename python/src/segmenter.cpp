@@ -204,7 +204,18 @@ public:
         const int w = int(integer(kInit, "width", width, INT_MIN, INT_MAX));
         const int h = int(integer(kInit, "height", height, INT_MIN, INT_MAX));
         py::object cuda_stream = py::none();
-        params_ = params_from(kwargs, outputs_, cuda_stream);
+        // preset="auto": the preset is chosen from the first frame's depth (pyrseg.measure_frame_noise), and the
+        // Segmenter made then, with the parameters given beside it over the chosen preset.
+        py::dict given = py::reinterpret_borrow<py::dict>(kwargs);
+        if (kwargs.contains("preset") && py::isinstance<py::str>(kwargs["preset"]) &&
+            kwargs["preset"].cast<std::string>() == "auto") {
+            given = py::dict(kwargs);
+            given.attr("pop")("preset");
+            auto_overrides_ = given;
+        } else if (kwargs.contains("preset") && !kwargs["preset"].is_none()) {
+            preset_name_ = text(kInit, "preset", kwargs["preset"]);
+        }
+        params_ = params_from(given, outputs_, cuda_stream);
         const std::string requested = backend.is_none() ? std::string() : text(kInit, "backend", backend);
         // The device-array path needs the Segmenter pyrseg/cuda.hpp makes on a stream; it segments host frames
         // too, so every CUDA Segmenter is made that way.
@@ -214,19 +225,26 @@ public:
         } else if (!cuda_stream.is_none()) {
             throw py::value_error("cuda_stream= is for the cuda backend; this Segmenter runs " + name);
         }
-        // A GPU backend's setup (devices, kernels, buffers) can take a while: other Python threads go on meanwhile.
-        const py::gil_scoped_release nogil;
-        if (device_) {
-            segmenter_.emplace(device_->make_segmenter(w, h, params_, outputs_));
-        } else {
-            segmenter_.emplace(w, h, params_, name, outputs_);
+        width_ = w;
+        height_ = h;
+        backend_ = name;
+        if (auto_overrides_) {
+            check_plan();  // the size and the parameters given are checked now, not on the first frame
+            return;
         }
+        make_segmenter();
     }
 
     py::object segment(const py::args& args, const py::kwargs& kwargs) {
         const Args a("segment()", kSegment, args, kwargs);
         const py::object points = a.object(0), normals = a.object(1), count = a.object(3);
         py::object out = a.object(2);
+        if (!segmenter_) {
+            if (is_device_array(points)) refuse_auto_on_device();
+            const CloudInput probe(points, normals, width(), height());
+            Scratch scratch;
+            choose_preset(measure_frame_noise(probe.view(scratch), params_.unit_mm));
+        }
         if (is_device_array(points)) {
             device().segment_cloud(*segmenter_, points, normals, out, count);
             return out;
@@ -247,6 +265,12 @@ public:
         camera.cx = a.number(3);
         camera.cy = a.number(4);
         camera.metres_per_unit = a.number(5);
+        if (!segmenter_) {
+            if (is_device_array(depth)) refuse_auto_on_device();
+            const DepthInput probe(depth);
+            Scratch scratch;
+            choose_preset(measure_frame_noise(with_camera(probe.view(scratch), camera)));
+        }
         if (is_device_array(depth)) {
             device().segment_depth(*segmenter_, depth, camera, out, count);
             return out;
@@ -261,16 +285,31 @@ public:
 
     py::object segment_mask(const py::args& args, const py::kwargs& kwargs) {
         const Args a("segment_mask()", kSegmentMask, args, kwargs);
+        if (!segmenter_) {
+            throw py::value_error(
+                "preset='auto' chooses the preset from a frame's depth, and a mask has none: segment a cloud or a "
+                "depth image first, or name the preset");
+        }
         const MaskInput input(a.object(0), a.object(1));
         // A mask has no points, so no normals: Result.normals is None for it whatever outputs= asks.
         return run(input, a.object(2), false,
                    [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment_mask(input.view(s), r); });
     }
 
-    [[nodiscard]] int width() const { return segmenter_->width(); }
-    [[nodiscard]] int height() const { return segmenter_->height(); }
-    [[nodiscard]] const std::string& backend() const { return segmenter_->backend_name(); }
-    [[nodiscard]] py::dict params() const { return params_to_dict(segmenter_->params()); }
+    [[nodiscard]] int width() const { return width_; }
+    [[nodiscard]] int height() const { return height_; }
+    [[nodiscard]] const std::string& backend() const { return segmenter_ ? segmenter_->backend_name() : backend_; }
+    // None until preset="auto" has chosen, on the first frame.
+    [[nodiscard]] py::object params() const {
+        return segmenter_ ? py::object(params_to_dict(segmenter_->params())) : py::object(py::none());
+    }
+    // The preset named, or the one preset="auto" chose (None before the first frame, or without a preset), and why.
+    [[nodiscard]] py::object preset() const {
+        return preset_name_ ? py::object(py::str(*preset_name_)) : py::object(py::none());
+    }
+    [[nodiscard]] py::object preset_reason() const {
+        return preset_reason_ ? py::object(py::str(*preset_reason_)) : py::object(py::none());
+    }
     [[nodiscard]] py::tuple outputs() const {
         py::list names;
         if (outputs_.raw_labels) names.append("raw_labels");
@@ -286,7 +325,7 @@ public:
             // Without the GIL first: a frame holding the lock may be waiting for it.
             const py::gil_scoped_release nogil;
             const std::lock_guard<std::mutex> lock(mutex_);
-            copy = segmenter_->last_timings();
+            if (segmenter_) copy = segmenter_->last_timings();
         }
         py::dict d;
         for (const PassTiming& t : copy) d[t.pass] = t.milliseconds;
@@ -298,6 +337,41 @@ public:
     }
 
 private:
+    // A GPU backend's setup (devices, kernels, buffers) can take a while: other Python threads go on meanwhile,
+    // except on preset="auto"'s first frame (release_gil false), where another thread's frame must wait for it.
+    void make_segmenter(bool release_gil = true) {
+        std::optional<py::gil_scoped_release> nogil;
+        if (release_gil) nogil.emplace();
+        if (device_) {
+            segmenter_.emplace(device_->make_segmenter(width_, height_, params_, outputs_));
+        } else {
+            segmenter_.emplace(width_, height_, params_, backend_, outputs_);
+        }
+    }
+
+    // preset="auto" on its first frame: the preset the frame's depth suggests, the parameters given over it. The
+    // GIL stays held, so that two threads' first frames cannot both choose.
+    void choose_preset(const FrameNoise& noise) {
+        if (segmenter_) return;
+        Outputs outputs;
+        py::object cuda_stream = py::none();
+        py::dict with_preset(*auto_overrides_);
+        with_preset["preset"] = sensor_kind_name(noise.suggested);
+        params_ = params_from(with_preset, outputs, cuda_stream);
+        preset_name_ = sensor_kind_name(noise.suggested);
+        preset_reason_ = noise.reason;
+        make_segmenter(false);
+    }
+
+    // The checks a Segmenter makes of its size and parameters, before preset="auto" has one.
+    void check_plan() const { (void)Segmenter(width_, height_, params_, "cpu"); }
+
+    [[noreturn]] static void refuse_auto_on_device() {
+        throw py::value_error(
+            "preset='auto' chooses the preset from the first frame's depth on the host: give that frame as a host "
+            "array, or name the preset");
+    }
+
     DeviceFrames& device() {
         if (!device_) {
             raise(ErrorCode::invalid_argument,
@@ -398,7 +472,13 @@ private:
 
     Params params_;
     Outputs outputs_;
-    std::optional<DeviceFrames> device_;  // before segmenter_: the Segmenter is destroyed first, on its stream
+    int width_ = 0;
+    int height_ = 0;
+    std::string backend_;                       // resolved at construction
+    std::optional<py::dict> auto_overrides_;    // preset="auto": the other keyword arguments, for the first frame
+    std::optional<std::string> preset_name_;    // named, or chosen by "auto"
+    std::optional<std::string> preset_reason_;  // why "auto" chose it
+    std::optional<DeviceFrames> device_;        // before segmenter_: the Segmenter is destroyed first, on its stream
     std::optional<Segmenter> segmenter_;
     Result result_;
     Scratch scratch_;
@@ -505,7 +585,9 @@ void bind_segmenter(py::module_& m) {
 Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, **params)
 
 backend: @BACKENDS@"auto", or None for $PYRSEG_BACKEND (else "auto").
-preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it.
+preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it. "auto" chooses one from
+the first frame's depth (pyrseg.measure_frame_noise) and keeps it: .preset and .preset_reason say which and why,
+and .params is None until then.
 params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
@@ -551,6 +633,9 @@ float64 converted, any other integer dtype converted to uint16 when its values a
         .def_property_readonly("height", [](const py::object& self) { return segmenter_of(self).height(); })
         .def_property_readonly("backend", [](const py::object& self) { return segmenter_of(self).backend(); })
         .def_property_readonly("params", [](const py::object& self) { return segmenter_of(self).params(); })
+        .def_property_readonly("preset", [](const py::object& self) { return segmenter_of(self).preset(); })
+        .def_property_readonly("preset_reason",
+                               [](const py::object& self) { return segmenter_of(self).preset_reason(); })
         .def_property_readonly("outputs", [](const py::object& self) { return segmenter_of(self).outputs(); })
         .def_property_readonly(
             "timings", [](const py::object& self) { return segmenter_of(self).timings(); },

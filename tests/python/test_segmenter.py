@@ -254,6 +254,36 @@ def test_frame_noise_suggests_a_preset():
     assert e.value.code == pyrseg.ErrorCode.invalid_parameter
 
 
+def test_preset_auto_chooses_on_the_first_frame_and_keeps_it():
+    s = pyrseg.synthetic.generate(160, 120, seed=4, sensor="kinect-v1")
+    seg = pyrseg.Segmenter(160, 120, "cpu", preset="auto", edge_rounds=5)
+    assert seg.params is None and seg.preset is None and seg.preset_reason is None
+    assert seg.width == 160 and seg.backend == "cpu" and seg.timings == {}
+    with pytest.raises(ValueError, match="auto"):
+        seg.segment_mask(np.ones((120, 160), bool))
+    r = seg.segment(s.points)
+    assert seg.preset == "kinect-v1" and "disparity steps" in seg.preset_reason
+    # The chosen preset with the parameters given beside "auto" over it, and the same labels as naming it.
+    assert seg.params == dict(pyrseg.preset("kinect-v1"), edge_rounds=5)
+    named = pyrseg.Segmenter(160, 120, "cpu", preset="kinect-v1", edge_rounds=5).segment(s.points)
+    np.testing.assert_array_equal(r.labels, named.labels)
+    # Kept for the stream: a frame of another kind of sensor does not change it.
+    scanner = pyrseg.synthetic.generate(160, 120, seed=4, sensor="structured-light")
+    seg.segment(scanner.points)
+    assert seg.preset == "kinect-v1"
+    # Depth images choose from their samples.
+    z = s.points[..., 2]
+    depth = np.where(np.isfinite(z), np.round(z), 0).astype(np.uint16)
+    d = pyrseg.Segmenter(160, 120, "cpu", preset="auto")
+    d.segment_depth(depth, fx=s.fx, fy=s.fy, cx=s.cx, cy=s.cy, metres_per_unit=0.001)
+    assert d.preset == "kinect-v1"
+    # Parameters given beside "auto" are checked at once.
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(160, 120, "cpu", preset="auto", merge_reach=0)
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter
+    assert pyrseg.Segmenter(160, 120, "cpu", preset="realsense-d435").preset == "realsense-d435"
+
+
 @pytest.mark.skipif(not (SHARED / "realsense" / "wood_table_3_depth.png").exists(), reason="RealSense frames absent")
 def test_realsense_depth_frames_suggest_the_stereo_preset():
     for name in ("wood_table_1", "wood_table_3", "low_table_5", "office_table_7"):
