@@ -42,6 +42,8 @@ constexpr const char* kEvalUsage =
     "                   [--seeds N] [--bridges W,...] [--noise MM] [--tune-seeds N] [--out-dir DIR] [--quick]\n"
     "       pyrseg eval --noise MM,... [--sizes WxH,...] [--seeds N] [--bridges W,...] [--out-dir DIR] [--quick]\n"
     "       pyrseg eval --tabletop DIR [--presets NAME,...] [--out-dir DIR]   (real RGB-D frames: --tabletop --help)\n"
+    "       pyrseg eval --tabletop-synthetic [--sensors NAME,...] [--seeds N] [--out-dir DIR]  (the same on synthetic\n"
+    "                   tabletops through the sensor models)\n"
     "\n"
     "Measures segmentation quality against ground truth on seeded synthetic bin-picking scenes (boxes, cylinders\n"
     "and spheres touching each other in a bin; seeds 1..N), comparing three labellings:\n"
@@ -884,7 +886,9 @@ void sensor_sweep(const SensorSweep& sweep, const fs::path& out_dir, std::ostrin
 
 int cmd_eval(const std::vector<std::string>& argv) {
     for (const std::string& a : argv) {
-        if (a == "--tabletop" || a.starts_with("--tabletop=")) return cmd_eval_tabletop(argv);
+        if (a == "--tabletop" || a.starts_with("--tabletop=") || a == "--tabletop-synthetic") {
+            return cmd_eval_tabletop(argv);
+        }
     }
     std::set<std::string> values = {"sizes",   "seeds",     "noise",  "bridges",   "out-dir",
                                     "sensors", "distances", "params", "tune-seeds"};

@@ -2,8 +2,10 @@
 // depth (tools/eval/tabletop_truth.hpp), with a picture per frame.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -14,6 +16,7 @@
 #include "pyrseg/io.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
 #include "tools/args.hpp"
 #include "tools/commands.hpp"
 #include "tools/eval/tabletop_scores.hpp"
@@ -80,10 +83,12 @@ struct Method {
 
 struct Frame {
     std::string name;
+    Intrinsics camera;
     DepthImage depth;
     std::vector<float> metres;
     eval::TabletopTruth truth;
-    RgbImage color;  // empty without NAME_color.png
+    RgbImage color;       // empty without NAME_color.png
+    bool picture = true;  // a picture of it is written
 };
 
 // Each name a preset (or `default`), NAME+merge with the merge on, NAME+nomerge with it off; the segment parameter
@@ -158,6 +163,7 @@ std::vector<Frame> read_frames(const std::vector<fs::path>& depths, double metre
             const float v = f.depth.depth[i];
             f.metres[i] = v > 0 ? float(v * metres_per_unit) : 0.0f;
         }
+        f.camera = k;
         f.truth = eval::make_tabletop_truth(f.depth.width, f.depth.height, f.metres, {k.fx, k.fy, k.cx, k.cy});
         f.color = read_color(p.parent_path() / (f.name + "_color.png"), f.depth.width, f.depth.height);
         frames.push_back(std::move(f));
@@ -216,14 +222,14 @@ constexpr const char* kTableHead =
 
 // LCCP's settings from lccp_grid() that do best on the frames: the most objects whole, then the fewest merged with
 // the table, then the highest mean best IoU. Prints each setting's totals.
-peers::LccpSettings tune_lccp(const std::vector<Frame>& frames, const Intrinsics& k, double metres_per_unit) {
+peers::LccpSettings tune_lccp(const std::vector<Frame>& frames, double metres_per_unit) {
     const std::vector<peers::LccpSettings> grid = lccp_grid();
     std::optional<std::size_t> best;
     Totals best_totals;
     for (std::size_t g = 0; g < grid.size(); ++g) {
         Totals t;
         for (const Frame& f : frames) {
-            const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
+            const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, metres_per_unit);
             const PclRun run = lccp_segment(cloud, f.color.rgb.empty() ? nullptr : f.color.rgb.data(), grid[g]);
             t.add(eval::score_tabletop(f.truth.labels, run.labels), 0.0);
         }
@@ -247,17 +253,174 @@ double median_ms(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+// Every method on every frame: a table per frame into per_frame, a picture per frame into out_dir; the totals.
+std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std::vector<Method>& methods,
+                                    double metres_per_unit, const fs::path& out_dir, std::ostringstream& per_frame) {
+    std::vector<Totals> totals(methods.size());
+    for (const Frame& f : frames) {
+        const int w = f.depth.width;
+        const int h = f.depth.height;
+        std::printf("%s: %d x %d, %u objects in the ground truth%s\n", f.name.c_str(), w, h, f.truth.objects,
+                    f.truth.found_plane ? "" : " (no support plane found)");
+        per_frame << "### " << f.name << "\n\n" << printed(kTableHead, "method");
+        std::vector<Panel> panels;
+        if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
+        panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
+        for (std::size_t m = 0; m < methods.size(); ++m) {
+            std::vector<std::uint32_t> labels;
+            double ms = 0;
+            if (methods[m].lccp) {
+                const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, metres_per_unit);
+                const auto start = std::chrono::steady_clock::now();
+                labels =
+                    lccp_segment(cloud, f.color.rgb.empty() ? nullptr : f.color.rgb.data(), *methods[m].lccp).labels;
+                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            } else if (methods[m].pcl) {
+                const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, metres_per_unit);
+                const auto start = std::chrono::steady_clock::now();
+                labels = pcl_segment(cloud, 1.0, methods[m].pcl).labels;
+                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            } else {
+                Segmenter segmenter(w, h, methods[m].params, "cpu");
+                const DepthView view = io::depth_view(f.depth, f.camera, metres_per_unit);
+                Result result = segmenter.segment(view);
+                std::vector<double> times;
+                for (int run = 0; run < 5; ++run) {
+                    const auto start = std::chrono::steady_clock::now();
+                    result = segmenter.segment(view);
+                    times.push_back(
+                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                }
+                labels = std::move(result.labels);
+                ms = median_ms(times);
+            }
+            const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
+            Totals one;
+            one.add(s, ms);
+            totals[m].add(s, ms);
+            per_frame << row("`" + methods[m].name + "`", one);
+            panels.push_back({methods[m].name, colorize(labels, w, h)});
+        }
+        per_frame << "\n";
+        if (f.picture) {
+            per_frame << "![" << f.name << "](tabletop_" << f.name << ".png)\n\n";
+            write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));
+        }
+    }
+
+    return totals;
+}
+
+// A synthetic tabletop: objects apart on a plain floor (no bin), rendered through a sensor model, as a depth camera
+// hands it over (whole millimetres); its truth is the generator's own (the floor is the table, each object of at
+// least 300 pixels an object), so touching objects are not joined as in a truth made from the depth.
+Frame synthetic_frame(synthetic::Sensor sensor, double distance_mm, std::uint64_t seed) {
+    synthetic::SceneOptions o;
+    o.seed = seed;
+    o.object_count = 8;
+    o.touching = false;
+    o.bin = false;
+    o.sensor = sensor;
+    o.camera_distance_mm = distance_mm;
+    const synthetic::Scene scene = synthetic::generate(o);
+    Frame f;
+    f.name = std::string(synthetic::sensor_name(sensor)) + "_" + std::to_string(int(distance_mm)) + "mm_seed" +
+             std::to_string(seed);
+    f.camera = Intrinsics{scene.fx, scene.fy, scene.cx, scene.cy};
+    f.depth.width = scene.width;
+    f.depth.height = scene.height;
+    const std::size_t pixels = std::size_t(scene.width) * std::size_t(scene.height);
+    f.depth.depth.resize(pixels);
+    f.metres.resize(pixels);
+    std::map<std::uint32_t, std::uint32_t> object_pixels;
+    for (std::size_t i = 0; i < pixels; ++i) {
+        const float z = scene.points[3 * i + 2];
+        const float mm = std::isfinite(z) && z > 0 && z < 65535 ? std::nearbyint(z) : 0.0f;
+        f.depth.depth[i] = mm;
+        f.metres[i] = mm / 1000.0f;
+        if (mm > 0 && scene.object_id[i] >= synthetic::kFirstObjectId) ++object_pixels[scene.object_id[i]];
+    }
+    std::map<std::uint32_t, std::uint32_t> truth_id;  // objects of at least 300 pixels, 2, 3, ... by id
+    for (const auto& [id, count] : object_pixels) {
+        if (count >= 300) truth_id.emplace(id, std::uint32_t(truth_id.size() + 2));
+    }
+    f.truth.labels.assign(pixels, eval::kTruthNone);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        if (f.depth.depth[i] == 0) continue;
+        const std::uint32_t id = scene.object_id[i];
+        if (id == synthetic::kFloorId) f.truth.labels[i] = eval::kTruthTable;
+        if (const auto it = truth_id.find(id); it != truth_id.end()) f.truth.labels[i] = it->second;
+    }
+    f.truth.objects = std::uint32_t(truth_id.size());
+    f.truth.found_plane = true;
+    f.picture = seed == 1;
+    return f;
+}
+
+int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) {
+    const int seeds = args.integer("seeds").value_or(4);
+    if (seeds < 1 || seeds > 1000) throw UsageError{"--seeds must be in 1..1000"};
+    std::vector<SensorKind> sensors;
+    std::stringstream list(args.value("sensors").value_or("kinect-v1,realsense-d435,azure-kinect"));
+    for (std::string item; std::getline(list, item, ',');) {
+        const std::optional<SensorKind> kind = sensor_kind_from_name(item);
+        if (!kind) throw UsageError{"--sensors: no sensor model named '" + printable(item) + "'"};
+        sensors.push_back(*kind);
+    }
+    if (sensors.empty()) throw UsageError{"--sensors is empty"};
+    const fs::path out_dir = args.value("out-dir").value_or("pyrseg-eval-tabletop");
+    fs::create_directories(out_dir);
+    std::string command = "pyrseg eval";
+    for (const std::string& a : argv) command += " " + a;
+    std::ostringstream md, per_frame;
+    md << "# pyrseg eval: synthetic tabletops\n\n`" << command << "`: 8 objects apart on a floor, seeds 1.." << seeds
+       << " at 800 and 1200 mm per sensor model, 640 x 480 in whole millimetres, CPU backend, "
+       << std::thread::hardware_concurrency() << " hardware threads. Ground truth: the generator's.\n\n## In sum\n\n"
+       << printed(kTableHead, "sensor model: method");
+    per_frame << "## Per frame\n\n";
+    for (const SensorKind kind : sensors) {
+        const std::string name = sensor_kind_name(kind);
+        std::vector<Frame> frames;
+        for (const double distance : {800.0, 1200.0}) {
+            for (int seed = 1; seed <= seeds; ++seed) {
+                frames.push_back(synthetic_frame(*synthetic::sensor_from_name(name), distance, std::uint64_t(seed)));
+            }
+        }
+        std::vector<Method> methods;
+        Params with = parse_params(args, kind);
+        methods.push_back({name, with, std::nullopt, std::nullopt});
+        Params without = with;
+        without.merge = !with.merge;
+        methods.push_back({name + (with.merge ? "+nomerge" : "+merge"), without, std::nullopt, std::nullopt});
+        if (pcl_peer_missing().empty()) {
+            methods.push_back({"PCL organized (" + name + " settings)", Params{}, kind, std::nullopt});
+        }
+        const std::vector<Totals> totals = evaluate_frames(frames, methods, 0.001, out_dir, per_frame);
+        for (std::size_t m = 0; m < methods.size(); ++m) md << row(name + ": `" + methods[m].name + "`", totals[m]);
+    }
+    md << "\n" << per_frame.str();
+    const fs::path report = out_dir / "tabletop_synthetic.md";
+    write_text_file(report, md.str());
+    std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);
+    std::printf("wrote %s\n", report.string().c_str());
+    return 0;
+}
+
 }  // namespace
 
 int cmd_eval_tabletop(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
-    values.insert({"tabletop", "presets", "pcl-sensor", "lccp", "calib", "depth-scale", "out-dir"});
+    values.insert({"tabletop", "presets", "pcl-sensor", "lccp", "calib", "depth-scale", "out-dir", "sensors", "seeds"});
     std::set<std::string> flags = kParameterFlagOptions;
-    flags.insert("help");
+    flags.insert({"help", "tabletop-synthetic"});
     const Args args(argv, values, flags);
     if (args.flag("help")) {
         std::fputs(kTabletopUsage, stdout);
         return 0;
+    }
+    if (args.flag("tabletop-synthetic")) {
+        if (args.value("tabletop")) throw UsageError{"--tabletop and --tabletop-synthetic: one or the other"};
+        return synthetic_tabletops(args, argv);
     }
     if (!args.positional().empty()) throw UsageError{"--tabletop takes no positional arguments"};
     const fs::path dir = args.value("tabletop").value_or("");
@@ -293,63 +456,16 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
     const std::vector<Frame> frames = read_frames(depths, metres_per_unit, k);
     if (lccp == "grid") {
         if (const std::string missing = pcl_peer_missing(); missing.empty()) {
-            const peers::LccpSettings chosen = tune_lccp(frames, k, metres_per_unit);
+            const peers::LccpSettings chosen = tune_lccp(frames, metres_per_unit);
             methods.push_back(
                 {"PCL supervoxels + LCCP (tuned: " + peers::describe(chosen) + ")", Params{}, std::nullopt, chosen});
         } else {
             std::fprintf(stderr, "pyrseg eval: LCCP left out: %s\n", missing.c_str());
         }
     }
-    std::vector<Totals> totals(methods.size());
     std::ostringstream per_frame;
     per_frame << "## Per frame\n\n";
-    for (const Frame& f : frames) {
-        const int w = f.depth.width;
-        const int h = f.depth.height;
-        std::printf("%s: %d x %d, %u objects in the ground truth%s\n", f.name.c_str(), w, h, f.truth.objects,
-                    f.truth.found_plane ? "" : " (no support plane found)");
-        per_frame << "### " << f.name << "\n\n" << printed(kTableHead, "method");
-        std::vector<Panel> panels;
-        if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
-        panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
-        for (std::size_t m = 0; m < methods.size(); ++m) {
-            std::vector<std::uint32_t> labels;
-            double ms = 0;
-            if (methods[m].lccp) {
-                const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
-                const auto start = std::chrono::steady_clock::now();
-                labels =
-                    lccp_segment(cloud, f.color.rgb.empty() ? nullptr : f.color.rgb.data(), *methods[m].lccp).labels;
-                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-            } else if (methods[m].pcl) {
-                const io::PointCloud cloud = io::depth_to_cloud(f.depth, k, metres_per_unit);
-                const auto start = std::chrono::steady_clock::now();
-                labels = pcl_segment(cloud, 1.0, methods[m].pcl).labels;
-                ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-            } else {
-                Segmenter segmenter(w, h, methods[m].params, "cpu");
-                const DepthView view = io::depth_view(f.depth, k, metres_per_unit);
-                Result result = segmenter.segment(view);
-                std::vector<double> times;
-                for (int run = 0; run < 5; ++run) {
-                    const auto start = std::chrono::steady_clock::now();
-                    result = segmenter.segment(view);
-                    times.push_back(
-                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-                }
-                labels = std::move(result.labels);
-                ms = median_ms(times);
-            }
-            const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
-            Totals one;
-            one.add(s, ms);
-            totals[m].add(s, ms);
-            per_frame << row("`" + methods[m].name + "`", one);
-            panels.push_back({methods[m].name, colorize(labels, w, h)});
-        }
-        per_frame << "\n![" << f.name << "](tabletop_" << f.name << ".png)\n\n";
-        write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));
-    }
+    const std::vector<Totals> totals = evaluate_frames(frames, methods, metres_per_unit, out_dir, per_frame);
 
     std::string command = "pyrseg eval";
     for (const std::string& a : argv) command += " " + a;

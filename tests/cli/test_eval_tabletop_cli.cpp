@@ -84,4 +84,20 @@ TEST(CliEvalTabletop, TheSharedRealsenseFramesGetTablesAndPictures) {
     fs::remove_all(out);
 }
 
+// The same evaluation on synthetic tabletops through a sensor model, against the generator's own truth.
+TEST(CliEvalTabletop, SyntheticTabletopsThroughASensorModel) {
+    const fs::path out = fs::temp_directory_path() / ("pyrseg_tabletop_synthetic_" + std::to_string(::getpid()));
+    const CliRun r = run("eval --tabletop-synthetic --sensors realsense-d435 --seeds 1 --out-dir " + out.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(out / "tabletop_synthetic.md");
+    std::stringstream md;
+    md << in.rdbuf();
+    EXPECT_NE(md.str().find("| realsense-d435: `realsense-d435` |"), std::string::npos) << md.str();
+    EXPECT_NE(md.str().find("| realsense-d435: `realsense-d435+nomerge` |"), std::string::npos) << md.str();
+    EXPECT_TRUE(fs::exists(out / "tabletop_realsense-d435_800mm_seed1.png"));
+    EXPECT_EQ(run("eval --tabletop-synthetic --sensors nonesuch").status, 2);
+    EXPECT_EQ(run("eval --tabletop-synthetic --tabletop " + out.string()).status, 2);
+    fs::remove_all(out);
+}
+
 }  // namespace
