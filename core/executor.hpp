@@ -56,6 +56,9 @@ public:
     // Step 6d (Params::merge; docs/algorithm.md section 5b): level N's segments that meet along a convex or flat
     // boundary take the smallest label of the group they join. Runs on a cloud or depth frame, never on a mask.
     virtual void merge_segments() = 0;
+    // A backend that marks labels before compact (marks_labels_before_compact) and returns true here marks them in
+    // merge_segments, as it relabels each row: the pipeline then makes no marks after the merge.
+    [[nodiscard]] virtual bool marks_labels_in_merge() const { return false; }
     // Step 7 marks the labels present at level N, counts them (the segment count K, reported by read_back) and,
     // when apply, renumbers them. compact does all of it, unless the backend returns true here: its label_edges
     // then marks them as well (each row while it is in cache), the pipeline calls mark_labels where label_edges does

@@ -79,9 +79,9 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
             clock.run("final_fill", [&] { ex.final_fill(n); });        // steps 5, 6 a, b
             if (edges) clock.run("edges", [&] { ex.label_edges(); });  // step 6 c (and the marks, with marks)
         }
-        // The merge changes labels after the edges marked them: the marks are made again after it.
+        // The merge changes labels after the edges marked them: the marks are made again, by it or after it.
         if (merge) clock.run("merge", [&] { ex.merge_segments(); });  // step 6d
-        marked = marks && edges && !merge;
+        marked = marks && (merge ? ex.marks_labels_in_merge() : edges);
     }
     if (marks && !marked) clock.run("compact", [&] { ex.mark_labels(n); });
     clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7

@@ -54,6 +54,7 @@ public:
     void final_fill_with_edges(int level) override;
     void label_edges() override;
     void merge_segments() override;  // cpu_merge.cpp
+    [[nodiscard]] bool marks_labels_in_merge() const override { return true; }
     // label_edges marks each row once its labels are final: one pass over the image fewer.
     [[nodiscard]] bool marks_labels_before_compact() const override { return true; }
     void mark_labels(int level) override;

@@ -1,6 +1,7 @@
 // Step 6d, the merge (docs/algorithm.md section 5b), with the GPUs' functions (shaders/pyr_merge_table.h) over a
 // table sized once per Segmenter: every row's crossings counted into the pair table at once, then the pairs that
-// join united and every label of level N given its group's smallest label.
+// join united and every label of level N given its group's smallest label, each row marked for step 7 as it is
+// relabelled.
 #include <algorithm>
 #include <atomic>
 
@@ -71,10 +72,14 @@ void CpuExecutor::merge_segments() {
         merge_words_[l] = merge_words_[merge_words_[l]];
         joined = joined || merge_words_[l] != l;
     }
-    if (!joined) return;
+    // Each row relabelled (when any group joined) and its labels marked for step 7 (marks_labels_in_merge).
+    std::fill(lut_.begin(), lut_.end(), 0u);
     rows(lv.height, [&](size_t y) {
         uint32_t* row = labels_.data() + lv.offset + y * lv.width;
-        for (size_t x = 0; x < lv.width; ++x) row[x] = merge_words_[row[x]];
+        if (joined) {
+            for (size_t x = 0; x < lv.width; ++x) row[x] = merge_words_[row[x]];
+        }
+        mark_row_labels(row, lv.width);
     });
 }
 
