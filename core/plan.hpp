@@ -51,8 +51,8 @@ struct Plan {
     // and the fixed point of the point sums, 2^stats_point_shift steps per input unit.
     std::uint32_t stats_slots = 0;
     int stats_point_shift = 0;
-    // The merge's pair table on GPUs (shaders/pyr_merge_table.h): a power of two above twice the pairs a frame can
-    // have; 0 without the merge.
+    // The merge's pair table (shaders/pyr_merge_table.h, every backend): a power of two above twice the pairs a
+    // frame can have; 0 without the merge.
     std::uint32_t merge_slots = 0;
     // Outputs::normals: the frame returns the normals the metric used, so a backend must keep them per pixel.
     bool keep_normals = false;

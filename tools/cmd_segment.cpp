@@ -154,9 +154,6 @@ struct FrameReport {
 
 // What the run says: --quiet leaves stderr to warnings and errors, and a batch of clouds in metres needs one note,
 // not one per frame.
-// The samples measure_frame_noise needs before it judges a sensor (presets.hpp).
-constexpr std::size_t kMinNoiseSamples = 1000;
-
 struct RunNotes {
     bool quiet = false;
     bool metres_read = false;
@@ -284,33 +281,35 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     Params params = frame_params;
     std::optional<SensorKind> kind;  // the sensor the parameters are for, when one is named or chosen
     if (sensor && !sensor->automatic) kind = sensor->kind;
-    if (sensor && sensor->automatic && notes.auto_sensor) {
-        kind = *notes.auto_sensor;
-        params = parse_params(args, kind);
-        params.unit_mm = frame_params.unit_mm;
-        sensor_note = std::string(", sensor auto: ") + sensor_kind_name(*kind);
-    } else if (!sensor || sensor->automatic) {
+    // --sensor auto measures until it has chosen; without --sensor, a frame is measured for the hint until it has
+    // been given (nothing else reads the measurement).
+    std::optional<SensorKind> automatic = sensor && sensor->automatic ? notes.auto_sensor : std::nullopt;
+    const bool measure = sensor ? sensor->automatic && !automatic : !notes.quiet && !notes.hinted;
+    if (measure) {
         const FrameNoise noise = loaded.depth ? measure_frame_noise(loaded.depth->view(cloud.width, cloud.height))
                                               : measure_frame_noise(view, frame_params.unit_mm);
         if (sensor) {
-            kind = noise.suggested;
-            params = parse_params(args, noise.suggested);
-            params.unit_mm = frame_params.unit_mm;
-            sensor_note = std::string(", sensor auto: ") + sensor_kind_name(noise.suggested);
-            if (noise.samples >= kMinNoiseSamples) {
+            automatic = noise.suggested;
+            if (noise.samples >= kMinFrameNoiseSamples) {
                 notes.auto_sensor = noise.suggested;
                 if (!notes.quiet) {
                     std::fprintf(stderr, "pyrseg: sensor auto: %s for this run, from %s: %s\n",
                                  sensor_kind_name(noise.suggested), printable(input).c_str(), noise.reason.c_str());
                 }
             }
-        } else if (noise.suggested != SensorKind::structured_light && !notes.quiet && !notes.hinted) {
+        } else if (noise.suggested != SensorKind::structured_light) {
             notes.hinted = true;
             std::fprintf(stderr,
                          "pyrseg: hint: %s: %s; the default parameters suit low-noise scanners. Try --sensor %s (or "
                          "--sensor auto, or the preset of your camera: --help lists them)\n",
                          printable(input).c_str(), noise.reason.c_str(), sensor_kind_name(noise.suggested));
         }
+    }
+    if (automatic) {
+        kind = *automatic;
+        params = parse_params(args, kind);
+        params.unit_mm = frame_params.unit_mm;
+        sensor_note = std::string(", sensor auto: ") + sensor_kind_name(*kind);
     }
     const bool warm_up = !segmenter || segmenter->width() != cloud.width || segmenter->height() != cloud.height ||
                          !same_params(segmenter->params(), params);

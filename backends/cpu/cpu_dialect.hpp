@@ -79,6 +79,20 @@ inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
     }
 }
 
+// The old value, as the GPUs' atomic min and compare-and-swap return it (the merge's shaders/pyr_merge_table.h).
+inline std::uint32_t atomic_min(std::uint32_t& word, std::uint32_t v) {
+    std::atomic_ref<std::uint32_t> a(word);
+    std::uint32_t old = a.load(std::memory_order_relaxed);
+    while (old > v && !a.compare_exchange_weak(old, v, std::memory_order_relaxed)) {
+    }
+    return old;
+}
+
+inline std::uint32_t atomic_cas(std::uint32_t& word, std::uint32_t expected, std::uint32_t v) {
+    std::atomic_ref<std::uint32_t>(word).compare_exchange_strong(expected, v, std::memory_order_relaxed);
+    return expected;
+}
+
 }  // namespace pyrseg::cpu
 
 #define PYR_CTX_PARAM const ::pyrseg::cpu::PassContext& ctx

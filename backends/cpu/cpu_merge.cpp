@@ -7,29 +7,10 @@
 
 #include "backends/cpu/cpu_executor.hpp"
 
-namespace pyrseg::cpu {
-namespace {
-
-std::uint32_t atomic_word_cas(std::uint32_t& word, std::uint32_t expected, std::uint32_t v) {
-    std::atomic_ref<std::uint32_t>(word).compare_exchange_strong(expected, v, std::memory_order_relaxed);
-    return expected;  // the old value
-}
-
-std::uint32_t atomic_word_min(std::uint32_t& word, std::uint32_t v) {
-    std::atomic_ref<std::uint32_t> a(word);
-    std::uint32_t old = a.load(std::memory_order_relaxed);
-    while (old > v && !a.compare_exchange_weak(old, v, std::memory_order_relaxed)) {
-    }
-    return old;
-}
-
-}  // namespace
-}  // namespace pyrseg::cpu
-
 #define PYR_UF_LOAD(i) std::atomic_ref<std::uint32_t>(ctx.merge[i]).load(std::memory_order_relaxed)
 #define PYR_UF_STORE(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).store((v), std::memory_order_relaxed)
-#define PYR_UF_MIN(i, v) ::pyrseg::cpu::atomic_word_min(ctx.merge[i], (v))
-#define PYR_UF_CAS(i, e, v) ::pyrseg::cpu::atomic_word_cas(ctx.merge[i], (e), (v))
+#define PYR_UF_MIN(i, v) ::pyrseg::cpu::atomic_min(ctx.merge[i], (v))
+#define PYR_UF_CAS(i, e, v) ::pyrseg::cpu::atomic_cas(ctx.merge[i], (e), (v))
 #define PYR_UF_ADD(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).fetch_add((v), std::memory_order_relaxed)
 
 namespace pyrseg::cpu::pixel {

@@ -63,6 +63,8 @@ struct FrameNoise {
     SensorKind suggested = SensorKind::structured_light;
     std::string reason;  // one sentence for users: what was measured and why that kind
 };
+// Below this many samples a frame is too small to judge: it is suggested the defaults.
+inline constexpr std::size_t kMinFrameNoiseSamples = 1000;
 // unit_mm as in Params.
 [[nodiscard]] PYRSEG_EXPORT FrameNoise measure_frame_noise(const CloudView& cloud, double unit_mm);
 // The same from a depth image's samples (metres_per_unit as in DepthView; the intrinsics are not needed).
