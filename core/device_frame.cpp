@@ -50,7 +50,7 @@ Segmenter::Impl& impl_of(Segmenter& segmenter) {
 template <class Bind>
 void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceLabels& labels) {
     bind();
-    run_pipeline(impl.plan, input, *impl.executor, impl.timings);
+    run_pipeline(impl.plan, input, false, *impl.executor, impl.timings);
     impl.executor->write_device_labels(labels);
     impl.timings.clear();  // host times of queued work: meaningless, and no device times were kept
 }

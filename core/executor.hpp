@@ -4,6 +4,7 @@
 // per-pixel logic is in shaders/). Where a backend runs several passes as one, it says so in a query
 // (fuses_points_to_mask, fuses_edges_into_final_fill, marks_labels_before_compact) and the pipeline calls the
 // fused pass instead: no pass depends on what an earlier call of the frame chose.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -37,6 +38,10 @@ public:
     // into the points the passes from normals on read.
     virtual void bind_depth(const DepthView& depth, const DepthTables& tables) = 0;
     virtual void depth_to_points() = 0;
+    // A frame's colour image (RGB8, rows row_step_bytes apart), bound after its cloud or depth; color_edges (step
+    // 0c, docs/algorithm.md section 2c) then clears B where it finds a colour edge, after the metric.
+    virtual void bind_color(const std::uint8_t* rgb, std::size_t row_step_bytes) = 0;
+    virtual void color_edges() = 0;
     virtual void estimate_normals() = 0;  // when the cloud has no normals
     virtual void quantize() = 0;          // validity and qn per pixel
     virtual void metric() = 0;            // fillable mask B into level N

@@ -33,7 +33,8 @@ private:
 
 }  // namespace
 
-void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vector<PassTiming>& timings) {
+void run_pipeline(const Plan& plan, InputKind input, bool with_color, PassExecutor& ex,
+                  std::vector<PassTiming>& timings) {
     PassClock clock(timings, ex);
     const int n = plan.level_count;
     if (input != InputKind::mask) {
@@ -45,6 +46,9 @@ void run_pipeline(const Plan& plan, InputKind input, PassExecutor& ex, std::vect
             if (estimate) clock.run("normals", [&] { ex.estimate_normals(); });
             clock.run("quantize", [&] { ex.quantize(); });
             clock.run("metric", [&] { ex.metric(); });
+        }
+        if (with_color && plan.params.color_edge_threshold < kMaxColorEdgeThreshold) {
+            clock.run("color", [&] { ex.color_edges(); });  // step 0c
         }
     }
     const bool marks = ex.marks_labels_before_compact();

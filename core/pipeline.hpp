@@ -10,6 +10,8 @@ namespace pyrseg::core {
 enum class InputKind { cloud_with_normals, cloud_without_normals, depth, mask };
 
 // Runs the contract's passes in order on `executor`; times each pass (host wall time) into `timings`.
-void run_pipeline(const Plan& plan, InputKind input, PassExecutor& executor, std::vector<PassTiming>& timings);
+// with_color: the frame came with a colour image (PassExecutor::bind_color), which the colour edge term uses.
+void run_pipeline(const Plan& plan, InputKind input, bool with_color, PassExecutor& executor,
+                  std::vector<PassTiming>& timings);
 
 }  // namespace pyrseg::core

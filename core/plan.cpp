@@ -66,6 +66,18 @@ void check_metric_parameters(const Params& p) {
     }
 }
 
+void check_color_parameters(const Params& p) {
+    if (p.color_edge_threshold < 0 || p.color_edge_threshold > kMaxColorEdgeThreshold) {
+        bad_parameter("color_edge_threshold must be in 0.." + std::to_string(kMaxColorEdgeThreshold) +
+                      " (a sum of R, G and B differences; " + std::to_string(kMaxColorEdgeThreshold) +
+                      " ignores the colour), got " + std::to_string(p.color_edge_threshold));
+    }
+    if (p.color_edge_stride < 1 || p.color_edge_stride > kMaxColorEdgeStride) {
+        bad_parameter("color_edge_stride must be in 1.." + std::to_string(kMaxColorEdgeStride) + " pixels, got " +
+                      std::to_string(p.color_edge_stride));
+    }
+}
+
 void check_merge_parameters(const Params& p, Thresholds& t) {
     if (p.merge_reach < 1 || p.merge_reach > kMaxMergeReach) {
         bad_parameter("merge_reach must be in 1.." + std::to_string(kMaxMergeReach) + " pixels, got " +
@@ -142,6 +154,7 @@ Thresholds compute_thresholds(const Params& params) {
         }
     }
     check_merge_parameters(params, t);
+    check_color_parameters(params);
     return t;
 }
 

@@ -94,6 +94,29 @@ void check_normals(const CloudView& cloud, const core::CloudLayout& layout) {
                                                  ": normalise them, or give (0, 0, 0) or NaN for no normal");
 }
 
+// A frame's colour image: rows of at least 3 * width bytes, all of them addressable; returns the row step.
+std::size_t check_color(const std::uint8_t* color, std::size_t row_step_bytes, int width, int height) {
+    if (color == nullptr) {
+        if (row_step_bytes != 0) {
+            throw Error(ErrorCode::invalid_argument,
+                        "color_row_step_bytes is " + std::to_string(row_step_bytes) + " but color is null");
+        }
+        return 0;
+    }
+    const std::size_t row = 3 * std::size_t(width);
+    const std::size_t step = row_step_bytes == 0 ? row : row_step_bytes;
+    if (step < row) {
+        throw Error(ErrorCode::invalid_argument, "color_row_step_bytes " + std::to_string(row_step_bytes) +
+                                                     " is smaller than a row of RGB8 (3 x width " +
+                                                     std::to_string(width) + " = " + std::to_string(row) + ")");
+    }
+    if (step > (std::numeric_limits<std::size_t>::max() - row) / std::size_t(height)) {
+        throw Error(ErrorCode::invalid_argument,
+                    "color_row_step_bytes " + std::to_string(row_step_bytes) + " is too large to address");
+    }
+    return step;
+}
+
 }  // namespace
 
 namespace {
@@ -128,12 +151,14 @@ void with_host_memory(const Segmenter::Impl& impl, const Work& work) {
 // One frame: the input to the backend, the passes, the results back; all timed ("upload" and "download" after
 // the passes).
 template <class Bind>
-void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out) {
+void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out,
+               const std::uint8_t* color = nullptr, std::size_t color_row_step_bytes = 0) {
     with_host_memory(impl, [&] {
         const auto upload_start = std::chrono::steady_clock::now();
         bind();
+        if (color != nullptr) impl.executor->bind_color(color, color_row_step_bytes);
         const double upload_ms = milliseconds_since(upload_start);
-        core::run_pipeline(impl.plan, input, *impl.executor, impl.timings);
+        core::run_pipeline(impl.plan, input, color != nullptr, *impl.executor, impl.timings);
         const auto download_start = std::chrono::steady_clock::now();
         impl.executor->read_back(out, impl.outputs);
         impl.timings.push_back(PassTiming{"upload", upload_ms});
@@ -169,15 +194,17 @@ void Segmenter::segment(const CloudView& cloud, Result& out) {
     check_frame_size("the cloud", cloud.width, cloud.height, impl.plan);
     const core::CloudLayout layout = core::cloud_layout(cloud);  // throws when the steps do not fit
     if (cloud.normals != nullptr) check_normals(cloud, layout);
+    const std::size_t color_step = check_color(cloud.color, cloud.color_row_step_bytes, cloud.width, cloud.height);
     const auto input =
         cloud.normals != nullptr ? core::InputKind::cloud_with_normals : core::InputKind::cloud_without_normals;
     run_frame(
-        impl, input, [&] { impl.executor->bind_cloud(cloud); }, out);
+        impl, input, [&] { impl.executor->bind_cloud(cloud); }, out, cloud.color, color_step);
 }
 
 void Segmenter::segment(const DepthView& depth, Result& out) {
     Impl& impl = live(impl_);
     check_frame_size("the depth image", depth.width, depth.height, impl.plan);
+    const std::size_t color_step = check_color(depth.color, depth.color_row_step_bytes, depth.width, depth.height);
     core::make_depth_tables(depth, impl.plan.params.unit_mm, impl.depth_tables);
     // The sampled median catches a wrong depth scale. That is a property of the camera, not of each frame's content:
     // once a frame with enough data has passed, the same camera is not checked again (a covered lens later in a
@@ -186,7 +213,8 @@ void Segmenter::segment(const DepthView& depth, Result& out) {
         impl.checked_camera.remember(depth);
     }
     run_frame(
-        impl, core::InputKind::depth, [&] { impl.executor->bind_depth(depth, impl.depth_tables); }, out);
+        impl, core::InputKind::depth, [&] { impl.executor->bind_depth(depth, impl.depth_tables); }, out, depth.color,
+        color_step);
 }
 
 Result Segmenter::segment(const DepthView& depth) {

@@ -22,8 +22,9 @@
     B(sums, 6, U32, PLAIN)    /* the compaction scan, K last; the depth frames' ray tables */                \
     B(fill, 7, U32, COHERENT) /* the fills' union-find: parents, then minima */                              \
     B(out, 8, U32, PLAIN)     /* the compacted labels */                                                     \
-    B(texels, 9, U32, PLAIN)  /* the robust normals' texels, PYR_TEXEL_WORDS per pixel */
+    B(texels, 9, U32, PLAIN)  /* the robust normals' texels, PYR_TEXEL_WORDS per pixel */                    \
+    B(color, 10, U32, PLAIN)  /* a frame's colour image: R, G, B bytes per pixel, packed row by row */
 
-#define PYR_BUFFER_COUNT 10
+#define PYR_BUFFER_COUNT 11
 
 #endif /* PYR_BUFFERS_H */

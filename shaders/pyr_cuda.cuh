@@ -31,6 +31,7 @@ struct PyrArgs {
     pyr_unpack_q16(pyr_ctx.quant[(i)*2u + (static_cast<unsigned>(c) >> 1u)] >> ((static_cast<unsigned>(c) & 1u) * 16u))
 #define PYR_QZ(i) pyr_ctx.points[(i)*3u + 2u]
 #define PYR_MASK(i) static_cast<unsigned>(pyr_ctx.mask[i])
+#define PYR_COLOR_WORD(j) pyr_ctx.color[j]
 #define PYR_LABEL(i) pyr_ctx.labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_ctx.labels[i] = (v))
 #define PYR_VALID(p) (pyr_ctx.quant[(p)*2u + 1u] >> 16u)

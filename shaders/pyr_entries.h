@@ -127,6 +127,22 @@ PYR_KERNEL_2D(metric_robust) {
 }
 #endif
 
+/* color_edges (2D, w x h): h, offset of level N, stride, threshold. Step 0c: the fillable pixels on a colour edge
+ * cleared. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_COLOR_EDGES)
+PYR_KERNEL_2D(color_edges) {
+    pyr_u32 h = PYR_ARG(0);
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= h) return;
+    pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
+    if ((PYR_MASK(i) & PYR_MASK_FILLABLE) != 0u &&
+        pyr_color_edge(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(2), PYR_ARG(3)) != 0u) {
+        PYR_STORE_MASK(i, 0u);
+    }
+}
+#endif
+
 /* bind_mask (1D, pixels): pixels, offset of level N. The caller's mask arrives in the points buffer, one word per
  * pixel: bit 0 fillable, bit 1 valid. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_BIND_MASK)

@@ -20,6 +20,7 @@
     K(quantize, QUANTIZE, 1)             \
     K(metric, METRIC, 2)                 \
     K(metric_robust, METRIC_ROBUST, 2)   \
+    K(color_edges, COLOR_EDGES, 2)       \
     K(bind_mask, BIND_MASK, 1)           \
     K(mip, MIP, 2)                       \
     K(init_labels, INIT_LABELS, 2)       \

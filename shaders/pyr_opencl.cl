@@ -18,6 +18,7 @@
 #define PYR_QN(i, c) pyr_unpack_q16(pyr_buf_quant[(i)*2u + ((uint)(c) >> 1u)] >> (((uint)(c)&1u) * 16u))
 #define PYR_QZ(i) pyr_buf_points[(i)*3u + 2u]
 #define PYR_MASK(i) ((uint)pyr_buf_mask[i])
+#define PYR_COLOR_WORD(j) pyr_buf_color[j]
 #define PYR_LABEL(i) pyr_buf_labels[i]
 #define PYR_STORE_LABEL(i, v) (pyr_buf_labels[i] = (v))
 #define PYR_VALID(p) (pyr_buf_quant[(p)*2u + 1u] >> 16u)

@@ -5,6 +5,7 @@
 #ifndef PYR_PASSES_H
 #define PYR_PASSES_H
 
+#include "pyr_color.h"
 #include "pyr_compact.h"
 #include "pyr_depth.h"
 #include "pyr_edges.h"

@@ -79,6 +79,7 @@ struct Method {
     Params params;
     std::optional<SensorKind> pcl;  // set: PCL's organized segmentation with the settings tuned for that model
     std::optional<peers::LccpSettings> lccp;  // set: PCL's supervoxels + LCCP with these settings
+    bool color = true;                        // the frame's colour image goes to pyrseg (when it has one)
 };
 
 struct Frame {
@@ -96,17 +97,26 @@ struct Frame {
 std::vector<Method> parse_methods(const Args& args) {
     std::vector<Method> out;
     const auto add = [&](const std::string& item) {
-        const bool merge = item.ends_with("+merge");
-        const bool no_merge = item.ends_with("+nomerge");
-        const std::string name = item.substr(0, item.size() - (merge ? 6 : no_merge ? 8 : 0));
+        std::stringstream parts(item);
+        std::string name;
+        std::getline(parts, name, '+');
         std::optional<SensorKind> kind;
         if (name != "default") {
             kind = sensor_kind_from_name(name);
             if (!kind) throw UsageError{"--presets: no sensor preset named '" + printable(name) + "'"};
         }
         Params p = kind ? parse_params(args, kind) : parse_params(args, std::nullopt);
-        if (merge || no_merge) p.merge = merge;
-        out.push_back({item, p, std::nullopt, std::nullopt});
+        bool color = true;
+        for (std::string modifier; std::getline(parts, modifier, '+');) {
+            if (modifier == "merge" || modifier == "nomerge") {
+                p.merge = modifier == "merge";
+            } else if (modifier == "nocolor") {
+                color = false;
+            } else {
+                throw UsageError{"--presets: '" + printable(item) + "': the modifiers are +merge, +nomerge, +nocolor"};
+            }
+        }
+        out.push_back({item, p, std::nullopt, std::nullopt, color});
     };
     const std::optional<std::string> list = args.value("presets");
     if (!list) {
@@ -282,7 +292,8 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             } else {
                 Segmenter segmenter(w, h, methods[m].params, "cpu");
-                const DepthView view = io::depth_view(f.depth, f.camera, metres_per_unit);
+                DepthView view = io::depth_view(f.depth, f.camera, metres_per_unit);
+                if (methods[m].color && !f.color.rgb.empty()) view.color = f.color.rgb.data();
                 Result result = segmenter.segment(view);
                 std::vector<double> times;
                 for (int run = 0; run < 5; ++run) {

@@ -276,6 +276,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     view.normals = cloud.normals.empty() ? nullptr : cloud.normals.data();
     view.width = cloud.width;
     view.height = cloud.height;
+    view.color = loaded.color.empty() ? nullptr : loaded.color.data();
     const std::optional<SensorChoice> sensor = parse_sensor(args);
     std::string sensor_note;
     Params params = frame_params;
@@ -321,8 +322,12 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
     const auto start = std::chrono::steady_clock::now();
-    const Result result =
-        loaded.depth ? segmenter->segment(loaded.depth->view(cloud.width, cloud.height)) : segmenter->segment(view);
+    DepthView depth_view;
+    if (loaded.depth) {
+        depth_view = loaded.depth->view(cloud.width, cloud.height);
+        depth_view.color = view.color;
+    }
+    const Result result = loaded.depth ? segmenter->segment(depth_view) : segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
 
     // All of the frame's outputs or none (tools/output_files.hpp).
@@ -379,15 +384,17 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     return {report, result.segment_count, elapsed.count(), warm_up};
 }
 
-// Folders expand to their supported files, glob patterns to their matches (name order), other names stay.
-std::vector<fs::path> expand_inputs(const std::vector<std::string>& names) {
+// Folders expand to their supported files, glob patterns to their matches (name order), other names stay. With
+// --color DIR, a folder's NAME_color.png files are colour images, not frames.
+std::vector<fs::path> expand_inputs(const std::vector<std::string>& names, bool color_images) {
     std::vector<fs::path> inputs;
     for (const std::string& name : names) {
         std::error_code ec;
         if (fs::is_directory(name, ec)) {
             std::vector<fs::path> found;
             for (const fs::directory_entry& e : fs::directory_iterator(name, ec)) {
-                if (e.is_regular_file(ec) && is_supported_input(e.path())) found.push_back(e.path());
+                const bool color_image = color_images && e.path().filename().string().ends_with("_color.png");
+                if (e.is_regular_file(ec) && is_supported_input(e.path()) && !color_image) found.push_back(e.path());
             }
             std::sort(found.begin(), found.end());
             // A warning, not a note: a name that brings no frame is likely a mistake, and --quiet keeps warnings.
@@ -466,7 +473,7 @@ int run_batch(const Args& args, const Params& params, RunNotes& notes) {
     const std::string out_dir_name = *args.value("out-dir");
     const fs::path out_dir = out_dir_name;
     const std::set<std::string> kinds = parse_write_list(args.value("write").value_or("labels,png"));
-    const std::vector<fs::path> inputs = expand_inputs(args.positional());
+    const std::vector<fs::path> inputs = expand_inputs(args.positional(), args.value("color").has_value());
     if (inputs.empty()) throw Error(ErrorCode::io, "the batch has no input file");
     make_output_folder(out_dir_name);
     // Every frame's names before the first is read: none may replace an input or another frame's output.
@@ -548,7 +555,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
     for (const OutputOption& o : output_options()) values.insert(o.name);
-    values.insert({"backend", "out-dir", "write", "progress"});
+    values.insert({"backend", "out-dir", "write", "progress", "color"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert({"help", "quiet", "verbose"});
     const Args args(argv, values, flags, {{"-q", "quiet"}, {"-v", "verbose"}});
@@ -569,12 +576,22 @@ int cmd_segment(const std::vector<std::string>& argv) {
         if (args.positional().empty()) throw UsageError{"expects at least one INPUT (file, folder or pattern)"};
         if (out.any()) throw UsageError{"in a batch (--out-dir), choose the outputs with --write, not file names"};
         if (args.value("out-dir")->empty()) throw UsageError{"--out-dir needs a folder name (\".\" for this one)"};
+        if (const auto color = args.value("color"); color && !fs::is_directory(*color)) {
+            throw UsageError{
+                "in a batch (--out-dir), --color names the folder of the frames' NAME_color.png images, "
+                "not a file: " +
+                printable(*color)};
+        }
         say_backend_choice(args, notes);
         return run_batch(args, params, notes);
     }
     if (args.value("write") || args.value("progress")) throw UsageError{"--write and --progress need --out-dir"};
     if (args.positional().size() != 1) {
         throw UsageError{"expects exactly one INPUT file (for a batch of several, give --out-dir)"};
+    }
+    if (const auto color = args.value("color"); color && fs::is_directory(*color)) {
+        throw UsageError{"--color names the colour image of the one INPUT (a folder is for batches): " +
+                         printable(*color)};
     }
     check_outputs(named_outputs(out));
     say_backend_choice(args, notes);

@@ -56,7 +56,8 @@ struct LoadedInput {
     io::PointCloud cloud;  // the points (for depth images, back-projected on the host: outputs that need a cloud)
     std::string kind;      // "PCD", "depth image"
     bool millimetres;      // the cloud is in millimetres whatever --unit-mm says
-    std::optional<DepthFrame> depth;  // depth images and NumPy depth maps: segmented from these samples
+    std::optional<DepthFrame> depth;       // depth images and NumPy depth maps: segmented from these samples
+    std::vector<std::uint8_t> color = {};  // --color's image, RGB8, W*H*3 (empty without --color)
 };
 [[nodiscard]] LoadedInput load_input(const std::filesystem::path& path, const Args& args);
 // Whether load_input reads files with this path's extension (batches pick such files out of folders).

@@ -33,6 +33,10 @@ const char* const kInputHelp =
     "                        the frame's median depth outside 0.05 to 100 m is refused, with the value that fits.\n"
     "  --depth-scale S       deprecated: depth units per metre, the inverse of --metres-per-unit (1000 for\n"
     "                        millimetres); still read, with a warning saying what to pass instead\n"
+    "  --color PATH          the colour camera's image registered to the frame (an 8-bit RGB or RGBA PNG of the\n"
+    "                        frame's size; RealSense: aligned to depth), for the colour edge term\n"
+    "                        (--color-edge-threshold). In a batch PATH is a folder: frame NAME_depth.EXT or NAME.EXT\n"
+    "                        takes PATH/NAME_color.png, and a frame without one is segmented without colour\n"
     "\n";
 
 const std::set<std::string> kInputValueOptions = {"intrinsics", "calib", "metres-per-unit", "depth-scale"};
@@ -193,7 +197,41 @@ bool is_supported_input(const std::filesystem::path& path) {
     return is_cloud_extension(ext) || is_depth_image_extension(ext);
 }
 
-LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
+namespace {
+
+// --color's image for the frame at `input`: the file itself, or in a folder the frame's NAME_color.png (nothing when
+// the folder has none).
+std::vector<std::uint8_t> color_for(const std::filesystem::path& input, const Args& args, int width, int height) {
+    const std::optional<std::string> option = args.value("color");
+    if (!option) return {};
+    std::filesystem::path path = *option;
+    if (std::filesystem::is_directory(path)) {
+        std::string name = input.stem().string();
+        if (name.size() > 6 && name.ends_with("_depth")) name.resize(name.size() - 6);
+        path /= name + "_color.png";
+        if (!std::filesystem::exists(path)) return {};
+    }
+    const io::Image png = io::read_png(path);
+    if (png.bit_depth != 8 || png.channels < 3) {
+        throw Error(ErrorCode::format, path.string() + ": --color needs an 8-bit RGB or RGBA PNG, this one has " +
+                                           std::to_string(png.channels) + " channel(s) of " +
+                                           std::to_string(png.bit_depth) + " bits");
+    }
+    if (png.width != width || png.height != height) {
+        throw Error(ErrorCode::size_mismatch, path.string() + ": the colour image is " + std::to_string(png.width) +
+                                                  " x " + std::to_string(png.height) + " but the frame is " +
+                                                  std::to_string(width) + " x " + std::to_string(height) +
+                                                  " (register the colour to the depth: RealSense's align)");
+    }
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
+    std::vector<std::uint8_t> rgb(3 * pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = png.data[std::size_t(png.channels) * i + c];
+    }
+    return rgb;
+}
+
+LoadedInput load_frame(const std::filesystem::path& path, const Args& args) {
     const std::string ext = lower_extension(path);
     if (is_cloud_extension(ext)) {
         for (const std::string& option : kInputValueOptions) {
@@ -231,6 +269,14 @@ LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
     }
     throw Error(ErrorCode::format, path.string() + ": unsupported input format '" + ext +
                                        "' (pyrseg reads .pcd, .ply and .npy clouds, and .png/.tif/.tiff depth images)");
+}
+
+}  // namespace
+
+LoadedInput load_input(const std::filesystem::path& path, const Args& args) {
+    LoadedInput loaded = load_frame(path, args);
+    loaded.color = color_for(path, args, loaded.cloud.width, loaded.cloud.height);
+    return loaded;
 }
 
 }  // namespace pyrseg::cli

@@ -48,12 +48,31 @@ const char* const kParameterHelp =
     "                        or flat (default 1 mm), plus --merge-tolerance-per-m2 MM per square metre of depth.\n"
     "  --merge-min-crossings C   a boundary shorter than C crossings never joins (default 16).\n"
     "  --merge-max-bad S     the share of a boundary's crossings that may be concave or steps (0..1, default 0.05).\n"
+    "  --color-edge-threshold T   with a colour image (--color), a pixel whose neighbours along its row or column\n"
+    "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (765: colour unused).\n"
+    "  --color-edge-stride S those neighbours lie S pixels either side of it (1..16, default 1).\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
-const std::set<std::string> kParameterValueOptions = {
-    "ct",          "dt",          "unit-mm",         "bridge-levels",          "unjoinable-gap",      "normal-radius",
-    "metric",      "sensor",      "normal-window",   "curvature-stride",       "dt-per-m2",           "ct-growth",
-    "edge-rounds", "merge-reach", "merge-tolerance", "merge-tolerance-per-m2", "merge-min-crossings", "merge-max-bad"};
+const std::set<std::string> kParameterValueOptions = {"ct",
+                                                      "dt",
+                                                      "unit-mm",
+                                                      "bridge-levels",
+                                                      "unjoinable-gap",
+                                                      "normal-radius",
+                                                      "metric",
+                                                      "sensor",
+                                                      "normal-window",
+                                                      "curvature-stride",
+                                                      "dt-per-m2",
+                                                      "ct-growth",
+                                                      "edge-rounds",
+                                                      "merge-reach",
+                                                      "merge-tolerance",
+                                                      "merge-tolerance-per-m2",
+                                                      "merge-min-crossings",
+                                                      "merge-max-bad",
+                                                      "color-edge-threshold",
+                                                      "color-edge-stride"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw", "merge", "no-merge"};
 
 std::optional<SensorChoice> parse_sensor(const Args& args) {
@@ -102,6 +121,8 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("merge-tolerance-per-m2")) p.merge_tolerance_per_m2 = *v;
     if (auto v = args.integer("merge-min-crossings")) p.merge_min_crossings = *v;
     if (auto v = args.number("merge-max-bad")) p.merge_max_bad_share = *v;
+    if (auto v = args.integer("color-edge-threshold")) p.color_edge_threshold = *v;
+    if (auto v = args.integer("color-edge-stride")) p.color_edge_stride = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

@@ -67,10 +67,18 @@ struct PassContext {
     std::uint8_t* mask = nullptr;              // all levels
     std::uint32_t* labels = nullptr;           // all levels
     const std::uint32_t* lut = nullptr;
-    std::uint32_t* stats = nullptr;   // the statistics words, PYR_STATS_WORDS per slot
-    RobustTexelPlanes robust_texels;  // the robust normals' texels of the frame
-    std::uint32_t* merge = nullptr;   // the merge's words (backends/cpu/cpu_merge.cpp)
+    std::uint32_t* stats = nullptr;       // the statistics words, PYR_STATS_WORDS per slot
+    RobustTexelPlanes robust_texels;      // the robust normals' texels of the frame
+    std::uint32_t* merge = nullptr;       // the merge's words (backends/cpu/cpu_merge.cpp)
+    const std::uint8_t* color = nullptr;  // the caller's colour image (RGB8), when the frame has one
+    std::size_t color_row_bytes = 0;
 };
+
+// Pixel (x, y)'s colour as 0x00BBGGRR, read where the caller has it.
+inline std::uint32_t rgb_at(const PassContext& ctx, std::uint32_t x, std::uint32_t y) {
+    const std::uint8_t* p = ctx.color + std::size_t(y) * ctx.color_row_bytes + 3 * std::size_t(x);
+    return std::uint32_t(p[0]) | (std::uint32_t(p[1]) << 8) | (std::uint32_t(p[2]) << 16);
+}
 
 inline void atomic_max(std::uint32_t& word, std::uint32_t v) {
     std::atomic_ref<std::uint32_t> a(word);
@@ -106,6 +114,7 @@ inline std::uint32_t atomic_cas(std::uint32_t& word, std::uint32_t expected, std
 // function it expands in).
 #define PYR_ROBUST_TEXEL(jx, jy) (ctx.robust_texels.load(static_cast<std::size_t>(jy) * (w) + (jx)))
 #define PYR_MASK(i) static_cast<std::uint32_t>(ctx.mask[i])
+#define PYR_RGB_AT(x, y, w) ::pyrseg::cpu::rgb_at(ctx, (x), (y))
 #define PYR_LABEL(i) (ctx.labels[i])
 #define PYR_STORE_LABEL(i, v) (ctx.labels[i] = (v))
 #define PYR_VALID(p) static_cast<std::uint32_t>(ctx.mask_valid != nullptr ? ctx.mask_valid[p] : PYR_Q_VALID(p))

@@ -52,6 +52,8 @@ PassContext CpuExecutor::context() {
     c.labels = labels_.data();
     c.lut = lut_.data();
     c.stats = stats_.data();
+    c.color = color_;
+    c.color_row_bytes = color_row_bytes_;
     return c;
 }
 

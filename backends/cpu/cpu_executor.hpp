@@ -32,6 +32,8 @@ public:
     void bind_mask(const MaskView& mask) override;
     void bind_depth(const DepthView& depth, const core::DepthTables& tables) override;
     void depth_to_points() override;
+    void bind_color(const std::uint8_t* rgb, std::size_t row_step_bytes) override;  // cpu_inputs.cpp
+    void color_edges() override;                                                    // cpu_front_end.cpp
 
     void estimate_normals() override;
     void quantize() override;
@@ -116,6 +118,8 @@ private:
     std::vector<std::uint8_t> edge_changed_;   // per row, whether a round changed it (edge_rounds > 1 only)
     std::vector<std::uint64_t> edge_bits_;     // per row, the pixels a round labels, a bit each (edge_rounds > 1)
     DepthView depth_{};                        // a depth frame, as the caller has it
+    const std::uint8_t* color_ = nullptr;      // the frame's colour image, as the caller has it (or null)
+    std::size_t color_row_bytes_ = 0;
     const core::DepthTables* depth_tables_ = nullptr;
     std::vector<float> depth_points_;          // its back-projection (depth frames only)
     std::vector<std::uint32_t> quant_;         // kQuantWords per pixel

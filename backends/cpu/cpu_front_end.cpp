@@ -151,6 +151,25 @@ void CpuExecutor::points_to_mask(bool estimate_normals) {
     valid_bytes_ = true;
 }
 
+// Step 0c: the fillable pixels on a colour edge cleared in level N.
+void CpuExecutor::color_edges() {
+    const PassContext c = context();
+    const auto w = uint32_t(plan_.width);
+    const auto h = uint32_t(plan_.height);
+    const auto stride = uint32_t(plan_.params.color_edge_stride);
+    const auto threshold = uint32_t(plan_.params.color_edge_threshold);
+    std::uint8_t* mask = mask_.data() + plan_.full().offset;
+    rows(size_t(h), [&](size_t y) {
+        std::uint8_t* row = mask + y * w;
+        for (uint32_t x = 0; x < w; ++x) {
+            if ((row[x] & PYR_MASK_FILLABLE) != 0 &&
+                pixel::pyr_color_edge(c, w, h, x, uint32_t(y), stride, threshold) != 0u) {
+                row[x] = std::uint8_t(row[x] & ~PYR_MASK_FILLABLE);
+            }
+        }
+    });
+}
+
 // The robust texels' planes (RobustTexelPlanes) in robust_texels_, sized on first use.
 RobustTexelPlanes CpuExecutor::robust_planes() {
     const size_t pixels = plan_.pixel_count();

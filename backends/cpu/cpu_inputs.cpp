@@ -10,6 +10,7 @@ using std::uint32_t;
 
 void CpuExecutor::bind_cloud(const CloudView& cloud) {
     fill_rounds_ = 0;
+    color_ = nullptr;
     cloud_ = cloud;
     layout_ = core::cloud_layout(cloud);
     normals_estimated_ = false;
@@ -20,11 +21,18 @@ void CpuExecutor::bind_cloud(const CloudView& cloud) {
 // The depth image stays where the caller has it; depth_to_points writes the points this backend owns.
 void CpuExecutor::bind_depth(const DepthView& depth, const core::DepthTables& tables) {
     fill_rounds_ = 0;
+    color_ = nullptr;
     depth_ = depth;
     depth_tables_ = &tables;
     normals_estimated_ = false;
     valid_bytes_ = false;
     from_mask_ = false;
+}
+
+// The colour image, like the cloud, stays where the caller has it.
+void CpuExecutor::bind_color(const std::uint8_t* rgb, std::size_t row_step_bytes) {
+    color_ = rgb;
+    color_row_bytes_ = row_step_bytes;
 }
 
 void CpuExecutor::depth_to_points() {
@@ -69,6 +77,7 @@ void CpuExecutor::depth_to_points() {
 
 void CpuExecutor::bind_mask(const MaskView& mask) {
     fill_rounds_ = 0;
+    color_ = nullptr;
     from_mask_ = true;
     const size_t w = size_t(plan_.width);
     const size_t stride = mask.row_stride == 0 ? w : mask.row_stride;

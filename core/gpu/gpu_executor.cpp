@@ -103,6 +103,21 @@ public:
         set_depth(depth.view.format, tables);
     }
 
+    // The colour image packed row by row (3 bytes a pixel) into the color buffer.
+    void bind_color(const std::uint8_t* rgb, size_t row_step_bytes) override {
+        const size_t row = 3 * size_t(width());
+        host_color_.resize((row * size_t(height()) + 3) / 4);  // once per Segmenter
+        auto* packed = reinterpret_cast<unsigned char*>(host_color_.data());
+        for (size_t y = 0; y < size_t(height()); ++y) std::memcpy(packed + y * row, rgb + y * row_step_bytes, row);
+        device_->upload(Buffer::color, 0, host_color_.data(), 4 * host_color_.size());
+    }
+
+    void color_edges() override {
+        dispatch(Kernel::color_edges, width(), height(),
+                 args({height(), plan_.full().offset, uint32_t(plan_.params.color_edge_stride),
+                       uint32_t(plan_.params.color_edge_threshold)}));
+    }
+
     void depth_to_points() override {
         dispatch(Kernel::depth_points, width(), height(),
                  args({height(), depth_format_, bits(depth_scale_), rays_word()}));
@@ -368,6 +383,7 @@ private:
     DeviceLimits limits_;
     std::vector<float> host_points_, host_normals_;  // staging for strided clouds
     std::vector<std::uint32_t> host_depth_;          // a depth frame's samples, packed
+    std::vector<std::uint32_t> host_color_;          // a frame's colour image, packed
     std::vector<float> host_rays_;                   // its ku then kv
     std::vector<float> rays_on_device_;              // the ku and kv the sums buffer holds (empty: unknown)
     bool rays_pending_ = false;                      // the frame being queued uploads new ones
@@ -430,6 +446,8 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
         case Buffer::texels:
             // The robust normals' texels (shaders/pyr_robust.h), only for the robust metric.
             return plan.params.metric == Metric::robust ? 4 * size_t(PYR_TEXEL_WORDS) * px : 0;
+        case Buffer::color:
+            return (3 * px + 3) / 4 * 4;  // R, G, B per pixel, whole words
         case Buffer::count:
             break;
     }

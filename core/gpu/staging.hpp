@@ -13,9 +13,9 @@
 
 namespace pyrseg::gpu {
 
-// The staging areas a device needs for the executor's transfers between two waits: in, the points and normals; out,
-// the results (StagedResults), the segment count and the statistics words (within the lut buffer's size);
-// each with room for the arena's alignment.
+// The staging areas a device needs for the executor's transfers between two waits: in, the points, normals and colour;
+// out, the results (StagedResults), the segment count and the statistics words (within the lut buffer's size); each
+// with room for the arena's alignment.
 struct StagingBytes {
     std::size_t upload;
     std::size_t download;
@@ -23,7 +23,8 @@ struct StagingBytes {
 inline StagingBytes staging_bytes(const BufferSizes& sizes) {
     constexpr std::size_t kAlignmentRoom = 256;
     const std::size_t pixels = sizes[std::size_t(Buffer::out)] / 4;
-    return {sizes[std::size_t(Buffer::points)] + sizes[std::size_t(Buffer::normals)] + kAlignmentRoom,
+    return {sizes[std::size_t(Buffer::points)] + sizes[std::size_t(Buffer::normals)] +
+                sizes[std::size_t(Buffer::color)] + 2 * kAlignmentRoom,
             StagedResults::kBytesPerPixel * pixels + sizes[std::size_t(Buffer::lut)] + kAlignmentRoom};
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Non-owning views of an organized point cloud. Nothing viewed is ever modified.
 #include <cstddef>
+#include <cstdint>
 
 namespace pyrseg {
 
@@ -22,6 +23,11 @@ struct CloudView {
     int point_stride = 3;              // floats from one point to the next, >= 3
     std::size_t point_step_bytes = 0;  // bytes from one point to the next, >= 12; 0: point_stride floats
     std::size_t row_step_bytes = 0;    // bytes from one row to the next; 0: row_stride points
+    // Optional: the colour camera's image registered to the points (an RGB-D camera's aligned colour), 8-bit R, G, B
+    // per pixel; pixel (x, y) is color[y * color_row_step_bytes + 3 * x + c]. With it, pixels on a colour edge are
+    // not fillable (Params::color_edge_threshold; docs/algorithm.md section 2c).
+    const std::uint8_t* color = nullptr;
+    std::size_t color_row_step_bytes = 0;  // 0: 3 * width
 };
 
 }  // namespace pyrseg

@@ -27,6 +27,11 @@ struct DepthView {
     double metres_per_unit = 0.0;
     // Pinhole intrinsics in pixels: pixel (u, v) at depth z is ((u - cx) z / fx, (v - cy) z / fy, z).
     double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+    // Optional: the colour image registered to the depth (RealSense's align-to-depth, Azure Kinect's transformed
+    // colour), 8-bit R, G, B per pixel; pixel (x, y) is color[y * color_row_step_bytes + 3 * x + c]. With it, pixels on
+    // a colour edge are not fillable (Params::color_edge_threshold; docs/algorithm.md section 2c).
+    const std::uint8_t* color = nullptr;
+    std::size_t color_row_step_bytes = 0;  // 0: 3 * width
 };
 
 // The median depths in metres that depth cameras' frames have. Outside them the unit given for the samples (or a

@@ -16,6 +16,8 @@ inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
 inline constexpr int kMaxEdgeRounds = 63;
 inline constexpr int kMaxMergeReach = 16;
+inline constexpr int kMaxColorEdgeStride = 16;
+inline constexpr int kMaxColorEdgeThreshold = 765;
 
 // Which fillable test (docs/algorithm.md): the paper's (section 2, the contract) for low-noise scanners, or the
 // robust one (sections 2b and 8b) for depth cameras whose noise grows with the square of the depth.
@@ -42,8 +44,14 @@ struct Params {
     // merge_tolerance_mm + merge_tolerance_per_m2 * z_m^2 millimetres.
     double merge_tolerance_mm = 1.0;
     double merge_tolerance_per_m2 = 0.0;
-    int merge_min_crossings = 16;              // a shorter boundary never joins
-    double merge_max_bad_share = 0.05;         // 0..1: the share of its crossings a joining boundary may have bad
+    int merge_min_crossings = 16;       // a shorter boundary never joins
+    double merge_max_bad_share = 0.05;  // 0..1: the share of its crossings a joining boundary may have bad
+    // The colour edge term (docs/algorithm.md section 2c), used on frames that come with a colour image: a pixel is
+    // not fillable where its neighbours color_edge_stride pixels before and after it, along its row or its column,
+    // differ by more than color_edge_threshold, the sum of the absolute differences of R, G and B (0..765; 765
+    // ignores the colour).
+    int color_edge_threshold = 765;
+    int color_edge_stride = 1;                 // 1..16
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
     Metric metric = Metric::paper;

@@ -309,6 +309,52 @@ DepthView DepthInput::view(Scratch& scratch) const {
     return v;
 }
 
+ColorInput::ColorInput(const py::object& color, int width, int height) {
+    if (color.is_none()) return;
+    color_ = as_array(color, "color");
+    const py::array& a = *color_;
+    if (a.ndim() != 3 || a.shape(2) != 3) {
+        throw py::value_error("color must be H x W x 3 (R, G, B), got shape " + shape_text(a));
+    }
+    if (!is_native(a.dtype(), 'u', 1)) {
+        throw py::type_error("color must be uint8 (8-bit R, G, B), got " + dtype_text(a));
+    }
+    if (a.shape(0) != height || a.shape(1) != width) {
+        throw py::value_error("color is " + std::to_string(a.shape(1)) + " x " + std::to_string(a.shape(0)) +
+                              " (W x H) but the frame is " + std::to_string(width) + " x " + std::to_string(height) +
+                              ": register the colour to the depth (RealSense: align)");
+    }
+    const bool packed = (width <= 1 || a.strides(1) == 3) && a.strides(2) == 1;
+    const bool rows_ok = height <= 1 || a.strides(0) >= 3 * py::ssize_t(width);
+    copy_ = !packed || !rows_ok;
+}
+
+const std::uint8_t* ColorInput::data(Scratch& scratch, std::size_t& row_step_bytes) const {
+    row_step_bytes = 0;
+    if (!color_) return nullptr;
+    const py::array& a = *color_;
+    const auto* base = static_cast<const std::uint8_t*>(a.data());
+    if (!copy_) {
+        row_step_bytes = a.shape(0) > 1 ? std::size_t(a.strides(0)) : 0;
+        return base;
+    }
+    const py::ssize_t h = a.shape(0), w = a.shape(1);
+    scratch.color.resize(std::size_t(h * w * 3));
+    for (py::ssize_t y = 0; y < h; ++y) {
+        for (py::ssize_t x = 0; x < w; ++x) {
+            for (py::ssize_t c = 0; c < 3; ++c) {
+                scratch.color[std::size_t((y * w + x) * 3 + c)] =
+                    base[y * a.strides(0) + x * a.strides(1) + c * a.strides(2)];
+            }
+        }
+    }
+    return scratch.color.data();
+}
+
+void ColorInput::refuse_alias(const py::array& out) const {
+    if (color_) refuse_shared(out, *color_, "the colour image");
+}
+
 MaskInput::MaskInput(const py::object& mask, const py::object& valid) : mask_(as_array(mask, "mask")) {
     const auto check = [](const py::array& a, const char* what) {
         if (a.ndim() != 2) throw py::value_error(std::string(what) + " must be H x W, got shape " + shape_text(a));

@@ -17,7 +17,7 @@ namespace pyrseg::python {
 struct Scratch {
     std::vector<float> points, normals, depth;
     std::vector<std::uint16_t> depth_u16;
-    std::vector<std::uint8_t> fillable, valid;
+    std::vector<std::uint8_t> fillable, valid, color;
 };
 
 // A frame's conversion, prepared with the GIL held (the arrays inspected, references kept) and run without it: the
@@ -62,6 +62,21 @@ private:
     bool integer_ = false;  // another integer dtype, converted to uint16
     bool is_signed_ = false, swapped_ = false;
     int width_ = 0, height_ = 0;
+};
+
+// A frame's colour image (color=): None, or H x W x 3 uint8 R, G, B registered to the frame's pixels; read in place
+// when each row's pixels are packed (3 bytes apart), else copied.
+class ColorInput {
+public:
+    ColorInput(const py::object& color, int width, int height);
+    // The first byte (null for None) and the row step, after copying into `scratch` when needed. No Python calls.
+    const std::uint8_t* data(Scratch& scratch, std::size_t& row_step_bytes) const;
+    void refuse_alias(const py::array& out) const;
+    [[nodiscard]] bool given() const { return color_.has_value(); }
+
+private:
+    std::optional<py::array> color_;
+    bool copy_ = false;
 };
 
 class MaskInput {

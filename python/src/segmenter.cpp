@@ -119,6 +119,10 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.merge_min_crossings = whole();
     } else if (key == "merge_max_bad_share") {
         p.merge_max_bad_share = number(kInit, name, v);
+    } else if (key == "color_edge_threshold") {
+        p.color_edge_threshold = whole();
+    } else if (key == "color_edge_stride") {
+        p.color_edge_stride = whole();
     } else {
         return false;
     }
@@ -172,7 +176,8 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
                                  "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
                                  "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
-                                 "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share; and preset, "
+                                 "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
+                                 "color_edge_threshold, color_edge_stride; and preset, "
                                  "outputs, cuda_stream");
         }
     }
@@ -189,12 +194,22 @@ DepthView with_camera(DepthView samples, const DepthView& camera) {
     return samples;
 }
 
+// Device-resident frames take no colour image yet: a host colour beside a device frame would be a silent upload.
+void no_device_color(const py::object& color) {
+    if (!color.is_none()) {
+        throw py::value_error(
+            "color= is for host frames: a device-resident frame takes no colour image yet (segment it without "
+            "color=, or pass host arrays)");
+    }
+}
+
 // --- the Segmenter ----------------------------------------------------------------------------------------------
 
 // The frame methods' parameters (Args binds them; their docstrings show them).
-constexpr Param kSegment[] = {{"points"}, {"normals", "None"}, {"out", "None"}, {"count", "None"}};
-constexpr Param kSegmentDepth[] = {{"depth"},           {"fx"},          {"fy"},           {"cx"}, {"cy"},
-                                   {"metres_per_unit"}, {"out", "None"}, {"count", "None"}};
+constexpr Param kSegment[] = {{"points"}, {"normals", "None"}, {"out", "None"}, {"count", "None"}, {"color", "None"}};
+constexpr Param kSegmentDepth[] = {
+    {"depth"},         {"fx"},           {"fy"}, {"cx"}, {"cy"}, {"metres_per_unit"}, {"out", "None"},
+    {"count", "None"}, {"color", "None"}};
 constexpr Param kSegmentMask[] = {{"mask"}, {"valid", "None"}, {"out", "None"}};
 
 class PySegmenter {
@@ -246,13 +261,19 @@ public:
             choose_preset(measure_frame_noise(probe.view(scratch), params_.unit_mm));
         }
         if (is_device_array(points)) {
+            no_device_color(a.object(4));
             device().segment_cloud(*segmenter_, points, normals, out, count);
             return out;
         }
         no_count(count);
         const CloudInput input(points, normals, width(), height());
-        return run(input, out, true,
-                   [&input](Scratch& s, Segmenter& seg, Result& r) { seg.segment(input.view(s), r); });
+        const ColorInput color(a.object(4), width(), height());
+        if (!out.is_none()) color.refuse_alias(check_labels_out(out, width(), height()));
+        return run(input, out, true, [&input, &color](Scratch& s, Segmenter& seg, Result& r) {
+            CloudView view = input.view(s);
+            view.color = color.data(s, view.color_row_step_bytes);
+            seg.segment(view, r);
+        });
     }
 
     py::object segment_depth(const py::args& args, const py::kwargs& kwargs) {
@@ -272,14 +293,19 @@ public:
             choose_preset(measure_frame_noise(with_camera(probe.view(scratch), camera)));
         }
         if (is_device_array(depth)) {
+            no_device_color(a.object(8));
             device().segment_depth(*segmenter_, depth, camera, out, count);
             return out;
         }
         no_count(count);
         const DepthInput input(depth);
         warn_about_camera(input, camera);
-        return run(input, out, true, [&input, &camera](Scratch& s, Segmenter& seg, Result& r) {
-            seg.segment(with_camera(input.view(s), camera), r);
+        const ColorInput color(a.object(8), width(), height());
+        if (!out.is_none()) color.refuse_alias(check_labels_out(out, width(), height()));
+        return run(input, out, true, [&input, &camera, &color](Scratch& s, Segmenter& seg, Result& r) {
+            DepthView view = with_camera(input.view(s), camera);
+            view.color = color.data(s, view.color_row_step_bytes);
+            seg.segment(view, r);
         });
     }
 
@@ -591,7 +617,8 @@ and .params is None until then.
 params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
-merge_min_crossings, merge_max_bad_share (docs/algorithm.md).
+merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride (the colour edge term on frames
+given color=) (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
@@ -611,14 +638,16 @@ points: H x W x 3 (xyz), H x W x 4 (xyz and a pad, PCL's PointXYZ) or H x W x 6 
 place, any strides) or float64 (converted); normals: None (estimated) or H x W x 3. out: an H x W uint32 array
 to write the labels into (its elements distinct, sharing no memory with the inputs). A CUDA device array (backend
 "cuda") is segmented on the device, asynchronously on the Segmenter's stream: out= (an H x W uint32 device array) is
-then required and returned, and count= (a uint32 device array) receives the segment count.)",
+then required and returned, and count= (a uint32 device array) receives the segment count. color: None or an H x W x 3
+uint8 image registered to the points (R, G, B), for the colour edge term (color_edge_threshold; host frames only).)",
              [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
                  return segmenter_of(self).segment(args, kwargs);
              });
     def_args(segmenter, "segment_depth", kSegmentDepth,
              R"(Segments a depth image back-projected with the pinhole intrinsics: H x W uint16 or float32 in place,
 float64 converted, any other integer dtype converted to uint16 when its values are 0..65535 (PIL gives int32 for
-16-bit PNGs). metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 for float metres).)",
+16-bit PNGs). metres_per_unit is the SDK's depth scale (0.001 for millimetres, 1 for float metres). color: None or an
+H x W x 3 uint8 image registered to the depth (R, G, B), for the colour edge term (color_edge_threshold).)",
              [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
                  return segmenter_of(self).segment_depth(args, kwargs);
              });
@@ -781,6 +810,8 @@ py::dict params_to_dict(const Params& p) {
     d["merge_tolerance_per_m2"] = p.merge_tolerance_per_m2;
     d["merge_min_crossings"] = p.merge_min_crossings;
     d["merge_max_bad_share"] = p.merge_max_bad_share;
+    d["color_edge_threshold"] = p.color_edge_threshold;
+    d["color_edge_stride"] = p.color_edge_stride;
     return d;
 }
 

@@ -409,6 +409,56 @@ TEST(Cli, RealSenseFramesAutoChoosesTheStereoPresetOncePerBatch) {
     fs::remove_all(dir);
 }
 
+// The white bowl of wood_table_3 makes no depth step and only a weak crease at its rim: from depth alone it shares
+// the table's segment; with the colour image (--color, a colour edge threshold) it is a segment of its own, within
+// the bowl's outline and apart from the table.
+TEST(Cli, RealSenseColourSeparatesTheWhiteBowlFromTheTable) {
+    const fs::path data = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
+    if (!fs::exists(data / "wood_table_3_color.png")) GTEST_SKIP() << "RealSense frames not present: " << data;
+    const fs::path dir = temp_dir();
+    const std::string frame = (data / "wood_table_3_depth.png").string() + " --calib " +
+                              (data / "camera.yml").string() + " --sensor realsense-d435 --labels ";
+    const auto labels_of = [](const fs::path& path) {
+        const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(path);
+        EXPECT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+        std::vector<std::uint32_t> labels(std::size_t{640} * 480);
+        std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
+        return labels;
+    };
+    const auto at = [](const std::vector<std::uint32_t>& labels, int x, int y) {
+        return labels[std::size_t(y) * 640 + std::size_t(x)];
+    };
+    CliRun r = run("segment " + frame + (dir / "depth.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::vector<std::uint32_t> depth_only = labels_of(dir / "depth.npy");
+    EXPECT_EQ(at(depth_only, 460, 290), at(depth_only, 200, 400)) << "without colour the bowl is the table's";
+    r = run("segment " + frame + (dir / "color.npy").string() + " --color " +
+            (data / "wood_table_3_color.png").string() + " --color-edge-threshold 120");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::vector<std::uint32_t> labels = labels_of(dir / "color.npy");
+    const std::uint32_t bowl = at(labels, 460, 290);
+    ASSERT_NE(bowl, 0u);
+    EXPECT_EQ(at(labels, 440, 300), bowl);
+    const std::uint32_t table = at(labels, 200, 400);
+    EXPECT_NE(table, 0u);
+    EXPECT_NE(table, bowl);
+    EXPECT_EQ(at(labels, 600, 450), table);
+    std::size_t inside = 0, outside = 0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != bowl) continue;
+        const int x = int(i % 640), y = int(i / 640);
+        (x >= 390 && x <= 535 && y >= 205 && y <= 325 ? inside : outside) += 1;
+    }
+    EXPECT_GT(inside, 5000u);
+    EXPECT_EQ(outside, 0u);
+    // A colour image of another size, or a depth image given as the colour, is refused with the reason.
+    r = run("segment " + frame + (dir / "bad.npy").string() + " --color " + (data / "wood_table_1_depth.png").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("8-bit RGB"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "bad.npy"));
+    fs::remove_all(dir);
+}
+
 // The cracker box of wood_table_1 with the realsense-d435 preset: its front and top faces are one segment (the
 // merge joins them across their convex edge), which stays within the box and apart from the table.
 TEST(Cli, RealSenseBoxIsOneSegmentApartFromTheTable) {

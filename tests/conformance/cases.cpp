@@ -162,7 +162,35 @@ std::vector<ConformanceCase> build_merge_cases() {
     return cases;
 }
 
+constexpr int kColorCaseCount = 24;
+
+// Robust scenes with a colour image (docs/algorithm.md section 2c), the merge on in half of them; the colour term's
+// parameters over their ranges, from a stream of their own.
+std::vector<ConformanceCase> build_color_cases() {
+    std::vector<ConformanceCase> cases;
+    CaseRng rng(20261204);
+    const int fixed[][2] = {{1, 1}, {3, 9}, {33, 17}, {640, 480}, {2064, 1544}, {64, 1}};
+    for (int i = 0; i < kColorCaseCount; ++i) {
+        const bool sized = i < int(std::size(fixed));
+        const int w = sized ? fixed[i][0] : rng.range(9, 200);
+        const int h = sized ? fixed[i][1] : rng.range(9, 150);
+        ConformanceCase c = make_robust_case(2000 + i, w, h, rng);
+        c.params.merge = rng.chance(50);
+        c.params.color_edge_threshold = rng.pick({0, 20, 60, 120, 300, 764, kMaxColorEdgeThreshold});
+        c.params.color_edge_stride = rng.pick({1, 1, 2, 3, kMaxColorEdgeStride});
+        c.color_row_padding = rng.pick({0, 0, 1, 5});
+        c.name = "color" + c.name.substr(std::string("robust").size());
+        cases.push_back(c);
+    }
+    return cases;
+}
+
 }  // namespace
+
+const std::vector<ConformanceCase>& color_conformance_cases() {
+    static const std::vector<ConformanceCase> cases = build_color_cases();
+    return cases;
+}
 
 const std::vector<ConformanceCase>& merge_conformance_cases() {
     static const std::vector<ConformanceCase> cases = build_merge_cases();

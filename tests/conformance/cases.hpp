@@ -14,6 +14,7 @@ struct ConformanceCase {
     synthetic::SceneOptions scene;
     Params params;
     bool given_normals = false;  // the scene's exact normals; otherwise the normals pass estimates them
+    int color_row_padding = -1;  // >= 0: the frame comes with a colour image, rows padded by this many bytes
 };
 
 [[nodiscard]] const std::vector<ConformanceCase>& conformance_cases();
@@ -21,5 +22,7 @@ struct ConformanceCase {
 [[nodiscard]] const std::vector<ConformanceCase>& robust_conformance_cases();
 // Robust scenes with the merge (docs/algorithm.md section 5b) on, its parameters varied.
 [[nodiscard]] const std::vector<ConformanceCase>& merge_conformance_cases();
+// Robust scenes with a colour image (docs/algorithm.md section 2c), the colour term's parameters varied.
+[[nodiscard]] const std::vector<ConformanceCase>& color_conformance_cases();
 
 }  // namespace pyrseg::test

@@ -3,6 +3,8 @@
 // reason the backend gives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -20,10 +22,32 @@
 namespace pyrseg::test {
 namespace {
 
+// A colour image for a scene: each object's own colour, stripes on every other object (texture inside a surface),
+// and seeded noise of a few levels, so that colour edges fall on object borders, inside objects and at random.
+std::vector<std::uint8_t> scene_colors(const synthetic::Scene& scene, std::uint64_t seed) {
+    std::vector<std::uint8_t> rgb(3 * scene.object_id.size());
+    std::uint64_t state = seed * 6364136223846793005ull + 1442695040888963407ull;
+    for (std::size_t i = 0; i < scene.object_id.size(); ++i) {
+        const std::uint32_t id = scene.object_id[i];
+        const std::size_t x = i % std::size_t(scene.width);
+        const bool stripe = (id & 1u) != 0 && (x / 7) % 2 == 0;
+        for (int c = 0; c < 3; ++c) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            const auto noise = int((state >> 33) % 25) - 12;
+            const int base = int((id * 2654435761u >> (8 * c)) & 0xffu) + (stripe ? 70 : 0) + noise;
+            rgb[3 * i + std::size_t(c)] = std::uint8_t(std::clamp(base, 0, 255));
+        }
+    }
+    return rgb;
+}
+
 // Segments `points` with `backend` and compares every output with the reference.
+// color: packed RGB8 for the reference; the backend gets the same rows color_row_padding bytes apart.
 void expect_conformance(const std::string& backend, const float* points, const float* normals, int width, int height,
-                        const Params& params, const float* warmup_points = nullptr) {
-    const pyrseg_ref::Output ref = pyrseg_ref::segment(points, normals, width, height, to_reference(params));
+                        const Params& params, const float* warmup_points = nullptr,
+                        const std::vector<std::uint8_t>* color = nullptr, std::size_t color_row_padding = 0) {
+    const pyrseg_ref::Output ref = pyrseg_ref::segment(points, normals, width, height, to_reference(params),
+                                                       color != nullptr ? color->data() : nullptr);
     if (!ref.ok) {
         EXPECT_THROW(Segmenter(width, height, params, backend, everything()), pyrseg::Error)
             << "the reference rejects these parameters (" << ref.error << ") but the backend accepts them";
@@ -40,6 +64,16 @@ void expect_conformance(const std::string& backend, const float* points, const f
     }
     view.points = points;
     view.normals = normals;
+    std::vector<std::uint8_t> padded;
+    if (color != nullptr) {
+        const std::size_t row = 3 * std::size_t(width);
+        const std::size_t step = row + color_row_padding;
+        padded.assign(step * std::size_t(height), 0xa5);
+        for (std::size_t y = 0; y < std::size_t(height); ++y)
+            std::copy_n(color->data() + y * row, row, padded.data() + y * step);
+        view.color = padded.data();
+        view.color_row_step_bytes = color_row_padding == 0 ? 0 : step;
+    }
     segmenter.segment(view, result);
     EXPECT_TRUE(same_bytes("fillable mask", result.fillable_mask, ref.fillable, width));
     EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, width, 3));
@@ -111,6 +145,26 @@ INSTANTIATE_TEST_SUITE_P(Backends, MergeScenes,
                          [](const ::testing::TestParamInfo<MergeScenes::ParamType>& param_info) {
                              return std::get<0>(param_info.param) + "_" +
                                     merge_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
+                         });
+
+class ColorScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(ColorScenes, MatchesReference) {
+    const auto& [backend, index] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const ConformanceCase& c = color_conformance_cases()[std::size_t(index)];
+    const synthetic::Scene scene = synthetic::generate(c.scene);
+    const std::vector<std::uint8_t> color = scene_colors(scene, c.scene.seed);
+    expect_conformance(backend, scene.points.data(), c.given_normals ? scene.normals.data() : nullptr, scene.width,
+                       scene.height, c.params, nullptr, &color, std::size_t(c.color_row_padding));
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, ColorScenes,
+                         ::testing::Combine(::testing::ValuesIn(available_backend_names()),
+                                            ::testing::Range(0, int(color_conformance_cases().size()))),
+                         [](const ::testing::TestParamInfo<ColorScenes::ParamType>& param_info) {
+                             return std::get<0>(param_info.param) + "_" +
+                                    color_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
                          });
 
 // Depths in the subnormal range: validity (z > 0) and the metric's float depth differences must follow IEEE on

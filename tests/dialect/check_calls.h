@@ -13,6 +13,7 @@ PYR_FN pyr_i32 pyr_check_all(PYR_CTX_PARAM, pyr_u32 x, pyr_u32 y) {
     r += PYR_U32(pyr_robust_normal_q(PYR_CTX_ARG, 64u, 64u, x, y, 3u, 16.0f).z);
     pyr_robust_texel_store(PYR_CTX_ARG, y * 64u + x, pyr_robust_texel(PYR_CTX_ARG, 64u, 64u, x, y, 1u, 16.0f));
     r += pyr_mip_texel(PYR_CTX_ARG, lv, x, y);
+    r += pyr_color_edge(PYR_CTX_ARG, 64u, 64u, x, y, 1u, 48u);
     r += pyr_label_init_texel(PYR_CTX_ARG, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);

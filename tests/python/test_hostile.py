@@ -240,7 +240,7 @@ def test_missing_arguments_are_named_without_the_arrays():
     assert "fxx" in m, m
     m = short_type_error(lambda: seg.segment_depth(BIG, 1, 2, 3, 4, 0.001, fx=1))
     assert "fx" in m and "multiple" in m, m
-    m = short_type_error(lambda: seg.segment_depth(BIG, 1, 2, 3, 4, 0.001, None, None, 9))
+    m = short_type_error(lambda: seg.segment_depth(BIG, 1, 2, 3, 4, 0.001, None, None, None, 9))
     assert "at most" in m, m
     m = short_type_error(lambda: seg.segment())
     assert "'points'" in m, m

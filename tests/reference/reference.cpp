@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <numbers>
@@ -143,6 +144,8 @@ std::string check_params(int width, int height, const Params& p) {
     if (p.unjoinable_gap < 1) return "unjoinable_gap must be >= 1";
     if (std::string why = check_metric_params(p); !why.empty()) return why;
     if (std::string why = check_merge_params(p); !why.empty()) return why;
+    if (p.color_edge_threshold < 0 || p.color_edge_threshold > 765) return "color_edge_threshold must be in 0..765";
+    if (p.color_edge_stride < 1 || p.color_edge_stride > 16) return "color_edge_stride must be in 1..16";
     const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
     if (pixels > kMaxU32) return "image too large: W*H does not fit in 32 bits";
     return {};
@@ -1133,7 +1136,30 @@ std::vector<float> estimate_robust_normals(const float* points, int width, int h
     return normals_from_q(robust_normals_q(points, width, height, radius, window, unit_mm));
 }
 
-Output segment(const float* points, const float* normals, int width, int height, const Params& params) {
+// Section 2c: B cleared at every colour edge (both pixels of an axis in the image, their colours more than T apart).
+void clear_color_edges(std::vector<std::uint8_t>& fillable, const std::uint8_t* color, int width, int height,
+                       const Params& params) {
+    const std::int64_t w = width;
+    const std::int64_t h = height;
+    const std::int64_t s = params.color_edge_stride;
+    const auto differ = [&](std::int64_t xa, std::int64_t ya, std::int64_t xb, std::int64_t yb) {
+        const std::uint8_t* a = color + 3 * (ya * w + xa);
+        const std::uint8_t* b = color + 3 * (yb * w + xb);
+        std::int64_t d = 0;
+        for (int c = 0; c < 3; ++c) d += std::abs(std::int64_t(a[c]) - std::int64_t(b[c]));
+        return d > params.color_edge_threshold;
+    };
+    for (std::int64_t y = 0; y < h; ++y) {
+        for (std::int64_t x = 0; x < w; ++x) {
+            const bool along_x = x - s >= 0 && x + s <= w - 1 && differ(x - s, y, x + s, y);
+            const bool along_y = y - s >= 0 && y + s <= h - 1 && differ(x, y - s, x, y + s);
+            if (along_x || along_y) fillable[std::size_t(y * w + x)] = 0;
+        }
+    }
+}
+
+Output segment(const float* points, const float* normals, int width, int height, const Params& params,
+               const std::uint8_t* color) {
     if (std::string why = check_params(width, height, params); !why.empty()) return failure(std::move(why));
     if (normals == nullptr && params.normal_radius < 1) return failure("normal_radius must be >= 1");
     Plan plan;
@@ -1156,6 +1182,7 @@ Output segment(const float* points, const float* normals, int width, int height,
     }
     std::vector<std::uint8_t> fillable = robust ? robust_metric(points, used.data(), valid, width, height, params)
                                                 : metric(points, used.data(), valid, width, height, params);
+    if (color != nullptr) clear_color_edges(fillable, color, width, height, params);
     Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan, points, used.data());
     out.segments = segment_statistics(out, points, used.data(), width, params);
     out.normals = std::move(used);
@@ -1182,7 +1209,7 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
     return out;
 }
 
-Output segment_depth(const DepthInput& depth, int width, int height, const Params& params) {
+Output segment_depth(const DepthInput& depth, int width, int height, const Params& params, const std::uint8_t* color) {
     if (depth.width != width || depth.height != height) {
         return failure("the depth image is " + std::to_string(depth.width) + " x " + std::to_string(depth.height) +
                        " but width x height is " + std::to_string(width) + " x " + std::to_string(height));
@@ -1194,7 +1221,7 @@ Output segment_depth(const DepthInput& depth, int width, int height, const Param
     if (std::string why = make_plan(width, height, params, plan); !why.empty()) return failure(std::move(why));
     DepthPoints points = depth_to_points(depth, params.unit_mm);
     if (!points.ok) return failure(std::move(points.error));
-    return segment(points.points.data(), nullptr, width, height, params);
+    return segment(points.points.data(), nullptr, width, height, params, color);
 }
 
 }  // namespace pyrseg_ref

@@ -1,8 +1,8 @@
 #pragma once
 // The independent oracle for pyrseg: a plain, slow-but-linear implementation of the algorithm contract
 // (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals),
-// 8 (the normals pass), 1b (depth images) and 5b (the merge), written from that text only. The conformance suite
-// compares every backend with it bit for bit.
+// 8 (the normals pass), 1b (depth images), 2c (the colour edge term) and 5b (the merge), written from that text only.
+// The conformance suite compares every backend with it bit for bit.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -43,6 +43,9 @@ struct Params {
     double merge_tolerance_per_m2 = 0.0;  // t2, finite, >= 0: millimetres added to t0 per square metre of depth
     int merge_min_crossings = 16;         // C >= 1: crossings a pair needs to join
     double merge_max_bad_share = 0.05;    // f in [0, 1]: the largest share of bad crossings a joining pair may have
+    // Section 2c: the colour edge term, on frames given a colour image. Checked against their ranges always.
+    int color_edge_threshold = 765;  // T, 0..765; 765: no pixel is a colour edge
+    int color_edge_stride = 1;       // s, 1..16
 };
 
 // One segment's statistics (docs/algorithm.md section 10), in compacted order: exact integer sums.
@@ -67,8 +70,10 @@ struct Output {
 };
 
 // points: packed xyz float32, 3*W*H, row-major. normals: packed, or nullptr to estimate them (docs section 8, or
-// section 8b with Metric::robust). Output::normals holds the normals the metric used.
-Output segment(const float* points, const float* normals, int width, int height, const Params& params);
+// section 8b with Metric::robust). Output::normals holds the normals the metric used. color: packed R, G, B bytes,
+// 3*W*H, row-major, or nullptr for none (section 2c).
+Output segment(const float* points, const float* normals, int width, int height, const Params& params,
+               const std::uint8_t* color = nullptr);
 
 // Steps 3..7 only, from a given mask: fillable[i] is B; valid[i] (nullptr = every pixel valid) is used by edge
 // labelling (step 6c). Output::fillable echoes the mask, Output::normals stays empty.
@@ -108,6 +113,7 @@ DepthPoints depth_to_points(const DepthInput& depth, double unit_mm);
 
 // The whole algorithm from a depth image: section 1b with params.unit_mm, then segment() with normals estimated.
 // ok = false when depth.width / depth.height differ from width / height, or for any error of either step.
-Output segment_depth(const DepthInput& depth, int width, int height, const Params& params);
+Output segment_depth(const DepthInput& depth, int width, int height, const Params& params,
+                     const std::uint8_t* color = nullptr);
 
 }  // namespace pyrseg_ref

@@ -50,6 +50,8 @@ inline pyrseg_ref::Params to_reference(const Params& p) {
     r.merge_tolerance_per_m2 = p.merge_tolerance_per_m2;
     r.merge_min_crossings = p.merge_min_crossings;
     r.merge_max_bad_share = p.merge_max_bad_share;
+    r.color_edge_threshold = p.color_edge_threshold;
+    r.color_edge_stride = p.color_edge_stride;
     return r;
 }
 
