@@ -1,7 +1,8 @@
 // pyrseg per backend: the whole pipeline (and, as pipeline_depth, from a uint16 depth image back-projected on the
 // device) (with the paper's metric, and as pipeline_robust with the robust metric of
 // the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
-// pipeline_robust_merge with the preset's merge) (points, with estimated or given normals,
+// pipeline_robust_merge with the preset's merge, and as pipeline_robust_merge_color with a colour image and the
+// colour edge term as well) (points, with estimated or given normals,
 // to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame size,
 // next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers, carry
 // between machines.
@@ -30,6 +31,33 @@ void pipeline(benchmark::State& state, const std::string& backend, int width, in
     const CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
     time_frames(
         state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
+        [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params);
+}
+
+// A colour image for the scene: each object its own colour, stripes across every other object (colour edges inside
+// surfaces as well as between them).
+const std::vector<std::uint8_t>& scene_color(int width, int height) {
+    static std::map<std::pair<int, int>, std::vector<std::uint8_t>> cache;
+    std::vector<std::uint8_t>& rgb = cache[{width, height}];
+    if (rgb.empty()) {
+        const synthetic::Scene& s = scene(width, height);
+        rgb.resize(3 * s.object_id.size());
+        for (std::size_t i = 0; i < s.object_id.size(); ++i) {
+            const bool stripe = (s.object_id[i] & 1u) != 0 && (i % std::size_t(width)) / 9 % 2 == 0;
+            const std::uint32_t c = s.object_id[i] * 2654435761u + (stripe ? 0x505050u : 0u);
+            for (std::size_t k = 0; k < 3; ++k) rgb[3 * i + k] = std::uint8_t(c >> (8 * k));
+        }
+    }
+    return rgb;
+}
+
+void color_pipeline(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals,
+                    const Params& params) {
+    const synthetic::Scene& s = scene(width, height);
+    CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
+    view.color = scene_color(width, height).data();
+    time_frames(
+        state, backend, width, height, std::size_t(width) * std::size_t(height) * (12 * (given_normals ? 2 : 1) + 3),
         [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params);
 }
 
@@ -124,6 +152,15 @@ int register_all() {
                 const Params merged = sensor_preset(SensorKind::kinect_v1);
                 benchmark::RegisterBenchmark(("pipeline_robust_merge/" + b.name + "/" + suffix).c_str(),
                                              [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // And with a colour image and the colour edge term (step 0c): the difference to
+                // pipeline_robust_merge is the colour's cost, its upload included.
+                Params colored = merged;
+                colored.color_edge_threshold = 120;
+                benchmark::RegisterBenchmark(
+                    ("pipeline_robust_merge_color/" + b.name + "/" + suffix).c_str(),
+                    [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, colored); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
             }

@@ -48,9 +48,12 @@ Segmenter::Impl& impl_of(Segmenter& segmenter) {
 }
 
 template <class Bind>
-void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceLabels& labels) {
+void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceColor& color,
+         const DeviceLabels& labels) {
     bind();
-    run_pipeline(impl.plan, input, false, *impl.executor, impl.timings);
+    const bool with_color = color.rgb.handle != 0;
+    if (with_color) impl.executor->bind_device_color(color);
+    run_pipeline(impl.plan, input, with_color, *impl.executor, impl.timings);
     impl.executor->write_device_labels(labels);
     impl.timings.clear();  // host times of queued work: meaningless, and no device times were kept
 }
@@ -68,6 +71,16 @@ void check_device_depth(const DeviceDepth& depth, int width, int height) {
     const std::size_t row = sample * std::size_t(width);
     const std::size_t pitch = depth.view.row_step_bytes == 0 ? row : depth.view.row_step_bytes;
     check_rows("depth samples", depth.samples, pitch, row, std::size_t(height), sample, width, height);
+}
+
+void check_device_color(const DeviceColor& color, int width, int height) {
+    if (color.rgb.handle == 0) {
+        if (color.row_step_bytes != 0) bad("the colour image's row step is set but it has no buffer");
+        return;
+    }
+    const std::size_t row = 3 * std::size_t(width);
+    const std::size_t pitch = color.row_step_bytes == 0 ? row : color.row_step_bytes;
+    check_rows("colour image", color.rgb, pitch, row, std::size_t(height), 1, width, height);
 }
 
 void check_device_labels(const DeviceLabels& labels, int width, int height) {
@@ -104,12 +117,13 @@ void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const Devi
                       const std::function<void()>& checked) {
     Segmenter::Impl& impl = impl_of(segmenter);
     check_device_cloud(cloud, impl.plan.width, impl.plan.height);
+    check_device_color(cloud.color, impl.plan.width, impl.plan.height);
     check_device_labels(labels, impl.plan.width, impl.plan.height);
     const InputKind input =
         cloud.normals.handle != 0 ? InputKind::cloud_with_normals : InputKind::cloud_without_normals;
     if (checked) checked();
     run(
-        impl, input, [&] { impl.executor->bind_device_cloud(cloud); }, labels);
+        impl, input, [&] { impl.executor->bind_device_cloud(cloud); }, cloud.color, labels);
 }
 
 void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels,
@@ -122,16 +136,22 @@ void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const Devi
     }
     make_depth_tables(depth.view, impl.plan.params.unit_mm, impl.depth_tables, true);
     check_device_depth(depth, impl.plan.width, impl.plan.height);
+    if (depth.view.color != nullptr) bad("a device depth frame's colour goes in its color buffer, not view.color");
+    check_device_color(depth.color, impl.plan.width, impl.plan.height);
     check_device_labels(labels, impl.plan.width, impl.plan.height);
     if (checked) checked();
     run(
-        impl, InputKind::depth, [&] { impl.executor->bind_device_depth(depth, impl.depth_tables); }, labels);
+        impl, InputKind::depth, [&] { impl.executor->bind_device_depth(depth, impl.depth_tables); }, depth.color,
+        labels);
 }
 
 void PassExecutor::bind_device_cloud(const DeviceCloud& /*cloud*/) {
     throw Error(ErrorCode::invalid_argument, "this Segmenter's backend takes no device buffers");
 }
 void PassExecutor::bind_device_depth(const DeviceDepth& /*depth*/, const DepthTables& /*tables*/) {
+    throw Error(ErrorCode::invalid_argument, "this Segmenter's backend takes no device buffers");
+}
+void PassExecutor::bind_device_color(const DeviceColor& /*color*/) {
     throw Error(ErrorCode::invalid_argument, "this Segmenter's backend takes no device buffers");
 }
 void PassExecutor::write_device_labels(const DeviceLabels& /*labels*/) {

@@ -29,19 +29,28 @@ struct ExternalBuffer {
     std::size_t bytes = 0;
 };
 
+// A colour image registered to the frame (optional): R, G, B bytes packed within each row, rows row_step_bytes apart
+// (0: 3 * width). No handle: the frame has none.
+struct DeviceColor {
+    ExternalBuffer rgb;
+    std::size_t row_step_bytes = 0;
+};
+
 // A cloud: float32 xyz packed within each row (12 bytes a point), rows row_step_bytes apart (0: 12 * width).
 // Normals, when given, have the same layout.
 struct DeviceCloud {
     ExternalBuffer points;
     ExternalBuffer normals;
     std::size_t row_step_bytes = 0;
+    DeviceColor color;
 };
 
 // A depth image: the samples in `samples` (packed within each row), everything else as in DepthView (its `depth`
 // pointer is not used and must be null).
 struct DeviceDepth {
     ExternalBuffer samples;
-    DepthView view;
+    DepthView view;  // its color pointer is not used either and must be null
+    DeviceColor color;
 };
 
 // Where the labels go: uint32 per pixel, packed within each row, rows row_step_bytes apart (0: 4 * width); the

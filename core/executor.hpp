@@ -22,6 +22,7 @@ struct Plan;
 struct DepthTables;
 struct DeviceCloud;
 struct DeviceDepth;
+struct DeviceColor;
 struct DeviceLabels;
 
 class PassExecutor {
@@ -82,6 +83,7 @@ public:
     // The CPU backend (and any executor without a device) throws pyrseg::Error.
     virtual void bind_device_cloud(const DeviceCloud& cloud);
     virtual void bind_device_depth(const DeviceDepth& depth, const DepthTables& tables);
+    virtual void bind_device_color(const DeviceColor& color);  // after bind_device_cloud or bind_device_depth
     virtual void write_device_labels(const DeviceLabels& labels);
     // The GPU device the executor runs on (for the interop functions); nullptr on the CPU.
     [[nodiscard]] virtual gpu::Device* gpu_device() { return nullptr; }

@@ -151,21 +151,42 @@ void CpuExecutor::points_to_mask(bool estimate_normals) {
     valid_bytes_ = true;
 }
 
-// Step 0c: the fillable pixels on a colour edge cleared in level N.
+namespace {
+
+// |R_a - R_b| + |G_a - G_b| + |B_a - B_b| of two pixels' bytes (pyr_color_difference, on the bytes in place).
+inline uint32_t byte_difference(const std::uint8_t* a, const std::uint8_t* b) {
+    const auto d = [](int u, int v) { return uint32_t(u > v ? u - v : v - u); };
+    return d(a[0], b[0]) + d(a[1], b[1]) + d(a[2], b[2]);
+}
+
+}  // namespace
+
+// Step 0c: the fillable pixels on a colour edge cleared in level N. The columns whose row neighbours both lie in the
+// image read the caller's bytes directly; the few others go through the shared function (the same test).
 void CpuExecutor::color_edges() {
     const PassContext c = context();
     const auto w = uint32_t(plan_.width);
     const auto h = uint32_t(plan_.height);
-    const auto stride = uint32_t(plan_.params.color_edge_stride);
+    const auto s = uint32_t(plan_.params.color_edge_stride);
     const auto threshold = uint32_t(plan_.params.color_edge_threshold);
     std::uint8_t* mask = mask_.data() + plan_.full().offset;
     rows(size_t(h), [&](size_t y) {
         std::uint8_t* row = mask + y * w;
+        const std::uint8_t* mid = color_ + y * color_row_bytes_;
+        const bool vertical = y >= s && y + s < h;
+        const std::uint8_t* up = vertical ? color_ + (y - s) * color_row_bytes_ : nullptr;
+        const std::uint8_t* down = vertical ? color_ + (y + s) * color_row_bytes_ : nullptr;
+        const uint32_t inner_end = w > s ? w - s : 0;
         for (uint32_t x = 0; x < w; ++x) {
-            if ((row[x] & PYR_MASK_FILLABLE) != 0 &&
-                pixel::pyr_color_edge(c, w, h, x, uint32_t(y), stride, threshold) != 0u) {
-                row[x] = std::uint8_t(row[x] & ~PYR_MASK_FILLABLE);
+            if ((row[x] & PYR_MASK_FILLABLE) == 0) continue;
+            bool edge = false;
+            if (x >= s && x < inner_end) {
+                edge = byte_difference(mid + 3 * size_t(x - s), mid + 3 * size_t(x + s)) > threshold ||
+                       (vertical && byte_difference(up + 3 * size_t(x), down + 3 * size_t(x)) > threshold);
+            } else {
+                edge = pixel::pyr_color_edge(c, w, h, x, uint32_t(y), s, threshold) != 0u;
             }
+            if (edge) row[x] = std::uint8_t(row[x] & ~PYR_MASK_FILLABLE);
         }
     });
 }

@@ -180,9 +180,11 @@ void segment(Segmenter& segmenter, const CloudPointers& cloud, const LabelPointe
         const RelaxedCapture relaxed;
         c.points = external(device, cloud.points, cloud.points_bytes, "points");
         c.normals = external(device, cloud.normals, cloud.normals_bytes, "normals");
+        c.color.rgb = external(device, cloud.color, cloud.color_bytes, "colour image");
         l = labels_of(device, out);
     }
     c.row_step_bytes = cloud.row_step_bytes;
+    c.color.row_step_bytes = cloud.color_row_step_bytes;
     core::run_device_frame(segmenter, c, l);
 }
 
@@ -194,9 +196,11 @@ void segment(Segmenter& segmenter, const DepthPointers& depth, const LabelPointe
     {
         const RelaxedCapture relaxed;
         d.samples = external(device, depth.samples, depth.bytes, "depth samples");
+        d.color.rgb = external(device, depth.color, depth.color_bytes, "colour image");
         l = labels_of(device, out);
     }
     d.view = depth.view;
+    d.color.row_step_bytes = depth.color_row_step_bytes;
     core::run_device_frame(segmenter, d, l);
 }
 

@@ -120,6 +120,8 @@ cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuf
     c.points = external(device, cloud.points, cloud.points_offset, "points");
     c.normals = external(device, cloud.normals, cloud.normals_offset, "normals");
     c.row_step_bytes = cloud.row_step_bytes;
+    c.color.rgb = external(device, cloud.color, cloud.color_offset, "colour image");
+    c.color.row_step_bytes = cloud.color_row_step_bytes;
     const core::DeviceLabels l = labels_of(device, out);
     check_events(wait);
     core::run_device_frame(segmenter, c, l, [&] { device.wait_for(wait); });
@@ -132,6 +134,8 @@ cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuff
     core::DeviceDepth d;
     d.samples = external(device, depth.samples, depth.offset, "depth samples");
     d.view = depth.view;
+    d.color.rgb = external(device, depth.color, depth.color_offset, "colour image");
+    d.color.row_step_bytes = depth.color_row_step_bytes;
     const core::DeviceLabels l = labels_of(device, out);
     check_events(wait);
     core::run_device_frame(segmenter, d, l, [&] { device.wait_for(wait); });

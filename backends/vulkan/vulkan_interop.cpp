@@ -104,6 +104,8 @@ core::DeviceCloud cloud_of(const CloudBuffers& cloud) {
     c.points = external(cloud.points, cloud.points_offset, cloud.points_bytes);
     c.normals = external(cloud.normals, cloud.normals_offset, cloud.normals_bytes);
     c.row_step_bytes = std::size_t(cloud.row_step_bytes);
+    c.color.rgb = external(cloud.color, cloud.color_offset, cloud.color_bytes);
+    c.color.row_step_bytes = std::size_t(cloud.color_row_step_bytes);
     return c;
 }
 
@@ -111,6 +113,8 @@ core::DeviceDepth depth_of(const DepthBuffer& depth) {
     core::DeviceDepth d;
     d.samples = external(depth.samples, depth.offset, depth.bytes);
     d.view = depth.view;
+    d.color.rgb = external(depth.color, depth.color_offset, depth.color_bytes);
+    d.color.row_step_bytes = std::size_t(depth.color_row_step_bytes);
     return d;
 }
 

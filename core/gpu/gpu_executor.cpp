@@ -112,6 +112,13 @@ public:
         device_->upload(Buffer::color, 0, host_color_.data(), 4 * host_color_.size());
     }
 
+    // A device-resident colour image: copied on the device, packed as bind_color packs it.
+    void bind_device_color(const core::DeviceColor& color) override {
+        const size_t row = 3 * size_t(width());
+        const size_t pitch = color.row_step_bytes == 0 ? row : color.row_step_bytes;
+        device_->copy_in(Buffer::color, 0, color.rgb, pitch, row, height());
+    }
+
     void color_edges() override {
         dispatch(Kernel::color_edges, width(), height(),
                  args({height(), plan_.full().offset, uint32_t(plan_.params.color_edge_stride),

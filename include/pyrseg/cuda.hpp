@@ -59,6 +59,11 @@ struct CloudPointers {
     const float* normals = nullptr;  // nullptr: normals are estimated
     std::size_t normals_bytes = 0;
     std::size_t row_step_bytes = 0;
+    // Optional: the colour image registered to the frame, R, G, B bytes packed within each row, rows
+    // color_row_step_bytes apart (0: 3 * width) (the colour edge term, Params::color_edge_threshold).
+    const std::uint8_t* color = nullptr;
+    std::size_t color_bytes = 0;
+    std::size_t color_row_step_bytes = 0;
 };
 
 // A depth image: samples packed within each row from `samples` on; `view` gives everything else (format, size, row
@@ -67,7 +72,10 @@ struct CloudPointers {
 struct DepthPointers {
     const void* samples = nullptr;
     std::size_t bytes = 0;
-    DepthView view;
+    DepthView view;                       // its color pointer must be null too: a colour image goes in `color`
+    const std::uint8_t* color = nullptr;  // optional, as CloudPointers::color
+    std::size_t color_bytes = 0;
+    std::size_t color_row_step_bytes = 0;
 };
 
 // Where the results go: uint32 labels packed within each row, rows row_step_bytes apart (0: 4 * width, else a

@@ -43,6 +43,12 @@ struct CloudBuffers {
     cl_mem normals = nullptr;  // nullptr: normals are estimated
     std::size_t normals_offset = 0;
     std::size_t row_step_bytes = 0;
+    // Optional: the colour image registered to the frame, R, G, B bytes packed within each row, rows
+    // color_row_step_bytes apart (0: 3 * width), from byte color_offset on (the colour edge term,
+    // Params::color_edge_threshold).
+    cl_mem color = nullptr;
+    std::size_t color_offset = 0;
+    std::size_t color_row_step_bytes = 0;
 };
 
 // A depth image in the application's buffer: samples packed within each row from byte `offset` on; `view` gives
@@ -50,7 +56,10 @@ struct CloudBuffers {
 struct DepthBuffer {
     cl_mem samples = nullptr;
     std::size_t offset = 0;
-    DepthView view;
+    DepthView view;          // its color pointer must be null too: a colour image goes in `color`
+    cl_mem color = nullptr;  // optional, as CloudBuffers::color
+    std::size_t color_offset = 0;
+    std::size_t color_row_step_bytes = 0;
 };
 
 // Where the results go: uint32 labels packed within each row (rows row_step_bytes apart; 0: 4 * width) from byte

@@ -67,6 +67,13 @@ struct CloudBuffers {
     VkDeviceSize normals_offset = 0;
     VkDeviceSize normals_bytes = 0;
     VkDeviceSize row_step_bytes = 0;
+    // Optional: the colour image registered to the frame, R, G, B bytes packed within each row, rows
+    // color_row_step_bytes apart (0: 3 * width), from byte color_offset on, in a buffer of color_bytes (the colour
+    // edge term, Params::color_edge_threshold). Any offset and row step.
+    VkBuffer color = VK_NULL_HANDLE;
+    VkDeviceSize color_offset = 0;
+    VkDeviceSize color_bytes = 0;
+    VkDeviceSize color_row_step_bytes = 0;
 };
 
 // A depth image: samples packed within each row from byte `offset` on; `view` gives everything else (format, size,
@@ -76,7 +83,11 @@ struct DepthBuffer {
     VkBuffer samples = VK_NULL_HANDLE;
     VkDeviceSize offset = 0;
     VkDeviceSize bytes = 0;
-    DepthView view;
+    DepthView view;                   // its color pointer must be null too: a colour image goes in `color`
+    VkBuffer color = VK_NULL_HANDLE;  // optional, as CloudBuffers::color
+    VkDeviceSize color_offset = 0;
+    VkDeviceSize color_bytes = 0;
+    VkDeviceSize color_row_step_bytes = 0;
 };
 
 // Where the results go: uint32 labels packed within each row (rows row_step_bytes apart; 0: 4 * width) from byte

@@ -115,6 +115,11 @@ cuda::CloudPointers CudaAdapter::cloud(const CloudFrame& frame) const {
         c.normals_bytes = size(frame.normals.buffer) - frame.normals.offset;
     }
     c.row_step_bytes = frame.row_step_bytes;
+    if (frame.color.buffer != Region::kNone) {
+        c.color = reinterpret_cast<const std::uint8_t*>(pointer(frame.color.buffer) + frame.color.offset);
+        c.color_bytes = size(frame.color.buffer) - frame.color.offset;
+    }
+    c.color_row_step_bytes = frame.color_row_step_bytes;
     return c;
 }
 
@@ -125,6 +130,11 @@ cuda::DepthPointers CudaAdapter::depth(const DepthFrame& frame) const {
         d.bytes = size(frame.samples.buffer) - frame.samples.offset;
     }
     d.view = frame.view;
+    if (frame.color.buffer != Region::kNone) {
+        d.color = reinterpret_cast<const std::uint8_t*>(pointer(frame.color.buffer) + frame.color.offset);
+        d.color_bytes = size(frame.color.buffer) - frame.color.offset;
+    }
+    d.color_row_step_bytes = frame.color_row_step_bytes;
     return d;
 }
 

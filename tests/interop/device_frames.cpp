@@ -282,6 +282,87 @@ TEST_P(DeviceFrames, DepthFramesMatchTheHostPath) {
     }
 }
 
+// Frames with a colour image on the device (the colour edge term, docs/algorithm.md section 2c): packed and in
+// padded rows from an odd offset, a frame without colour between them (nothing of the colour stays), a cloud with
+// colour; each as the CPU's host path segments it.
+TEST_P(DeviceFrames, ColourFramesMatchTheHostPath) {
+    synthetic::SceneOptions o;
+    o.width = 87;
+    o.height = 59;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const int w = o.width;
+    const int h = o.height;
+    const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    std::vector<std::uint16_t> u16(pixels);
+    std::vector<std::uint8_t> rgb(3 * pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        const float z = scene.points[3 * i + 2];
+        u16[i] = std::isfinite(z) ? std::uint16_t(std::lround(z)) : 0;
+        // Each object its own colour, and a stripe across every object: colour edges inside surfaces too.
+        const std::uint32_t id = scene.object_id[i] * 2654435761u + ((i % std::size_t(w)) / 9 % 2 == 0 ? 0x404040u : 0);
+        for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = std::uint8_t(id >> (8 * c));
+    }
+    Params params = sensor_preset(SensorKind::kinect_v1);
+    params.color_edge_threshold = 60;
+    Segmenter cpu(w, h, params, "cpu");
+    DepthView view{u16.data(), DepthFormat::u16, w, h, 0, 0.001, scene.fx, scene.fy, scene.cx, scene.cy};
+    const Result plain = cpu.segment(view);
+    view.color = rgb.data();
+    const Result coloured = cpu.segment(view);
+    ASSERT_FALSE(same_bytes("colour changes the labels", plain.labels, coloured.labels, w));
+    CloudView cloud;
+    cloud.points = scene.points.data();
+    cloud.width = w;
+    cloud.height = h;
+    cloud.color = rgb.data();
+    const Result cloud_coloured = cpu.segment(cloud);
+
+    const std::size_t padded_pitch = 3 * std::size_t(w) + 5;
+    const std::vector<unsigned char> padded = pitched(rgb.data(), w, h, 3, padded_pitch);
+    DepthView device_view = view;
+    device_view.depth = nullptr;
+    device_view.color = nullptr;
+    const Region samples = put(u16.data(), 2 * pixels);
+    DepthFrame packed{samples, device_view, put(rgb.data(), rgb.size()), 0};
+    DepthFrame rows{samples, device_view, put(padded.data(), padded.size(), 3), padded_pitch};
+    DepthFrame none{samples, device_view};
+    CloudFrame cloud_in;
+    cloud_in.points = put(scene.points.data(), 12 * pixels);
+    cloud_in.color = packed.color;
+    const auto out = [&] {
+        LabelFrame l;
+        l.labels = {api().allocate(4 * pixels), 0};
+        return l;
+    };
+    std::vector<Frame> frames = {{packed, out()}, {none, out()}, {rows, out()}, {cloud_in, out()}};
+    const std::vector<const Result*> expected = {&coloured, &plain, &coloured, &cloud_coloured};
+    const char* what[] = {"depth, packed colour", "depth, no colour", "depth, colour rows of 3W+5 from byte 3",
+                          "cloud, packed colour"};
+    Segmenter segmenter = api().make_segmenter(w, h, params);
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        api().run(segmenter, frames, way);
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            SCOPED_TRACE(ways[way].name + ": " + what[i]);
+            EXPECT_TRUE(same_bytes("labels", words(frames[i].out.labels.buffer, 0, pixels), expected[i]->labels, w));
+        }
+    }
+    // A colour image too short for the frame is refused.
+    DepthFrame short_color{samples, device_view, put(rgb.data(), rgb.size() - 1), 0};
+    std::vector<Frame> bad = {{short_color, out()}};
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        try {
+            api().run(segmenter, bad, way);
+            ADD_FAILURE() << ways[way].name << ": a short colour buffer was accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("colour image"), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     Refusals r(api());
     constexpr int kW = Wall::kWidth;

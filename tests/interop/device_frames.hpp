@@ -31,11 +31,15 @@ struct CloudFrame {
     Region points;
     Region normals;  // kNone: normals are estimated
     std::size_t row_step_bytes = 0;
+    Region color = {};  // kNone: no colour image
+    std::size_t color_row_step_bytes = 0;
 };
 
 struct DepthFrame {
     Region samples;
-    DepthView view;  // view.depth stays null: the samples are on the device
+    DepthView view;     // view.depth stays null: the samples are on the device
+    Region color = {};  // kNone: no colour image
+    std::size_t color_row_step_bytes = 0;
 };
 
 struct LabelFrame {

@@ -107,12 +107,13 @@ cl_mem OpenclAdapter::mem(int buffer) const {
 }
 
 opencl::CloudBuffers OpenclAdapter::cloud(const CloudFrame& frame) const {
-    return {mem(frame.points.buffer), frame.points.offset, mem(frame.normals.buffer), frame.normals.offset,
-            frame.row_step_bytes};
+    return {mem(frame.points.buffer), frame.points.offset,     mem(frame.normals.buffer), frame.normals.offset,
+            frame.row_step_bytes,     mem(frame.color.buffer), frame.color.offset,        frame.color_row_step_bytes};
 }
 
 opencl::DepthBuffer OpenclAdapter::depth(const DepthFrame& frame) const {
-    return {mem(frame.samples.buffer), frame.samples.offset, frame.view};
+    return {mem(frame.samples.buffer), frame.samples.offset, frame.view,
+            mem(frame.color.buffer),   frame.color.offset,   frame.color_row_step_bytes};
 }
 
 opencl::LabelBuffers OpenclAdapter::labels(const LabelFrame& frame) const {

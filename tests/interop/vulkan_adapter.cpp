@@ -286,6 +286,12 @@ vulkan::CloudBuffers VulkanAdapter::cloud(const CloudFrame& frame) const {
         c.normals_bytes = buffer(frame.normals.buffer).bytes;
     }
     c.row_step_bytes = frame.row_step_bytes;
+    if (frame.color.buffer != Region::kNone) {
+        c.color = buffer(frame.color.buffer).buffer;
+        c.color_offset = frame.color.offset;
+        c.color_bytes = buffer(frame.color.buffer).bytes;
+    }
+    c.color_row_step_bytes = frame.color_row_step_bytes;
     return c;
 }
 
@@ -297,6 +303,12 @@ vulkan::DepthBuffer VulkanAdapter::depth(const DepthFrame& frame) const {
         d.bytes = buffer(frame.samples.buffer).bytes;
     }
     d.view = frame.view;
+    if (frame.color.buffer != Region::kNone) {
+        d.color = buffer(frame.color.buffer).buffer;
+        d.color_offset = frame.color.offset;
+        d.color_bytes = buffer(frame.color.buffer).bytes;
+    }
+    d.color_row_step_bytes = frame.color_row_step_bytes;
     return d;
 }
 

@@ -208,6 +208,47 @@ TEST_P(NoAllocation, WarmRobustAndDepthFramesAllocateNothing) {
     EXPECT_GT(result.segment_count, 1u);
 }
 
+// Frames with a colour image (the colour edge term), clouds and depth images, with and without colour in turn.
+TEST_P(NoAllocation, WarmColourFramesAllocateNothing) {
+    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
+        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
+                        "no_allocation_without_validation_layer runs this test without it";
+    }
+    synthetic::SceneOptions o;
+    o.width = 160;
+    o.height = 120;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene a = synthetic::generate(o);
+    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
+    std::vector<std::uint8_t> rgb(3 * depth.size());
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = a.points[3 * i + 2];
+        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+        for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = std::uint8_t((a.object_id[i] * 2654435761u) >> (8 * c));
+    }
+    DepthView dv{depth.data(), DepthFormat::u16, o.width, o.height, 0, 0.001, a.fx, a.fy, a.cx, a.cy};
+    dv.color = rgb.data();
+    CloudView cv{a.points.data(), nullptr, o.width, o.height};
+    cv.color = rgb.data();
+    CloudView plain{a.points.data(), nullptr, o.width, o.height};
+    Params params = sensor_preset(SensorKind::kinect_v1);
+    params.color_edge_threshold = 60;
+    Segmenter segmenter(o.width, o.height, params, GetParam());
+    Result result;
+    segmenter.segment(cv, result);
+    segmenter.segment(dv, result);
+    segmenter.segment(plain, result);
+    EXPECT_EQ(allocations_during([&] {
+                  for (int frame = 0; frame < 6; ++frame) {
+                      if (frame % 3 == 0) segmenter.segment(cv, result);
+                      if (frame % 3 == 1) segmenter.segment(dv, result);
+                      if (frame % 3 == 2) segmenter.segment(plain, result);
+                  }
+              }),
+              0);
+    EXPECT_GT(result.segment_count, 1u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, NoAllocation, ::testing::ValuesIn(available()),
                          [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
