@@ -27,7 +27,7 @@ constexpr double kConsumerSecondDifferenceMm = 0.4;
 constexpr double kTrimmedShare = 0.9;  // the share of the smallest second differences averaged
 
 // The robust metric with normal radius 1: the window (R) does the smoothing; and the merge (docs/algorithm.md section
-// 5b) with its defaults: on the real RealSense tabletop frames it finds 9 of 19 objects whole instead of 6 and
+// 5b) with its defaults: on the real RealSense tabletop frames it finds 12 of 21 objects whole instead of 9 and
 // merges none more into the table, and on every consumer sensor model of the synthetic sweep it changes nothing
 // (docs/quality.md). The structured-light scanner's preset keeps it off: on that model it merges 9 more objects.
 struct Robust {

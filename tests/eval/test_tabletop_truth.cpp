@@ -180,6 +180,32 @@ TEST(TabletopTruth, FindsTheTablePlaneAndTheObjectsOnIt) {
     }
 }
 
+// A small table seen from farther up fills less of the frame than the floor around it (as low_table_5 of the shared
+// RealSense frames): the support is still the table, the plane above the floor, and its boxes are the objects.
+TEST(TabletopTruth, ASmallTableAboveAWideFloorIsTheSupport) {
+    Scene scene = tabletop();
+    scene.table_x = 0.3;
+    scene.table_y = 0.7;
+    scene.floor_z = -0.45;
+    scene.boxes.pop_back();
+    const std::vector<Pixel> pixels = render(scene);
+    std::size_t table = 0, floor = 0;
+    for (const Pixel& p : pixels) {
+        table += p.hit == Hit::table;
+        floor += p.hit == Hit::floor;
+    }
+    ASSERT_GT(floor, table) << "the floor fills more of the frame";
+    const auto truth = make_tabletop_truth(kWidth, kHeight, depths(pixels), kCamera);
+    ASSERT_TRUE(truth.found_plane);
+    EXPECT_NEAR(truth.plane.offset, 0.7, 0.0005) << "the table's plane, not the floor's (1.15 m below the eye)";
+    EXPECT_EQ(truth.objects, 2u);
+    // Without the rule (no plane above the first counts), the floor would be the support.
+    pyrseg::eval::TabletopTruthParams first_plane_only;
+    first_plane_only.min_support_share = 2.0;
+    const auto floor_truth = make_tabletop_truth(kWidth, kHeight, depths(pixels), kCamera, first_plane_only);
+    EXPECT_NEAR(floor_truth.plane.offset, 1.15, 0.001);
+}
+
 TEST(TabletopTruth, HolesAndFarPixelsOutsideTheTableAreNotObjects) {
     Scene scene = tabletop();
     // A box standing on the floor behind the table rises above the table's plane, outside its outline.

@@ -155,10 +155,14 @@ SupportPlane refine(const SupportPlane& plane, const Points& p, double tolerance
     return out;
 }
 
-SupportPlane find_plane(const Points& p, const TabletopTruthParams& params, bool* found) {
+// RANSAC over p's valid pixels, then least squares; with `parallel_to`, only hypotheses within
+// params.support_parallel_degrees of parallel to it.
+SupportPlane find_plane(const Points& p, const TabletopTruthParams& params, bool* found,
+                        const SupportPlane* parallel_to = nullptr) {
     *found = false;
     SupportPlane best;
     if (p.valid_pixels.size() < 3) return best;
+    const double min_cosine = std::cos(params.support_parallel_degrees * 3.14159265358979323846 / 180.0);
     // Hypotheses are scored on an even subsample of at most 20,000 valid pixels; the winner on all of them.
     const std::size_t stride = std::max<std::size_t>(1, p.valid_pixels.size() / 20000);
     SplitMix rng{params.seed};
@@ -169,6 +173,7 @@ SupportPlane find_plane(const Points& p, const TabletopTruthParams& params, bool
         const Vec3& c = p.xyz[p.valid_pixels[rng.below(p.valid_pixels.size())]];
         const SupportPlane h = plane_through(a, b, c);
         if (h.normal == Vec3{0, 0, 0}) continue;
+        if (parallel_to != nullptr && std::abs(dot(h.normal, parallel_to->normal)) < min_cosine) continue;
         std::uint64_t score = 0;
         for (std::size_t j = 0; j < p.valid_pixels.size(); j += stride) {
             score += std::abs(height_above(h, p.xyz[p.valid_pixels[j]])) <= params.plane_tolerance;
@@ -182,6 +187,32 @@ SupportPlane find_plane(const Points& p, const TabletopTruthParams& params, bool
     *found = true;
     for (int round = 0; round < 3; ++round) best = refine(best, p, params.plane_tolerance);
     return best;
+}
+
+// The support: the plane RANSAC finds first; then, as long as the points above it hold a plane parallel to it with at
+// least params.min_support_share of the frame's valid pixels, that plane: a table stands above the floor it is on,
+// and may fill less of the frame than the floor around it.
+SupportPlane find_support(const Points& p, const TabletopTruthParams& params, bool* found) {
+    SupportPlane support = find_plane(p, params, found);
+    if (!*found) return support;
+    const double min_inliers = params.min_support_share * double(p.valid_pixels.size());
+    Points above = p;
+    for (int level = 0; level < 4; ++level) {
+        above.valid_pixels.clear();
+        for (const std::size_t i : p.valid_pixels) {
+            if (height_above(support, p.xyz[i]) > params.plane_tolerance) above.valid_pixels.push_back(i);
+        }
+        if (double(above.valid_pixels.size()) < min_inliers) break;
+        bool higher_found = false;
+        const SupportPlane higher = find_plane(above, params, &higher_found, &support);
+        if (!higher_found || double(higher.inliers) < min_inliers ||
+            std::abs(dot(higher.normal, support.normal)) <
+                std::cos(params.support_parallel_degrees * 3.14159265358979323846 / 180.0)) {
+            break;
+        }
+        support = refine(higher, p, params.plane_tolerance);
+    }
+    return support;
 }
 
 // 4-connected components of the pixels `member` admits, joined where `joins(i, j)` holds for neighbours i, j; each
@@ -272,7 +303,7 @@ TabletopTruth make_tabletop_truth(int width, int height, std::span<const float> 
     TabletopTruth truth;
     truth.labels.assign(depth.size(), kTruthNone);
     const Points p = back_project(width, height, depth, camera);
-    truth.plane = find_plane(p, params, &truth.found_plane);
+    truth.plane = find_support(p, params, &truth.found_plane);
     if (!truth.found_plane) return truth;
     const SupportPlane& plane = truth.plane;
     const auto height_of = [&](std::size_t i) { return height_above(plane, p.xyz[i]); };

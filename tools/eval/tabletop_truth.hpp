@@ -1,9 +1,10 @@
 #pragma once
 // A ground truth for a real tabletop depth frame, made from the depth the way the OCID dataset was annotated
-// (docs/quality.md, "Real frames"): the support plane (RANSAC, refined by least squares); the table = the plane's
-// inliers in their largest image component; the objects = the pixels that stand min_height..max_height above the
-// plane and project into the table's outline on it (the convex hull of the table's points in the plane), split into
-// depth-continuous components of at least min_object_pixels pixels. Touching objects stay one object.
+// (docs/quality.md, "Real frames"): the support plane (RANSAC, refined by least squares; the highest such plane
+// parallel to the first with at least a tenth of the valid pixels, so that a table wins over the floor); the table =
+// the plane's inliers in their largest image component; the objects = the pixels that stand min_height..max_height
+// above the plane and project into the table's outline on it (the convex hull of the table's points in the plane),
+// split into depth-continuous components of at least min_object_pixels pixels. Touching objects stay one object.
 //
 // Deterministic: the RANSAC samples come from a seeded generator of its own, so a frame always gets the same truth.
 // Plain C++, no dependency on the library (the frame is a depth array in metres and the pinhole intrinsics).
@@ -30,6 +31,10 @@ struct TabletopTruthParams {
     double step_growth = 0.02;
     std::uint32_t min_object_pixels = 300;
     std::uint32_t ransac_iterations = 400;
+    // The support is the highest plane parallel to the first one found (within support_parallel_degrees) that holds
+    // at least min_support_share of the valid pixels: a table above the floor it stands on.
+    double min_support_share = 0.1;
+    double support_parallel_degrees = 10.0;
     std::uint64_t seed = 1;
 };
 
