@@ -49,7 +49,8 @@ const char* const kParameterHelp =
     "  --merge-min-crossings C   a boundary shorter than C crossings never joins (default 16).\n"
     "  --merge-max-bad S     the share of a boundary's crossings that may be concave or steps (0..1, default 0.05).\n"
     "  --color-edge-threshold T   with a colour image (--color), a pixel whose neighbours along its row or column\n"
-    "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (765: colour unused).\n"
+    "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (default and every\n"
+    "                        preset: 765, the colour unused).\n"
     "  --color-edge-stride S those neighbours lie S pixels either side of it (1..16, default 1).\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
