@@ -76,10 +76,10 @@ inline const SceneMask& scene_mask(int width, int height) {
 // limit) is reported as skipped with its reason.
 template <class Frame>
 void time_frames(benchmark::State& state, const std::string& backend, int width, int height, std::size_t input_bytes,
-                 const Frame& frame, const Params& params = {}) {
+                 const Frame& frame, const Params& params = {}, const Outputs& outputs = {}) {
     std::unique_ptr<Segmenter> segmenter;
     try {
-        segmenter = std::make_unique<Segmenter>(width, height, params, backend);
+        segmenter = std::make_unique<Segmenter>(width, height, params, backend, outputs);
     } catch (const Error& e) {
         state.SkipWithError(e.what());
         return;

@@ -1,11 +1,11 @@
 // pyrseg per backend: the whole pipeline (and, as pipeline_depth, from a uint16 depth image back-projected on the
 // device) (with the paper's metric, and as pipeline_robust with the robust metric of
 // the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
-// pipeline_robust_merge with the preset's merge, and as pipeline_robust_merge_color with a colour image and the
-// colour edge term as well) (points, with estimated or given normals,
-// to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame size,
-// next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers, carry
-// between machines.
+// pipeline_robust_merge with the preset's merge, as pipeline_robust_merge_stats with the segment statistics, and as
+// pipeline_robust_merge_color with a colour image and the colour edge term as well) (points, with estimated or given
+// normals, to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame
+// size, next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers,
+// carry between machines.
 //   pyrseg_bench --benchmark_filter=2064          full PhoXi frames only
 //   pyrseg_bench --benchmark_format=json > b.json && pyrseg_bench_summary b.json   ratio tables and a plot
 #include <benchmark/benchmark.h>
@@ -26,12 +26,12 @@ namespace pyrseg::bench {
 namespace {
 
 void pipeline(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals,
-              const Params& params = {}) {
+              const Params& params = {}, const Outputs& outputs = {}) {
     const synthetic::Scene& s = scene(width, height);
     const CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
     time_frames(
         state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
-        [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params);
+        [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params, outputs);
 }
 
 // A colour image for the scene: each object its own colour, stripes across every other object (colour edges inside
@@ -152,6 +152,15 @@ int register_all() {
                 const Params merged = sensor_preset(SensorKind::kinect_v1);
                 benchmark::RegisterBenchmark(("pipeline_robust_merge/" + b.name + "/" + suffix).c_str(),
                                              [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // And with the segment statistics (section 10: moments, plane and box fits): the difference to
+                // pipeline_robust_merge is what they cost.
+                Outputs stats;
+                stats.segment_stats = true;
+                benchmark::RegisterBenchmark(
+                    ("pipeline_robust_merge_stats/" + b.name + "/" + suffix).c_str(),
+                    [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, stats); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
                 // And with a colour image and the colour edge term (step 0c): the difference to

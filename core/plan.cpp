@@ -78,6 +78,17 @@ void check_color_parameters(const Params& p) {
     }
 }
 
+void check_planar_parameters(const Params& p) {
+    if (!std::isfinite(p.planar_tolerance_mm) || p.planar_tolerance_mm < 0.0) {
+        bad_parameter("planar_tolerance_mm must be a finite number of millimetres >= 0, got " +
+                      std::to_string(p.planar_tolerance_mm));
+    }
+    if (!std::isfinite(p.planar_tolerance_per_m2) || p.planar_tolerance_per_m2 < 0.0) {
+        bad_parameter("planar_tolerance_per_m2 must be a finite number of millimetres per square metre >= 0, got " +
+                      std::to_string(p.planar_tolerance_per_m2));
+    }
+}
+
 void check_merge_parameters(const Params& p, Thresholds& t) {
     if (p.merge_reach < 1 || p.merge_reach > kMaxMergeReach) {
         bad_parameter("merge_reach must be in 1.." + std::to_string(kMaxMergeReach) + " pixels, got " +
@@ -155,6 +166,7 @@ Thresholds compute_thresholds(const Params& params) {
     }
     check_merge_parameters(params, t);
     check_color_parameters(params);
+    check_planar_parameters(params);
     return t;
 }
 
@@ -246,6 +258,10 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         // K <= w_M * h_M; the fallback's labels are pixels.
         const PyrLevel& lm = plan.small_image ? plan.full() : plan.level(m);
         plan.stats_slots = lm.width * lm.height;
+        if (std::uint64_t(plan.lut_size()) + std::uint64_t(plan.stats_slots) * PYR_STATS_WORDS > kMax32) {
+            throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                        " is too large for the statistics' 32-bit word indices");
+        }
         plan.stats_point_shift = stats_point_shift(params.unit_mm);
     }
     return plan;

@@ -9,7 +9,9 @@
  *    shared code can shadow a buffer an accessor macro refers to; shared code avoids the keywords of all four
  *    languages (OpenCL C: local, global, constant, private, kernel; GLSL: input, output, sample, filter, ...);
  *  - no bool in structs, no recursion, no overloading, integer literals with a u suffix where unsigned;
- *  - float expressions that decide a result are PYR_PRECISE (GLSL `precise`; contraction is off elsewhere).
+ *  - float expressions that decide a result are PYR_PRECISE (GLSL `precise`; contraction is off elsewhere);
+ *  - no 64-bit integer types (GLSL has none without an extension): a wide product is PYR_U32(a) * PYR_U32(b) for
+ *    its low word and PYR_MUL_HI_I32(a, b) for the high word of the signed product.
  */
 #ifndef PYR_SHIM_H
 #define PYR_SHIM_H
@@ -30,6 +32,13 @@
 #define PYR_MSB(u) findMSB(u)
 #define PYR_PRECISE precise
 #define PYR_TYPEDEF(name)
+#define PYR_MUL_HI_I32(a, b) pyr_glsl_mul_hi(a, b)
+int pyr_glsl_mul_hi(int a, int b) {
+    int hi;
+    int lo;
+    imulExtended(a, b, hi, lo);
+    return hi;
+}
 
 #elif defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)
 #pragma OPENCL FP_CONTRACT OFF
@@ -48,6 +57,7 @@
 #define PYR_MSB(u) (31 - (int)clz((uint)(u)))
 #define PYR_PRECISE
 #define PYR_TYPEDEF(name) typedef struct name name;
+#define PYR_MUL_HI_I32(a, b) mul_hi((int)(a), (int)(b))
 
 #elif defined(__CUDACC__)
 #define PYR_FN static __host__ __device__ __forceinline__
@@ -72,6 +82,8 @@
 #define PYR_SQRT(f) sqrtf(f)
 #define PYR_PRECISE
 #define PYR_TYPEDEF(name)
+#define PYR_MUL_HI_I32(a, b) \
+    static_cast<int>((static_cast<long long>(a) * static_cast<long long>(b)) >> 32)
 /* Atomics for accessor macros: shared functions are __host__ __device__, and CUDA's atomics are device-only. */
 #ifdef __CUDA_ARCH__
 #define pyr_cuda_atomic_add(p, v) atomicAdd((p), (v))
@@ -124,6 +136,8 @@ static inline unsigned int pyr_cuda_host_atomic_min(unsigned int* p, unsigned in
 #define PYR_MSB(u) (static_cast<std::int32_t>(std::bit_width(static_cast<std::uint32_t>(u))) - 1)
 #define PYR_PRECISE
 #define PYR_TYPEDEF(name)
+#define PYR_MUL_HI_I32(a, b) \
+    static_cast<std::int32_t>((static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b)) >> 32)
 #endif
 
 #endif /* PYR_SHIM_H */

@@ -91,7 +91,7 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 /* Per-segment statistics (docs/algorithm.md section 10): one slot of PYR_STATS_WORDS uint32 words per compacted
  * label, slot K-1 for label K, zeroed before the pass. Bounding-box minima are kept as the maximum of their
  * complement, so that zero is the neutral start of every word and the pass needs only atomic add and max. Sums
- * are 64-bit two's complement in two words, low word first. */
+ * are 64-bit two's complement in two words (96-bit in three for the products), low word first. */
 #define PYR_STATS_COUNT 0u
 #define PYR_STATS_NOT_X_MIN 1u
 #define PYR_STATS_NOT_Y_MIN 2u
@@ -100,7 +100,14 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 #define PYR_STATS_RAW_LABEL 5u
 #define PYR_STATS_POINT_SUM 6u   /* x, y, z: 6 words, sums of rint(p * 2^point_shift) */
 #define PYR_STATS_NORMAL_SUM 12u /* x, y, z: 6 words, sums of qn */
-#define PYR_STATS_WORDS 18u
+/* The fixed-point z's range, as the maxima of its order-preserving key (the int32's bits with the sign bit
+ * flipped) and of the key's complement. */
+#define PYR_STATS_Z_KEY_MAX 18u
+#define PYR_STATS_NOT_Z_KEY_MIN 19u
+/* xx, xy, xz, yy, yz, zz: 18 words, sums of the products of the fixed-point coordinates, each 96-bit two's
+ * complement in three words (a product is below 2^62 in magnitude, a frame has fewer than 2^32 pixels). */
+#define PYR_STATS_PRODUCT_SUM 20u
+#define PYR_STATS_WORDS 38u
 
 /* The merge's pair table on GPUs (shaders/pyr_merge_table.h): words per slot. */
 #define PYR_MERGE_SLOT_WORDS 4u

@@ -52,6 +52,8 @@ const char* const kParameterHelp =
     "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (default and every\n"
     "                        preset: 765, the colour unused).\n"
     "  --color-edge-stride S those neighbours lie S pixels either side of it (1..16, default 1).\n"
+    "  --planar-tolerance MM a segment is planar (--stats) when its points lie within MM RMS of their plane\n"
+    "                        (default 2 mm), plus --planar-tolerance-per-m2 MM per square metre of depth.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const std::set<std::string> kParameterValueOptions = {"ct",
@@ -73,7 +75,9 @@ const std::set<std::string> kParameterValueOptions = {"ct",
                                                       "merge-min-crossings",
                                                       "merge-max-bad",
                                                       "color-edge-threshold",
-                                                      "color-edge-stride"};
+                                                      "color-edge-stride",
+                                                      "planar-tolerance",
+                                                      "planar-tolerance-per-m2"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw", "merge", "no-merge"};
 
 std::optional<SensorChoice> parse_sensor(const Args& args) {
@@ -124,6 +128,8 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("merge-max-bad")) p.merge_max_bad_share = *v;
     if (auto v = args.integer("color-edge-threshold")) p.color_edge_threshold = *v;
     if (auto v = args.integer("color-edge-stride")) p.color_edge_stride = *v;
+    if (auto v = args.number("planar-tolerance")) p.planar_tolerance_mm = *v;
+    if (auto v = args.number("planar-tolerance-per-m2")) p.planar_tolerance_per_m2 = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

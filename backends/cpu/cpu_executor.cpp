@@ -1,5 +1,5 @@
-// The executor's buffers (allocated once per Segmenter, none per frame), the pyramid's passes (mip and label init)
-// and the per-segment statistics.
+// The executor's buffers (allocated once per Segmenter, none per frame) and the pyramid's passes (mip and label
+// init).
 #include "backends/cpu/cpu_executor.hpp"
 
 #include <algorithm>
@@ -94,18 +94,6 @@ void CpuExecutor::init_row(const PassContext& c, const PyrLevel& lv, const PyrLe
                            uint32_t mode) {
     uint32_t* out = labels_.data() + lv.offset + size_t(y) * lv.width;
     for (uint32_t x = 0; x < lv.width; ++x) out[x] = pixel::pyr_label_init_texel(c, lv, parent, x, y, mode);
-}
-
-// Rows in parallel, each in one run: a row adds each stretch of equal labels to its slot at once.
-void CpuExecutor::segment_stats() {
-    std::fill_n(stats_.begin(), std::min(stats_.size(), size_t(segment_count_) * PYR_STATS_WORDS), 0u);
-    const PassContext c = context();
-    const PyrLevel full = plan_.full();
-    const uint32_t with_points = from_mask_ ? 0u : 1u;
-    const float scale = plan_.stats_point_scale();
-    rows(full.height, [&](size_t y) {
-        pixel::pyr_stats_row_run(c, full, uint32_t(y), 0u, full.width, with_points, scale, 0u, plan_.stats_slots);
-    });
 }
 
 }  // namespace pyrseg::cpu

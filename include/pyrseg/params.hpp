@@ -51,7 +51,12 @@ struct Params {
     // differ by more than color_edge_threshold, the sum of the absolute differences of R, G and B (0..765; 765
     // ignores the colour).
     int color_edge_threshold = 765;
-    int color_edge_stride = 1;                 // 1..16
+    int color_edge_stride = 1;  // 1..16
+    // Segment statistics (docs/algorithm.md section 10b): a segment is planar when its points' RMS distance to their
+    // least-squares plane is at most planar_tolerance_mm + planar_tolerance_per_m2 * z_m^2 millimetres (z_m: its
+    // centroid's depth in metres). Only the `planar` flag reads them.
+    double planar_tolerance_mm = 2.0;
+    double planar_tolerance_per_m2 = 0.0;
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
     Metric metric = Metric::paper;

@@ -14,6 +14,13 @@ struct Outputs {
     bool segment_stats = false;  // per-segment statistics (Result::segments), a pass of every backend
 };
 
+// A 128-bit two's-complement integer, high * 2^64 + low: an exact sum too wide for 64 bits.
+struct WideSum {
+    std::uint64_t low = 0;
+    std::int64_t high = 0;
+    friend bool operator==(const WideSum&, const WideSum&) = default;
+};
+
 // One segment's statistics (docs/algorithm.md section 10). Every backend computes the integer fields with the same
 // exact arithmetic, so they agree bit for bit; the double fields are derived from them on the host.
 struct SegmentStats {
@@ -25,10 +32,31 @@ struct SegmentStats {
     std::array<std::int64_t, 3> point_sum{};
     std::array<std::int64_t, 3> normal_sum{};
     int point_shift = 0;  // the fixed point's binary exponent, from Params::unit_mm (steps of 1/16 mm or finer)
-    // Derived: the 3D centroid (mean point, the caller's units) and the unit mean normal (normal_sum normalised;
-    // zero when it is zero). NaN when the frame was a caller's mask, which has no points.
+    // The second moments, exact: sums of the products of the fixed-point coordinates xx, xy, xz, yy, yz, zz (units
+    // of 2^(-2 point_shift)). And the least and greatest fixed-point z. Zero for a mask.
+    std::array<WideSum, 6> point_product_sum{};
+    std::int32_t z_fixed_min = 0;
+    std::int32_t z_fixed_max = 0;
+    // Derived on the host (docs/algorithm.md section 10b). NaN when the frame was a caller's mask, which has no
+    // points. The 3D centroid (mean point, the caller's units) and the unit mean normal (normal_sum normalised;
+    // zero when it is zero).
     std::array<double, 3> centroid{};
     std::array<double, 3> mean_normal{};
+    std::array<double, 6> covariance{};  // xx, xy, xz, yy, yz, zz: the points' covariance, the caller's units squared
+    double z_min = 0, z_max = 0;         // the depth range (the caller's units)
+    // The least-squares plane: plane_normal . p + plane_offset = 0, the unit normal towards the camera (at the
+    // origin); plane_rms the points' RMS distance to it; curvature the smallest eigenvalue of the covariance over the
+    // sum of the three (0 flat .. 1/3 isotropic).
+    std::array<double, 3> plane_normal{};
+    double plane_offset = 0;
+    double plane_rms = 0;
+    double curvature = 0;
+    // The oriented box: centred on the centroid, rows of `axes` the principal axes by decreasing variance (a
+    // right-handed frame whose third axis is plane_normal), `extents` its side lengths along them, 2 sqrt(3 lambda)
+    // (the width of a uniform distribution with the segment's variance lambda along that axis).
+    std::array<std::array<double, 3>, 3> axes{};
+    std::array<double, 3> extents{};
+    bool planar = false;  // plane_rms within the frame's planar tolerance (section 10b); false for a mask
 };
 
 struct Result {

@@ -123,6 +123,10 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.color_edge_threshold = whole();
     } else if (key == "color_edge_stride") {
         p.color_edge_stride = whole();
+    } else if (key == "planar_tolerance_mm") {
+        p.planar_tolerance_mm = number(kInit, name, v);
+    } else if (key == "planar_tolerance_per_m2") {
+        p.planar_tolerance_per_m2 = number(kInit, name, v);
     } else {
         return false;
     }
@@ -177,7 +181,8 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
                                  "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
                                  "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
-                                 "color_edge_threshold, color_edge_stride; and preset, "
+                                 "color_edge_threshold, color_edge_stride, planar_tolerance_mm, "
+                                 "planar_tolerance_per_m2; and preset, "
                                  "outputs, cuda_stream");
         }
     }
@@ -543,14 +548,35 @@ py::object stats_dtype() {
     field("point_sum", "(3,)<i8", offsetof(SegmentStats, point_sum));
     field("normal_sum", "(3,)<i8", offsetof(SegmentStats, normal_sum));
     field("point_shift", "<i4", offsetof(SegmentStats, point_shift));
+    // Each exact 128-bit sum as its two halves, value = high * 2**64 + low.
+    static_assert(sizeof(WideSum) == 16 && offsetof(WideSum, high) == 8);
+    const py::object np = py::module_::import("numpy");
+    py::list wide_fields;
+    wide_fields.append(py::make_tuple("low", "<u8"));
+    wide_fields.append(py::make_tuple("high", "<i8"));
+    names.append("point_product_sum");
+    formats.append(np.attr("dtype")(py::make_tuple(np.attr("dtype")(wide_fields), py::make_tuple(6))));
+    offsets.append(offsetof(SegmentStats, point_product_sum));
+    field("z_fixed_min", "<i4", offsetof(SegmentStats, z_fixed_min));
+    field("z_fixed_max", "<i4", offsetof(SegmentStats, z_fixed_max));
     field("centroid", "(3,)<f8", offsetof(SegmentStats, centroid));
     field("mean_normal", "(3,)<f8", offsetof(SegmentStats, mean_normal));
+    field("covariance", "(6,)<f8", offsetof(SegmentStats, covariance));
+    field("z_min", "<f8", offsetof(SegmentStats, z_min));
+    field("z_max", "<f8", offsetof(SegmentStats, z_max));
+    field("plane_normal", "(3,)<f8", offsetof(SegmentStats, plane_normal));
+    field("plane_offset", "<f8", offsetof(SegmentStats, plane_offset));
+    field("plane_rms", "<f8", offsetof(SegmentStats, plane_rms));
+    field("curvature", "<f8", offsetof(SegmentStats, curvature));
+    field("axes", "(3,3)<f8", offsetof(SegmentStats, axes));
+    field("extents", "(3,)<f8", offsetof(SegmentStats, extents));
+    field("planar", "?", offsetof(SegmentStats, planar));
     py::dict spec;
     spec["names"] = names;
     spec["formats"] = formats;
     spec["offsets"] = offsets;
     spec["itemsize"] = sizeof(SegmentStats);
-    return py::module_::import("numpy").attr("dtype")(spec);
+    return np.attr("dtype")(spec);
 }
 
 py::list backends() {
@@ -618,7 +644,8 @@ params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
 merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride (the colour edge term on frames
-given color=) (docs/algorithm.md).
+given color=); planar_tolerance_mm, planar_tolerance_per_m2 (when a segment's statistics call it planar)
+(docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
@@ -812,6 +839,8 @@ py::dict params_to_dict(const Params& p) {
     d["merge_max_bad_share"] = p.merge_max_bad_share;
     d["color_edge_threshold"] = p.color_edge_threshold;
     d["color_edge_stride"] = p.color_edge_stride;
+    d["planar_tolerance_mm"] = p.planar_tolerance_mm;
+    d["planar_tolerance_per_m2"] = p.planar_tolerance_per_m2;
     return d;
 }
 

@@ -225,6 +225,10 @@ TEST_P(FarPoints, SaturateInTheStatisticsLikeTheReference) {
     ASSERT_TRUE(ref.ok);
     ASSERT_EQ(ref.segments.size(), 1u);
     ASSERT_EQ(ref.segments[0].point_sum[2], std::int64_t(2147483520) * w * h) << "z must saturate";
+    ASSERT_GT(ref.segments[0].product_sum[5], pyrseg_ref::Int128(std::numeric_limits<std::int64_t>::max()))
+        << "the sum of z * z must need more than 64 bits";
+    ASSERT_LT(ref.segments[0].product_sum[2], pyrseg_ref::Int128(std::numeric_limits<std::int64_t>::min()))
+        << "the sum of x * z must be negative and need more than 64 bits";
     expect_conformance(GetParam(), points.data(), normals.data(), w, h, {});
 }
 

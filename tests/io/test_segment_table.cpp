@@ -25,6 +25,15 @@ std::vector<SegmentStats> two_segments() {
     a.y_max = 61;
     a.centroid = {-12.5, 0.1, 1234.0625};
     a.mean_normal = {0.0, 0.6, -0.8};
+    a.z_min = 1200;
+    a.z_max = 1300.5;
+    a.plane_normal = {0.0, 0.6, -0.8};
+    a.plane_offset = 987.25;
+    a.plane_rms = 0.5;
+    a.curvature = 0.001;
+    a.planar = true;
+    a.axes = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    a.extents = {40, 30, 2};
     SegmentStats b = a;
     b.label = 7;
     b.pixel_count = 1;
@@ -56,6 +65,15 @@ TEST(SegmentTable, JsonReadsBackExactly) {
     EXPECT_EQ(b["bbox"], nlohmann::json({3, 4, 50, 61}));
     EXPECT_EQ(b["centroid"][0].get<double>(), 1.0 / 3.0) << "doubles are written to round-trip";
     EXPECT_EQ(b["mean_normal"][2].get<double>(), -0.8);
+    EXPECT_EQ(b["depth_range"], nlohmann::json({1200.0, 1300.5}));
+    EXPECT_EQ(b["plane"]["normal"], nlohmann::json({0.0, 0.6, -0.8}));
+    EXPECT_EQ(b["plane"]["offset"].get<double>(), 987.25);
+    EXPECT_EQ(b["plane"]["rms"].get<double>(), 0.5);
+    EXPECT_EQ(b["plane"]["curvature"].get<double>(), 0.001);
+    EXPECT_EQ(b["plane"]["planar"], true);
+    EXPECT_EQ(b["box"]["centre"][0].get<double>(), 1.0 / 3.0);
+    EXPECT_EQ(b["box"]["axes"][1], nlohmann::json({0.0, 1.0, 0.0}));
+    EXPECT_EQ(b["box"]["extents"], nlohmann::json({40.0, 30.0, 2.0}));
 }
 
 TEST(SegmentTable, CsvHasAHeaderAndOneLinePerSegment) {
@@ -68,8 +86,12 @@ TEST(SegmentTable, CsvHasAHeaderAndOneLinePerSegment) {
     while (std::getline(text, line)) lines.push_back(line);
     ASSERT_EQ(lines.size(), 3u);
     EXPECT_EQ(lines[0],
-              "label,pixel_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z");
-    EXPECT_EQ(lines[1], "1,1200,3,4,50,61,-12.5,0.1,1234.0625,0.0,0.6,-0.8");
+              "label,pixel_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z,"
+              "z_min,z_max,plane_nx,plane_ny,plane_nz,plane_offset,plane_rms,curvature,planar,"
+              "axis0_x,axis0_y,axis0_z,axis1_x,axis1_y,axis1_z,axis2_x,axis2_y,axis2_z,extent0,extent1,extent2");
+    EXPECT_EQ(lines[1],
+              "1,1200,3,4,50,61,-12.5,0.1,1234.0625,0.0,0.6,-0.8,1200.0,1300.5,0.0,0.6,-0.8,987.25,0.5,0.001,1,"
+              "1.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,1.0,40.0,30.0,2.0");
 }
 
 TEST(SegmentTable, AMasksMissingGeometryIsEmptyInCsvAndNullInJson) {
@@ -77,11 +99,20 @@ TEST(SegmentTable, AMasksMissingGeometryIsEmptyInCsvAndNullInJson) {
     std::vector<SegmentStats> segments = two_segments();
     for (double& v : segments[0].centroid) v = std::numeric_limits<double>::quiet_NaN();
     for (double& v : segments[0].mean_normal) v = std::numeric_limits<double>::quiet_NaN();
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    segments[0].z_min = segments[0].z_max = segments[0].plane_offset = kNaN;
+    segments[0].plane_rms = segments[0].curvature = kNaN;
+    segments[0].planar = false;
+    segments[0].plane_normal.fill(kNaN);
+    for (auto& axis : segments[0].axes) axis.fill(kNaN);
+    segments[0].extents.fill(kNaN);
     write_segment_stats(dir.path() / "m.csv", segments, SegmentTable{});
     write_segment_stats(dir.path() / "m.json", segments, SegmentTable{});
-    EXPECT_NE(slurp(dir.path() / "m.csv").find("1,1200,3,4,50,61,,,,,,\n"), std::string::npos);
+    EXPECT_NE(slurp(dir.path() / "m.csv").find("1,1200,3,4,50,61" + std::string(27, ',') + "\n"), std::string::npos);
     const nlohmann::json doc = nlohmann::json::parse(slurp(dir.path() / "m.json"));
     EXPECT_TRUE(doc["segments"][0]["centroid"][1].is_null());
+    EXPECT_TRUE(doc["segments"][0]["plane"]["rms"].is_null());
+    EXPECT_TRUE(doc["segments"][0]["box"]["extents"][2].is_null());
 }
 
 TEST(SegmentTable, AnUnwritablePathIsAnErrorNamingIt) {

@@ -130,6 +130,33 @@ def test_outputs_and_statistics(scene):
         assert abs(np.linalg.norm(row["mean_normal"]) - 1) < 1e-6
 
 
+def test_segment_geometry_matches_numpy(scene):
+    # The covariance, plane and box (docs/algorithm.md section 10b) against numpy on the labelled points.
+    h, w, _ = scene.points.shape
+    r = pyrseg.Segmenter(w, h, "cpu", outputs=("segment_stats",)).segment(scene.points)
+    s = r.segments
+    assert r.segment_count > 3
+    for row in s[np.argsort(s["pixel_count"])[::-1][:4]]:
+        ys, xs = np.nonzero(r.labels == row["label"])
+        pts = scene.points[ys, xs].astype(np.float64)
+        cov = np.cov(pts.T, bias=True)
+        got = row["covariance"]
+        full = np.array([[got[0], got[1], got[2]], [got[1], got[3], got[4]], [got[2], got[4], got[5]]])
+        np.testing.assert_allclose(full, cov, atol=np.sqrt(np.trace(cov)) / 16 + 1 / 128)
+        assert row["z_min"] == pytest.approx(pts[:, 2].min(), abs=1 / 32)
+        assert row["z_max"] == pytest.approx(pts[:, 2].max(), abs=1 / 32)
+        values, vectors = np.linalg.eigh(cov)
+        assert abs(np.dot(row["plane_normal"], vectors[:, 0])) == pytest.approx(1, abs=1e-4)
+        assert np.dot(row["plane_normal"], row["centroid"]) < 0, "the normal faces the camera"
+        assert row["plane_rms"] == pytest.approx(np.sqrt(max(values[0], 0)), abs=0.05)
+        np.testing.assert_allclose(row["axes"] @ row["axes"].T, np.eye(3), atol=1e-9)
+        np.testing.assert_allclose(row["extents"], 2 * np.sqrt(3 * np.maximum(values[::-1], 0)), rtol=1e-3, atol=0.05)
+        assert bool(row["planar"]) == (row["plane_rms"] <= 2.0)
+        wide = [int(v["high"]) * 2**64 + int(v["low"]) for v in row["point_product_sum"]]
+        fixed = np.rint(pts * 2.0 ** row["point_shift"]).astype(np.int64)
+        assert wide[5] == sum(int(z) * int(z) for z in fixed[:, 2]), "the exact sum of z * z"
+
+
 def test_params_presets_and_errors(scene):
     h, w, _ = scene.points.shape
     assert set(pyrseg.presets()) == {"structured-light", "kinect-v1", "realsense-d435", "azure-kinect"}

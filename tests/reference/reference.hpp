@@ -48,6 +48,9 @@ struct Params {
     int color_edge_stride = 1;       // s, 1..16
 };
 
+// Exact sums of products (a product of two fixed-point coordinates is below 2^62 in magnitude).
+__extension__ typedef __int128 Int128;
+
 // One segment's statistics (docs/algorithm.md section 10), in compacted order: exact integer sums.
 struct Segment {
     std::uint32_t label = 0;  // as in Output::labels
@@ -56,6 +59,9 @@ struct Segment {
     std::int64_t point_sum[3] = {0, 0, 0};   // sum of rint(clamp(p * 2^point_shift)), zero for a mask
     std::int64_t normal_sum[3] = {0, 0, 0};  // sum of qn, zero for a mask
     int point_shift = 0;
+    // Sums of the products of the fixed-point coordinates (xx, xy, xz, yy, yz, zz), exact; zero for a mask.
+    Int128 product_sum[6] = {0, 0, 0, 0, 0, 0};
+    std::int64_t z_fixed_min = 0, z_fixed_max = 0;  // the fixed-point z's range; zero for a mask
 };
 
 struct Output {

@@ -110,6 +110,23 @@ inline ::testing::AssertionResult same_segments(const std::vector<SegmentStats>&
             if (a.point_sum[c] != e.point_sum[c]) return differ("point_sum", a.point_sum[c], e.point_sum[c]);
             if (a.normal_sum[c] != e.normal_sum[c]) return differ("normal_sum", a.normal_sum[c], e.normal_sum[c]);
         }
+        for (std::size_t i = 0; i < 6; ++i) {
+            const pyrseg_ref::Int128 got =
+                static_cast<pyrseg_ref::Int128>(a.point_product_sum[i].high) * (pyrseg_ref::Int128(1) << 64) +
+                static_cast<pyrseg_ref::Int128>(a.point_product_sum[i].low);
+            if (got != e.product_sum[i]) {
+                return differ("point_product_sum",
+                              std::to_string(i) + ": high word " + std::to_string(a.point_product_sum[i].high),
+                              "high word " + std::to_string(static_cast<std::int64_t>(e.product_sum[i] >> 64)) +
+                                  ", low words differ by " +
+                                  std::to_string(static_cast<std::int64_t>(
+                                      static_cast<std::uint64_t>(got) - static_cast<std::uint64_t>(e.product_sum[i]))));
+            }
+        }
+        if (a.z_fixed_min != e.z_fixed_min || a.z_fixed_max != e.z_fixed_max) {
+            return differ("z range", std::to_string(a.z_fixed_min) + ".." + std::to_string(a.z_fixed_max),
+                          std::to_string(e.z_fixed_min) + ".." + std::to_string(e.z_fixed_max));
+        }
     }
     return ::testing::AssertionSuccess();
 }
