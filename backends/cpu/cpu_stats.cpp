@@ -1,13 +1,16 @@
 // The per-segment statistics pass (docs/algorithm.md section 10) on the CPU: rows in parallel, each stretch of equal
-// labels summed in native 64-bit and 128-bit integers and added to its slot's words at once, with the shared
+// labels summed in native 64-bit and 128-bit integers (whole vectors of it by the target's stats_sums) and added
+// to its slot's words at once, with the shared
 // dialect's word arithmetic (shaders/pyr_stats.h: pyr_stats_flush), so the words are those of every other backend.
 // Sums of integers do not depend on how they are grouped, so summing a stretch in wide native integers instead of
 // the shader's 32-bit words changes nothing but the time. PYRSEG_CPU_SIMD=scalar runs the shared row function
 // itself (pyr_stats_row_run), which the conformance suite compares with this one.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 #include "backends/cpu/cpu_executor.hpp"
+#include "backends/cpu/simd/cpu_simd.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -37,31 +40,52 @@ inline std::int32_t fixed(float v, float scale) {
 #endif
 }
 
-// A stretch's wide sums. A product of two fixed-point coordinates is below 2^62 in magnitude, so products are summed
-// in 64 bits and folded into 128 when an addition would overflow (never, on real frames).
+// One stretch of a row whose pixels have the same slot: its count, x range and sums.
 struct Stretch {
     uint32_t slot = 0xffffffffu;
     uint32_t raw = 0;
     uint32_t count = 0;
     uint32_t x_min = 0;
     uint32_t x_max = 0;
-    std::int64_t point[3] = {0, 0, 0};
-    std::int64_t normal[3] = {0, 0, 0};
-    std::int32_t z_min = 0;
-    std::int32_t z_max = 0;
-    std::int64_t product[6] = {0, 0, 0, 0, 0, 0};
-    Int128 product_carry[6] = {0, 0, 0, 0, 0, 0};
+    simd::StatsSums sums;
+};
 
-    void add_product(size_t i, std::int64_t p) {
-        std::int64_t sum = 0;
-        if (__builtin_add_overflow(product[i], p, &sum)) {
-            product_carry[i] += Int128(product[i]) + p;
-            product[i] = 0;
-        } else {
-            product[i] = sum;
+// Pixels [x_begin, x_end) of row y, one at a time, into s.
+void add_pixels(const PassContext& c, uint32_t width, uint32_t y, uint32_t x_begin, uint32_t x_end, float scale,
+                simd::StatsSums& s) {
+    for (uint32_t x = x_begin; x < x_end; ++x) {
+        const float* p = c.points + size_t(y) * c.row_floats + size_t(x) * c.point_floats;
+        const std::int64_t q[3] = {fixed(p[0], scale), fixed(p[1], scale), fixed(p[2], scale)};
+        const size_t pixel_index = size_t(y) * width + x;
+        for (int k = 0; k < 3; ++k) {
+            s.point[k] += q[k];
+            s.normal[k] += quant_component(c.quant, pixel_index, k);
+        }
+        const auto z = static_cast<std::int32_t>(q[2]);
+        s.z_min = z < s.z_min ? z : s.z_min;
+        s.z_max = z > s.z_max ? z : s.z_max;
+        size_t product = 0;
+        for (size_t a = 0; a < 3; ++a) {
+            for (size_t b = a; b < 3; ++b) s.product[product++] += Int128(q[a] * q[b]);
         }
     }
-};
+}
+
+// Pixels [x_begin, x_end) of row y: whole vectors where the target has them, the rest one at a time.
+void add_stretch(const PassContext& c, const simd::VectorRows* rows, uint32_t width, uint32_t y, uint32_t x_begin,
+                 uint32_t x_end, float scale, simd::StatsSums& s) {
+    uint32_t x = x_begin;
+    while (x < x_end && rows != nullptr && c.point_floats == 3) {
+        x += rows->stats_sums(c.points + size_t(y) * c.row_floats + size_t(x) * 3, 3,
+                              c.quant + kQuantWords * (size_t(y) * width + x), x_end - x, scale, s);
+        if (x == x_end) return;
+        // A vector with a coordinate of 2^26 or more, or the last partial one: pixel by pixel.
+        const uint32_t next = std::min(x_end, x + 16u);
+        add_pixels(c, width, y, x, next, scale, s);
+        x = next;
+    }
+    add_pixels(c, width, y, x, x_end, scale, s);
+}
 
 pixel::PyrSum64 sum64(std::int64_t v) {
     const auto u = static_cast<std::uint64_t>(v);
@@ -82,57 +106,61 @@ void flush(const PassContext& c, const Stretch& s, uint32_t y, uint32_t with_poi
     r.count = s.count;
     r.x_max = s.x_max;
     if (with_points != 0u) {
-        r.px = sum64(s.point[0]);
-        r.py = sum64(s.point[1]);
-        r.pz = sum64(s.point[2]);
-        r.nx = sum64(s.normal[0]);
-        r.ny = sum64(s.normal[1]);
-        r.nz = sum64(s.normal[2]);
-        r.z_key_min = uint32_t(s.z_min) ^ 0x80000000u;
-        r.z_key_max = uint32_t(s.z_max) ^ 0x80000000u;
+        r.px = sum64(s.sums.point[0]);
+        r.py = sum64(s.sums.point[1]);
+        r.pz = sum64(s.sums.point[2]);
+        r.nx = sum64(s.sums.normal[0]);
+        r.ny = sum64(s.sums.normal[1]);
+        r.nz = sum64(s.sums.normal[2]);
+        r.z_key_min = uint32_t(s.sums.z_min) ^ 0x80000000u;
+        r.z_key_max = uint32_t(s.sums.z_max) ^ 0x80000000u;
         pixel::PyrSum96* products[6] = {&r.xx, &r.xy, &r.xz, &r.yy, &r.yz, &r.zz};
-        for (size_t i = 0; i < 6; ++i) *products[i] = sum96(s.product_carry[i] + s.product[i]);
+        for (size_t i = 0; i < 6; ++i) *products[i] = sum96(s.sums.product[i]);
     }
     pixel::pyr_stats_flush(c, 0u, r, y, with_points);
 }
 
-void stats_row(const PassContext& c, const PyrLevel& full, uint32_t y, uint32_t with_points, float scale,
-               uint32_t slots) {
+// Row y in runs of equal raw labels. A row crosses few segments but often crosses each many times (edge bands, the
+// merge's joined parts), so the row keeps the stretches of its last few slots open and adds each to its slot's words
+// once, at the end of the row or when a newer slot needs its place: the words are sums, maxima and minima, which
+// do not depend on how the row's pixels are grouped.
+void stats_row(const PassContext& c, const simd::VectorRows* rows, const PyrLevel& full, uint32_t y,
+               uint32_t with_points, float scale, uint32_t slots) {
+    constexpr size_t kOpen = 8;
     const uint32_t* labels = c.labels + full.offset + size_t(y) * full.width;
-    Stretch s;
-    for (uint32_t x = 0; x < full.width; ++x) {
+    Stretch open[kOpen];
+    size_t used = 0;
+    size_t last = 0;
+    for (uint32_t x = 0; x < full.width;) {
         const uint32_t raw = labels[x];
-        uint32_t slot = raw != 0u ? c.lut[raw] - 1u : 0xffffffffu;
-        if (slot >= slots) slot = 0xffffffffu;
-        if (slot != s.slot) {
-            if (s.slot != 0xffffffffu) flush(c, s, y, with_points);
-            s = Stretch{};
-            s.slot = slot;
-            s.raw = raw;
-            s.x_min = x;
+        uint32_t end = x + 1;
+        while (end < full.width && labels[end] == raw) ++end;
+        const uint32_t slot = raw != 0u ? c.lut[raw] - 1u : 0xffffffffu;
+        if (slot < slots) {
+            size_t k = last < used && open[last].slot == slot ? last : 0;
+            while (k < used && open[k].slot != slot) ++k;
+            if (k == used) {
+                if (used == kOpen) {
+                    flush(c, open[0], y, with_points);
+                    for (size_t j = 1; j < kOpen; ++j) open[j - 1] = open[j];
+                    --used;
+                    k = used;
+                }
+                open[k] = Stretch{};
+                open[k].slot = slot;
+                open[k].x_min = x;
+                ++used;
+            }
+            Stretch& s = open[k];
+            s.raw = std::max(s.raw, raw);
+            s.count += end - x;
+            s.x_max = end - 1;
+            if (with_points != 0u) add_stretch(c, rows, full.width, y, x, end, scale, s.sums);
+            last = k;
         }
-        if (slot == 0xffffffffu) continue;
-        ++s.count;
-        s.x_max = x;
-        if (with_points == 0u) continue;
-        const float* p = c.points + size_t(y) * c.row_floats + size_t(x) * c.point_floats;
-        const std::int64_t q[3] = {fixed(p[0], scale), fixed(p[1], scale), fixed(p[2], scale)};
-        const size_t pixel_index = size_t(y) * full.width + x;
-        for (int k = 0; k < 3; ++k) {
-            s.point[k] += q[k];
-            s.normal[k] += quant_component(c.quant, pixel_index, k);
-        }
-        const auto z = static_cast<std::int32_t>(q[2]);
-        s.z_min = s.count == 1 ? z : (z < s.z_min ? z : s.z_min);
-        s.z_max = s.count == 1 ? z : (z > s.z_max ? z : s.z_max);
-        s.add_product(0, q[0] * q[0]);
-        s.add_product(1, q[0] * q[1]);
-        s.add_product(2, q[0] * q[2]);
-        s.add_product(3, q[1] * q[1]);
-        s.add_product(4, q[1] * q[2]);
-        s.add_product(5, q[2] * q[2]);
+        x = end;
     }
-    if (s.slot != 0xffffffffu) flush(c, s, y, with_points);
+    for (size_t k = 0; k < used; ++k) flush(c, open[k], y, with_points);
 }
 
 }  // namespace
@@ -147,7 +175,7 @@ void CpuExecutor::segment_stats() {
         if (simd_ == nullptr) {
             pixel::pyr_stats_row_run(c, full, uint32_t(y), 0u, full.width, with_points, scale, 0u, plan_.stats_slots);
         } else {
-            stats_row(c, full, uint32_t(y), with_points, scale, plan_.stats_slots);
+            stats_row(c, simd_, full, uint32_t(y), with_points, scale, plan_.stats_slots);
         }
     });
 }

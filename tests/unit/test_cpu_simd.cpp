@@ -888,6 +888,7 @@ TEST_P(CpuSimdFrames, MatchTheScalarPathAndTheReference) {
         EXPECT_TRUE(same_bytes("raw labels", r.raw_labels, ref.raw_labels, f.w));
         EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, f.w));
         EXPECT_TRUE(same_segments(r.segments, ref.segments));
+        EXPECT_TRUE(same_segments(scalar.segments, ref.segments)) << "the scalar path's statistics";
         EXPECT_TRUE(same_bytes("normals (scalar path)", r.normals, scalar.normals, f.w, 3));
         EXPECT_TRUE(same_bytes("fillable mask (scalar path)", r.fillable_mask, scalar.fillable_mask, f.w));
         EXPECT_TRUE(same_bytes("labels (scalar path)", r.labels, scalar.labels, f.w));

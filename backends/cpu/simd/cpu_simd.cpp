@@ -72,6 +72,7 @@ constexpr std::size_t kMaxLanes = hn::MaxLanes(DF());
 #include "backends/cpu/simd/fill_rows-inl.h"  // NOLINT(bugprone-suspicious-include)
 #include "backends/cpu/simd/compact_rows-inl.h"  // NOLINT(bugprone-suspicious-include)
 #include "backends/cpu/simd/robust_rows-inl.h"  // NOLINT(bugprone-suspicious-include)
+#include "backends/cpu/simd/stats_rows-inl.h"  // NOLINT(bugprone-suspicious-include)
 // clang-format on
 
 // This target's row functions: constant data, so that nothing compiled for the target runs before it is chosen.
@@ -98,7 +99,8 @@ constexpr VectorRows kRows = {"",
                               &robust_normals_row,
                               &metric_robust_row,
                               &edge_candidates,
-                              &edge_row_from_candidates};
+                              &edge_row_from_candidates,
+                              &stats_sums};
 
 // Only returns the address of constant data; see available_targets.
 const VectorRows* get_rows() {
