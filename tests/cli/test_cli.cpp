@@ -639,6 +639,24 @@ TEST(Cli, StatsAreWrittenAsJsonOrCsv) {
     for (const nlohmann::json& s : doc["segments"]) counted += s["pixel_count"].get<std::size_t>();
     EXPECT_EQ(counted, labelled);
     EXPECT_GT(doc["segments"][0]["centroid"][2].get<double>(), 500.0) << "millimetres, about 1.2 m away";
+    // The largest segment (the scene's back plane or floor) is planar, its plane facing the camera.
+    const auto largest_segment = std::max_element(
+        doc["segments"].begin(), doc["segments"].end(),
+        [](const nlohmann::json& a, const nlohmann::json& b) { return a["pixel_count"] < b["pixel_count"]; });
+    const nlohmann::json& plane = (*largest_segment)["plane"];
+    EXPECT_TRUE(plane["planar"].get<bool>()) << plane.dump();
+    EXPECT_LT(plane["rms"].get<double>(), 2.0);
+    EXPECT_LT(plane["normal"][2].get<double>(), 0.0) << "towards the camera";
+    EXPECT_EQ((*largest_segment)["box"]["extents"].size(), 3u);
+    ASSERT_EQ(run("segment " + (dir / "scene.pcd").string() + " --planar-tolerance 0 --stats " +
+                  (dir / "strict.json").string())
+                  .status,
+              0);
+    std::ifstream strict_file(dir / "strict.json");
+    const nlohmann::json strict = nlohmann::json::parse(strict_file);
+    for (const nlohmann::json& s : strict["segments"]) {
+        EXPECT_EQ(s["plane"]["planar"].get<bool>(), s["plane"]["rms"].get<double>() == 0.0) << s.dump();
+    }
 
     ASSERT_EQ(run("segment " + (dir / "scene.pcd").string() + " --stats " + (dir / "s.csv").string()).status, 0);
     std::ifstream csv(dir / "s.csv");
