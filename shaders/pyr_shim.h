@@ -82,8 +82,7 @@ int pyr_glsl_mul_hi(int a, int b) {
 #define PYR_SQRT(f) sqrtf(f)
 #define PYR_PRECISE
 #define PYR_TYPEDEF(name)
-#define PYR_MUL_HI_I32(a, b) \
-    static_cast<int>((static_cast<long long>(a) * static_cast<long long>(b)) >> 32)
+#define PYR_MUL_HI_I32(a, b) static_cast<int>((static_cast<long long>(a) * static_cast<long long>(b)) >> 32)
 /* Atomics for accessor macros: shared functions are __host__ __device__, and CUDA's atomics are device-only. */
 #ifdef __CUDA_ARCH__
 #define pyr_cuda_atomic_add(p, v) atomicAdd((p), (v))

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -90,8 +91,9 @@ struct Frame {
     DepthImage depth;
     std::vector<float> metres;
     eval::TabletopTruth truth;
-    RgbImage color;       // empty without NAME_color.png
-    bool picture = true;  // a picture of it is written
+    RgbImage color;           // empty without NAME_color.png
+    bool picture = true;      // a picture of it is written
+    bool plane_known = true;  // truth.plane is the support's (the synthetic frames' truth has no plane)
 };
 
 // Each name a preset (or `default`), NAME+merge with the merge on, NAME+nomerge with it off; the segment parameter
@@ -265,9 +267,42 @@ double median_ms(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-// Every method on every frame: a table per frame into per_frame, a picture per frame into out_dir; the totals.
+// How far the plane of pyrseg's table segment (its statistics, docs/algorithm.md section 10b) lies from the ground
+// truth's support plane: the angle between their normals and the truth plane's distance from the segment's
+// centroid, which lies on the segment's plane.
+struct PlaneError {
+    double degrees = 0;
+    double mm = 0;
+    double rms_mm = 0;
+    bool planar = false;
+};
+
+PlaneError plane_error(const SegmentStats& table, const eval::SupportPlane& truth, double metres_per_unit) {
+    PlaneError e;
+    double cosine = 0;
+    double height = truth.offset;
+    for (std::size_t c = 0; c < 3; ++c) {
+        cosine += table.plane_normal[c] * truth.normal[c];
+        height += truth.normal[c] * table.centroid[c] * metres_per_unit;
+    }
+    e.degrees = std::acos(std::min(1.0, std::fabs(cosine))) * 180.0 / std::numbers::pi;
+    e.mm = std::fabs(height) * 1000.0;
+    e.rms_mm = table.plane_rms * metres_per_unit * 1000.0;
+    e.planar = table.planar;
+    return e;
+}
+
+// Every method on every frame: a table per frame into per_frame, a picture per frame into out_dir, the table plane's
+// errors of pyrseg's methods into planes; the totals.
 std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std::vector<Method>& methods,
-                                    double metres_per_unit, const fs::path& out_dir, std::ostringstream& per_frame) {
+                                    double metres_per_unit, const fs::path& out_dir, std::ostringstream& per_frame,
+                                    std::ostringstream& planes) {
+    std::vector<PlaneError> worst(methods.size());
+    std::vector<bool> measured(methods.size(), false);
+    planes << "## The table's plane\n\nThe plane of the segment that holds most of the table (its statistics) against "
+              "the ground truth's support plane: the angle between the normals, and the truth plane's distance from "
+              "the segment's centroid.\n\n| frame | method | angle (degrees) | distance (mm) | RMS to its plane (mm) | "
+              "planar |\n|---|---|---:|---:|---:|---|\n";
     std::vector<Totals> totals(methods.size());
     for (const Frame& f : frames) {
         const int w = f.depth.width;
@@ -280,6 +315,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
         panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
         for (std::size_t m = 0; m < methods.size(); ++m) {
             std::vector<std::uint32_t> labels;
+            Result statistics;
             double ms = 0;
             if (methods[m].lccp) {
                 const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, metres_per_unit);
@@ -306,8 +342,22 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 }
                 labels = std::move(result.labels);
                 ms = median_ms(times);
+                Outputs stats;
+                stats.segment_stats = true;
+                Segmenter with_stats(w, h, methods[m].params, "cpu", stats);
+                statistics = with_stats.segment(view);
             }
             const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
+            if (!statistics.segments.empty() && s.table_label != 0 && f.truth.found_plane && f.plane_known) {
+                const PlaneError e =
+                    plane_error(statistics.segments[s.table_label - 1], f.truth.plane, metres_per_unit);
+                planes << "| " << f.name << " | `" << methods[m].name << "` | " << printed("%.2f", e.degrees) << " | "
+                       << printed("%.1f", e.mm) << " | " << printed("%.1f", e.rms_mm) << " | "
+                       << (e.planar ? "yes" : "no") << " |\n";
+                worst[m].degrees = std::max(worst[m].degrees, e.degrees);
+                worst[m].mm = std::max(worst[m].mm, e.mm);
+                measured[m] = true;
+            }
             Totals one;
             one.add(s, ms);
             totals[m].add(s, ms);
@@ -320,7 +370,14 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
             write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));
         }
     }
-
+    planes << "\nThe worst frame:";
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+        if (measured[m]) {
+            planes << " `" << methods[m].name << "` " << printed("%.2f", worst[m].degrees) << " degrees, "
+                   << printed("%.1f", worst[m].mm) << " mm;";
+        }
+    }
+    planes << "\n\n";
     return totals;
 }
 
@@ -366,6 +423,7 @@ Frame synthetic_frame(synthetic::Sensor sensor, double distance_mm, std::uint64_
     }
     f.truth.objects = std::uint32_t(truth_id.size());
     f.truth.found_plane = true;
+    f.plane_known = false;
     f.picture = seed == 1;
     return f;
 }
@@ -408,7 +466,8 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
         if (pcl_peer_missing().empty()) {
             methods.push_back({"PCL organized (" + name + " settings)", Params{}, kind, std::nullopt});
         }
-        const std::vector<Totals> totals = evaluate_frames(frames, methods, 0.001, out_dir, per_frame);
+        std::ostringstream no_planes;
+        const std::vector<Totals> totals = evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes);
         for (std::size_t m = 0; m < methods.size(); ++m) md << row(name + ": `" + methods[m].name + "`", totals[m]);
     }
     md << "\n" << per_frame.str();
@@ -478,7 +537,8 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
     }
     std::ostringstream per_frame;
     per_frame << "## Per frame\n\n";
-    const std::vector<Totals> totals = evaluate_frames(frames, methods, metres_per_unit, out_dir, per_frame);
+    std::ostringstream planes;
+    const std::vector<Totals> totals = evaluate_frames(frames, methods, metres_per_unit, out_dir, per_frame, planes);
 
     std::string command = "pyrseg eval";
     for (const std::string& a : argv) command += " " + a;
@@ -489,7 +549,7 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
        << "(`pyrseg eval --tabletop --help`).\n\n## In sum\n\n"
        << printed(kTableHead, "method");
     for (std::size_t m = 0; m < methods.size(); ++m) md << row("`" + methods[m].name + "`", totals[m]);
-    md << "\n" << per_frame.str();
+    md << "\n" << planes.str() << per_frame.str();
     const fs::path report = out_dir / "tabletop.md";
     write_text_file(report, md.str());
     std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);
