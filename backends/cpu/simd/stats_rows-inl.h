@@ -2,6 +2,14 @@
 // Included by cpu_simd.cpp inside each target's namespace, once per target (foreach_target.h): no include guard.
 // NOLINTBEGIN(llvm-header-guard)
 
+// Adds the lanes of `v` to `into` and empties `v`. (SVE vectors are sizeless: no arrays or struct members of them,
+// so each sum below is a variable of its own.)
+template <class D, class V, typename T>
+HWY_INLINE void drain_lanes(D d, V& v, T& into) {
+    into += hn::GetLane(hn::SumOfLanes(d, v));
+    v = hn::Zero(d);
+}
+
 // See VectorRows::stats_sums. Each 64-bit lane gets at most 2 products of coordinates below 2^26 (so below 2^53)
 // per vector; the lanes are summed and emptied into the 128-bit sums every 512 / (64-bit lanes) vectors, so a
 // lane, and the sum of all lanes, stays below 2^62.
@@ -19,36 +27,57 @@ std::uint32_t stats_sums(const float* points, std::size_t stride, const std::uin
     const VF limit = hn::Set(df, PYR_STATS_POINT_LIMIT);
     const VF scales = hn::Set(df, scale);
     const VI bound = hn::Set(di, 1 << 26);
-    V64 point_sum[3] = {hn::Zero(d64), hn::Zero(d64), hn::Zero(d64)};
-    VI normal_sum[3] = {hn::Zero(di), hn::Zero(di), hn::Zero(di)};
-    V64 product_sum[6] = {hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64)};
+    V64 sum_x = hn::Zero(d64);
+    V64 sum_y = hn::Zero(d64);
+    V64 sum_z = hn::Zero(d64);
+    VI normal_x = hn::Zero(di);
+    VI normal_y = hn::Zero(di);
+    VI normal_z = hn::Zero(di);
+    V64 sum_xx = hn::Zero(d64);
+    V64 sum_xy = hn::Zero(d64);
+    V64 sum_xz = hn::Zero(d64);
+    V64 sum_yy = hn::Zero(d64);
+    V64 sum_yz = hn::Zero(d64);
+    V64 sum_zz = hn::Zero(d64);
     VI z_min = hn::Set(di, sums.z_min);
     VI z_max = hn::Set(di, sums.z_max);
-    const auto fold = [&] {
-        for (std::size_t k = 0; k < 3; ++k) {
-            sums.point[k] += hn::GetLane(hn::SumOfLanes(d64, point_sum[k]));
-            point_sum[k] = hn::Zero(d64);
-            sums.normal[k] += hn::GetLane(hn::SumOfLanes(di, normal_sum[k]));
-            normal_sum[k] = hn::Zero(di);
-        }
-        for (std::size_t k = 0; k < 6; ++k) {
-            sums.product[k] += hn::GetLane(hn::SumOfLanes(d64, product_sum[k]));
-            product_sum[k] = hn::Zero(d64);
-        }
+    // The products of the even lanes (MulEven) and of the odd lanes (shifted into the even ones) of a and b.
+    const auto products = [&](VI a, VI b) {
+        const VI a_odd = hn::BitCast(di, hn::ShiftRight<32>(hn::BitCast(d64, a)));
+        const VI b_odd = hn::BitCast(di, hn::ShiftRight<32>(hn::BitCast(d64, b)));
+        return hn::Add(hn::MulEven(a, b), hn::MulEven(a_odd, b_odd));
     };
-    // The even and odd 32-bit lanes of v, each sign-extended to 64 bits.
-    const auto even = [&](VI v) { return hn::ShiftRight<32>(hn::ShiftLeft<32>(hn::BitCast(d64, v))); };
-    const auto odd = [&](VI v) { return hn::ShiftRight<32>(hn::BitCast(d64, v)); };
+    // The even and odd 32-bit lanes of v, each sign-extended to 64 bits, added.
+    const auto lanes = [&](VI v) {
+        const V64 wide = hn::BitCast(d64, v);
+        return hn::Add(hn::ShiftRight<32>(hn::ShiftLeft<32>(wide)), hn::ShiftRight<32>(wide));
+    };
     std::size_t since_fold = 0;
+    const auto fold = [&](V64& px, V64& py, V64& pz, VI& nx, VI& ny, VI& nz, V64& xx, V64& xy, V64& xz, V64& yy,
+                          V64& yz, V64& zz) {
+        drain_lanes(d64, px, sums.point[0]);
+        drain_lanes(d64, py, sums.point[1]);
+        drain_lanes(d64, pz, sums.point[2]);
+        drain_lanes(di, nx, sums.normal[0]);
+        drain_lanes(di, ny, sums.normal[1]);
+        drain_lanes(di, nz, sums.normal[2]);
+        drain_lanes(d64, xx, sums.product[0]);
+        drain_lanes(d64, xy, sums.product[1]);
+        drain_lanes(d64, xz, sums.product[2]);
+        drain_lanes(d64, yy, sums.product[3]);
+        drain_lanes(d64, yz, sums.product[4]);
+        drain_lanes(d64, zz, sums.product[5]);
+        since_fold = 0;
+    };
     for (; i + n <= count; i += std::uint32_t(n)) {
         VF x;
         VF y;
         VF z;
         load_points(df, points + std::size_t(i) * stride, stride, x, y, z);
-        const VI q[3] = {hn::NearestInt(hn::Min(hn::Max(hn::Mul(x, scales), hn::Neg(limit)), limit)),
-                         hn::NearestInt(hn::Min(hn::Max(hn::Mul(y, scales), hn::Neg(limit)), limit)),
-                         hn::NearestInt(hn::Min(hn::Max(hn::Mul(z, scales), hn::Neg(limit)), limit))};
-        const VI largest = hn::Max(hn::Max(hn::Abs(q[0]), hn::Abs(q[1])), hn::Abs(q[2]));
+        const VI qx = hn::NearestInt(hn::Min(hn::Max(hn::Mul(x, scales), hn::Neg(limit)), limit));
+        const VI qy = hn::NearestInt(hn::Min(hn::Max(hn::Mul(y, scales), hn::Neg(limit)), limit));
+        const VI qz = hn::NearestInt(hn::Min(hn::Max(hn::Mul(z, scales), hn::Neg(limit)), limit));
+        const VI largest = hn::Max(hn::Max(hn::Abs(qx), hn::Abs(qy)), hn::Abs(qz));
         if (!hn::AllTrue(di, hn::Lt(largest, bound))) break;
         VU w0;
         VU w1;
@@ -56,29 +85,27 @@ std::uint32_t stats_sums(const float* points, std::size_t stride, const std::uin
         hn::LoadInterleaved3(du, quant + kQuantWords * std::size_t(i), w0, w1, w2);
         const VI b0 = hn::BitCast(di, w0);
         const VI b1 = hn::BitCast(di, w1);
-        normal_sum[0] = hn::Add(normal_sum[0], hn::ShiftRight<16>(hn::ShiftLeft<16>(b0)));
-        normal_sum[1] = hn::Add(normal_sum[1], hn::ShiftRight<16>(b0));
-        normal_sum[2] = hn::Add(normal_sum[2], hn::ShiftRight<16>(hn::ShiftLeft<16>(b1)));
-        z_min = hn::Min(z_min, q[2]);
-        z_max = hn::Max(z_max, q[2]);
-        const V64 qe[3] = {even(q[0]), even(q[1]), even(q[2])};
-        const V64 qo[3] = {odd(q[0]), odd(q[1]), odd(q[2])};
-        const VI qo32[3] = {hn::BitCast(di, qo[0]), hn::BitCast(di, qo[1]), hn::BitCast(di, qo[2])};
-        for (std::size_t k = 0; k < 3; ++k) point_sum[k] = hn::Add(point_sum[k], hn::Add(qe[k], qo[k]));
-        std::size_t product = 0;
-        for (std::size_t a = 0; a < 3; ++a) {
-            for (std::size_t b = a; b < 3; ++b) {
-                product_sum[product] =
-                    hn::Add(product_sum[product], hn::Add(hn::MulEven(q[a], q[b]), hn::MulEven(qo32[a], qo32[b])));
-                ++product;
-            }
-        }
+        normal_x = hn::Add(normal_x, hn::ShiftRight<16>(hn::ShiftLeft<16>(b0)));
+        normal_y = hn::Add(normal_y, hn::ShiftRight<16>(b0));
+        normal_z = hn::Add(normal_z, hn::ShiftRight<16>(hn::ShiftLeft<16>(b1)));
+        z_min = hn::Min(z_min, qz);
+        z_max = hn::Max(z_max, qz);
+        sum_x = hn::Add(sum_x, lanes(qx));
+        sum_y = hn::Add(sum_y, lanes(qy));
+        sum_z = hn::Add(sum_z, lanes(qz));
+        sum_xx = hn::Add(sum_xx, products(qx, qx));
+        sum_xy = hn::Add(sum_xy, products(qx, qy));
+        sum_xz = hn::Add(sum_xz, products(qx, qz));
+        sum_yy = hn::Add(sum_yy, products(qy, qy));
+        sum_yz = hn::Add(sum_yz, products(qy, qz));
+        sum_zz = hn::Add(sum_zz, products(qz, qz));
         if (++since_fold == fold_every) {
-            fold();
-            since_fold = 0;
+            fold(sum_x, sum_y, sum_z, normal_x, normal_y, normal_z, sum_xx, sum_xy, sum_xz, sum_yy, sum_yz, sum_zz);
         }
     }
-    if (since_fold != 0) fold();
+    if (since_fold != 0) {
+        fold(sum_x, sum_y, sum_z, normal_x, normal_y, normal_z, sum_xx, sum_xy, sum_xz, sum_yy, sum_yz, sum_zz);
+    }
     sums.z_min = hn::GetLane(hn::MinOfLanes(di, z_min));
     sums.z_max = hn::GetLane(hn::MaxOfLanes(di, z_max));
 #else
