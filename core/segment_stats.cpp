@@ -38,9 +38,9 @@ std::int32_t z_from_key(std::uint32_t key) {
 
 // Section 10b: the covariance from the exact sums, then the plane, the box and the planar flag.
 void derive_geometry(const Params& params, double unit, SegmentStats& s) {
-    const auto n = Int128(s.pixel_count);
+    const auto n = Int128(s.fillable_count);
     constexpr std::array<std::array<int, 2>, 6> kPairs = {{{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}}};
-    const double scale = unit * unit / (double(s.pixel_count) * double(s.pixel_count));
+    const double scale = unit * unit / (double(s.fillable_count) * double(s.fillable_count));
     for (std::size_t i = 0; i < 6; ++i) {
         // n * S_ab - S_a * S_b, exact: |n| < 2^32, |S_ab| < 2^94, |S_a| < 2^63.
         const Int128 centred = n * wide(s.point_product_sum[i]) - Int128(s.point_sum[std::size_t(kPairs[i][0])]) *
@@ -77,7 +77,7 @@ void derive_geometry(const Params& params, double unit, SegmentStats& s) {
     for (std::size_t i = 0; i < 3; ++i) s.extents[i] = 2.0 * std::sqrt(3.0 * std::max(e.values[i], 0.0));
     const double z_m = std::fabs(s.centroid[2]) * params.unit_mm * 1e-3;
     const double tolerance_mm = params.planar_tolerance_mm + params.planar_tolerance_per_m2 * z_m * z_m;
-    s.planar = s.pixel_count >= 3 && s.plane_rms * params.unit_mm <= tolerance_mm;
+    s.planar = s.fillable_count >= 3 && s.plane_rms * params.unit_mm <= tolerance_mm;
 }
 
 void no_geometry(SegmentStats& s) {
@@ -114,7 +114,8 @@ void decode_segment_stats(const std::uint32_t* words, std::uint32_t count, const
         s.x_max = int(w[PYR_STATS_X_MAX]);
         s.y_max = int(w[PYR_STATS_Y_MAX]);
         s.point_shift = plan.stats_point_shift;
-        if (!with_points) {
+        s.fillable_count = with_points ? w[PYR_STATS_FILLABLE_COUNT] : 0u;
+        if (s.fillable_count == 0) {
             no_geometry(s);
             continue;
         }
@@ -129,7 +130,7 @@ void decode_segment_stats(const std::uint32_t* words, std::uint32_t count, const
         s.z_fixed_min = z_from_key(~w[PYR_STATS_NOT_Z_KEY_MIN]);
         const double length = std::sqrt(length2);
         for (std::size_t c = 0; c < 3; ++c) {
-            s.centroid[c] = double(s.point_sum[c]) * unit / double(s.pixel_count);
+            s.centroid[c] = double(s.point_sum[c]) * unit / double(s.fillable_count);
             s.mean_normal[c] = length > 0 ? double(s.normal_sum[c]) / length : 0.0;
         }
         derive_geometry(plan.params, unit, s);

@@ -24,12 +24,13 @@ std::string csv_number(double v) {
 
 std::string to_csv(const std::vector<SegmentStats>& segments) {
     std::string out =
-        "label,pixel_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z,"
-        "z_min,z_max,plane_nx,plane_ny,plane_nz,plane_offset,plane_rms,curvature,planar,"
+        "label,pixel_count,fillable_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,"
+        "normal_x,normal_y,normal_z,z_min,z_max,plane_nx,plane_ny,plane_nz,plane_offset,plane_rms,curvature,planar,"
         "axis0_x,axis0_y,axis0_z,axis1_x,axis1_y,axis1_z,axis2_x,axis2_y,axis2_z,extent0,extent1,extent2\n";
     for (const SegmentStats& s : segments) {
-        out += std::to_string(s.label) + ',' + std::to_string(s.pixel_count) + ',' + std::to_string(s.x_min) + ',' +
-               std::to_string(s.y_min) + ',' + std::to_string(s.x_max) + ',' + std::to_string(s.y_max);
+        out += std::to_string(s.label) + ',' + std::to_string(s.pixel_count) + ',' + std::to_string(s.fillable_count) +
+               ',' + std::to_string(s.x_min) + ',' + std::to_string(s.y_min) + ',' + std::to_string(s.x_max) + ',' +
+               std::to_string(s.y_max);
         for (const double v : s.centroid) out += ',' + csv_number(v);
         for (const double v : s.mean_normal) out += ',' + csv_number(v);
         out += ',' + csv_number(s.z_min) + ',' + csv_number(s.z_max);
@@ -68,6 +69,7 @@ std::string to_json(const std::vector<SegmentStats>& segments, const SegmentTabl
     for (const SegmentStats& s : segments) {
         list.push_back({{"label", s.label},
                         {"pixel_count", s.pixel_count},
+                        {"fillable_count", s.fillable_count},
                         {"bbox", {s.x_min, s.y_min, s.x_max, s.y_max}},
                         {"centroid", vector3(s.centroid)},
                         {"mean_normal", vector3(s.mean_normal)},

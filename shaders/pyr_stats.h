@@ -4,8 +4,10 @@
  * of the additions, so every backend gets the same words whatever its scheduling.
  * Each invocation walks one run of a row and adds each stretch of equal labels to its slot at once, so a large
  * segment costs one atomic per stretch, not per pixel.
- * Needs: PYR_LABEL(i), PYR_LUT(l), PYR_PT(x, y, c), PYR_QN(i, c), and on the statistics words (a uint32 array):
- * PYR_STATS_ADD(w, v) (atomic add, evaluates to the old value) and PYR_STATS_MAX(w, v) (atomic max). */
+ * The sums of points, normals and products and the depth range run over the fillable pixels only (the edge pixels
+ * of step 6c hold mixed pixels and the sides of depth steps); the count and the box over every labelled pixel.
+ * Needs: PYR_LABEL(i), PYR_MASK(i), PYR_LUT(l), PYR_PT(x, y, c), PYR_QN(i, c), and on the statistics words (a uint32
+ * array): PYR_STATS_ADD(w, v) (atomic add, evaluates to the old value) and PYR_STATS_MAX(w, v) (atomic max). */
 #ifndef PYR_STATS_H
 #define PYR_STATS_H
 #include "pyr_types.h"
@@ -101,6 +103,7 @@ struct PyrStatsRun {
     pyr_u32 slot; /* 0xffffffff: none */
     pyr_u32 raw;
     pyr_u32 count;
+    pyr_u32 fillable;
     pyr_u32 x_min;
     pyr_u32 x_max;
     PyrSum64 px;
@@ -124,6 +127,7 @@ PYR_FN PyrStatsRun pyr_stats_run_start(pyr_u32 slot, pyr_u32 raw, pyr_u32 x) {
     r.slot = slot;
     r.raw = raw;
     r.count = 0u;
+    r.fillable = 0u;
     r.x_min = x;
     r.x_max = x;
     r.px = pyr_sum64(0u, 0u);
@@ -151,7 +155,8 @@ PYR_FN void pyr_stats_flush(PYR_CTX_PARAM, pyr_u32 base, PyrStatsRun r, pyr_u32 
     PYR_STATS_MAX(w + PYR_STATS_X_MAX, r.x_max);
     PYR_STATS_MAX(w + PYR_STATS_Y_MAX, y);
     PYR_STATS_MAX(w + PYR_STATS_RAW_LABEL, r.raw); /* every pixel of the slot has this raw label */
-    if (with_points != 0u) {
+    if (with_points != 0u && r.fillable != 0u) {
+        PYR_STATS_ADD(w + PYR_STATS_FILLABLE_COUNT, r.fillable);
         pyr_stats_add64(PYR_CTX_ARG, w + PYR_STATS_POINT_SUM, r.px);
         pyr_stats_add64(PYR_CTX_ARG, w + PYR_STATS_POINT_SUM + 2u, r.py);
         pyr_stats_add64(PYR_CTX_ARG, w + PYR_STATS_POINT_SUM + 4u, r.pz);
@@ -187,7 +192,8 @@ PYR_FN void pyr_stats_row_run(PYR_CTX_PARAM, PyrLevel full, pyr_u32 y, pyr_u32 x
         if (slot == 0xffffffffu) continue;
         r.count += 1u;
         r.x_max = x;
-        if (with_points != 0u) {
+        if (with_points != 0u && (PYR_MASK(full.offset + pixel) & PYR_MASK_FILLABLE) != 0u) {
+            r.fillable += 1u;
             pyr_i32 fx = pyr_stats_fixed(PYR_PT(x, y, 0u), point_scale);
             pyr_i32 fy = pyr_stats_fixed(PYR_PT(x, y, 1u), point_scale);
             pyr_i32 fz = pyr_stats_fixed(PYR_PT(x, y, 2u), point_scale);

@@ -107,7 +107,9 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 /* xx, xy, xz, yy, yz, zz: 18 words, sums of the products of the fixed-point coordinates, each 96-bit two's
  * complement in three words (a product is below 2^62 in magnitude, a frame has fewer than 2^32 pixels). */
 #define PYR_STATS_PRODUCT_SUM 20u
-#define PYR_STATS_WORDS 38u
+/* The fillable pixels, over which the sums of points, normals and products and the depth range run. */
+#define PYR_STATS_FILLABLE_COUNT 38u
+#define PYR_STATS_WORDS 39u
 
 /* The merge's pair table on GPUs (shaders/pyr_merge_table.h): words per slot. */
 #define PYR_MERGE_SLOT_WORDS 4u

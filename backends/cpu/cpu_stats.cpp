@@ -45,6 +45,7 @@ struct Stretch {
     uint32_t slot = 0xffffffffu;
     uint32_t raw = 0;
     uint32_t count = 0;
+    uint32_t fillable = 0;
     uint32_t x_min = 0;
     uint32_t x_max = 0;
     simd::StatsSums sums;
@@ -104,6 +105,7 @@ pixel::PyrSum96 sum96(Int128 v) {
 void flush(const PassContext& c, const Stretch& s, uint32_t y, uint32_t with_points) {
     pixel::PyrStatsRun r = pixel::pyr_stats_run_start(s.slot, s.raw, s.x_min);
     r.count = s.count;
+    r.fillable = s.fillable;
     r.x_max = s.x_max;
     if (with_points != 0u) {
         r.px = sum64(s.sums.point[0]);
@@ -155,7 +157,21 @@ void stats_row(const PassContext& c, const simd::VectorRows* rows, const PyrLeve
             s.raw = std::max(s.raw, raw);
             s.count += end - x;
             s.x_max = end - 1;
-            if (with_points != 0u) add_stretch(c, rows, full.width, y, x, end, scale, s.sums);
+            if (with_points != 0u) {
+                // The geometry's sums run over the fillable pixels only.
+                const std::uint8_t* mask = c.mask + full.offset + size_t(y) * full.width;
+                for (uint32_t a = x; a < end;) {
+                    if ((mask[a] & PYR_MASK_FILLABLE) == 0u) {
+                        ++a;
+                        continue;
+                    }
+                    uint32_t b = a + 1;
+                    while (b < end && (mask[b] & PYR_MASK_FILLABLE) != 0u) ++b;
+                    s.fillable += b - a;
+                    add_stretch(c, rows, full.width, y, a, b, scale, s.sums);
+                    a = b;
+                }
+            }
             last = k;
         }
         x = end;

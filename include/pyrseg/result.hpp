@@ -27,8 +27,9 @@ struct SegmentStats {
     std::uint32_t label = 0;                         // its value in Result::labels (the compacted id, or the raw label)
     std::uint32_t pixel_count = 0;                   // labelled pixels, edge pixels of step 6c included
     int x_min = 0, y_min = 0, x_max = 0, y_max = 0;  // bounding box in pixels, inclusive
-    // Sums over the segment's pixels, exact: points in fixed point (rint(p * 2^point_shift), the caller's units,
-    // each coordinate clamped to +-(2^31 - 128)) and the quantized normals qn (units of 2^-13). Zero for a mask.
+    std::uint32_t fillable_count = 0;  // its fillable pixels (not edge pixels), which the sums and the geometry are of
+    // Sums over the segment's fillable pixels, exact: points in fixed point (rint(p * 2^point_shift), the caller's
+    // units, each coordinate clamped to +-(2^31 - 128)) and the quantized normals qn (units of 2^-13). Zero for a mask.
     std::array<std::int64_t, 3> point_sum{};
     std::array<std::int64_t, 3> normal_sum{};
     int point_shift = 0;  // the fixed point's binary exponent, from Params::unit_mm (steps of 1/16 mm or finer)
@@ -38,8 +39,8 @@ struct SegmentStats {
     std::int32_t z_fixed_min = 0;
     std::int32_t z_fixed_max = 0;
     // Derived on the host (docs/algorithm.md section 10b). NaN when the frame was a caller's mask, which has no
-    // points. The 3D centroid (mean point, the caller's units) and the unit mean normal (normal_sum normalised;
-    // zero when it is zero).
+    // points. The 3D centroid (mean fillable point, the caller's units) and the unit mean normal (normal_sum
+    // normalised; zero when it is zero).
     std::array<double, 3> centroid{};
     std::array<double, 3> mean_normal{};
     std::array<double, 6> covariance{};  // xx, xy, xz, yy, yz, zz: the points' covariance, the caller's units squared

@@ -548,6 +548,7 @@ py::object stats_dtype() {
     field("point_sum", "(3,)<i8", offsetof(SegmentStats, point_sum));
     field("normal_sum", "(3,)<i8", offsetof(SegmentStats, normal_sum));
     field("point_shift", "<i4", offsetof(SegmentStats, point_shift));
+    field("fillable_count", "<u4", offsetof(SegmentStats, fillable_count));
     // Each exact 128-bit sum as its two halves, value = high * 2**64 + low.
     static_assert(sizeof(WideSum) == 16 && offsetof(WideSum, high) == 8);
     const py::object np = py::module_::import("numpy");

@@ -19,6 +19,7 @@ std::vector<SegmentStats> two_segments() {
     SegmentStats a;
     a.label = 1;
     a.pixel_count = 1200;
+    a.fillable_count = 1100;
     a.x_min = 3;
     a.y_min = 4;
     a.x_max = 50;
@@ -37,6 +38,7 @@ std::vector<SegmentStats> two_segments() {
     SegmentStats b = a;
     b.label = 7;
     b.pixel_count = 1;
+    b.fillable_count = 1;
     b.centroid = {1.0 / 3.0, 2.0, 3.0};
     return {a, b};
 }
@@ -62,6 +64,7 @@ TEST(SegmentTable, JsonReadsBackExactly) {
     const nlohmann::json& b = doc["segments"][1];
     EXPECT_EQ(b["label"], 7);
     EXPECT_EQ(b["pixel_count"], 1);
+    EXPECT_EQ(b["fillable_count"], 1);
     EXPECT_EQ(b["bbox"], nlohmann::json({3, 4, 50, 61}));
     EXPECT_EQ(b["centroid"][0].get<double>(), 1.0 / 3.0) << "doubles are written to round-trip";
     EXPECT_EQ(b["mean_normal"][2].get<double>(), -0.8);
@@ -85,12 +88,13 @@ TEST(SegmentTable, CsvHasAHeaderAndOneLinePerSegment) {
     std::vector<std::string> lines;
     while (std::getline(text, line)) lines.push_back(line);
     ASSERT_EQ(lines.size(), 3u);
-    EXPECT_EQ(lines[0],
-              "label,pixel_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z,"
-              "z_min,z_max,plane_nx,plane_ny,plane_nz,plane_offset,plane_rms,curvature,planar,"
-              "axis0_x,axis0_y,axis0_z,axis1_x,axis1_y,axis1_z,axis2_x,axis2_y,axis2_z,extent0,extent1,extent2");
+    EXPECT_EQ(
+        lines[0],
+        "label,pixel_count,fillable_count,x_min,y_min,x_max,y_max,centroid_x,centroid_y,centroid_z,"
+        "normal_x,normal_y,normal_z,z_min,z_max,plane_nx,plane_ny,plane_nz,plane_offset,plane_rms,curvature,planar,"
+        "axis0_x,axis0_y,axis0_z,axis1_x,axis1_y,axis1_z,axis2_x,axis2_y,axis2_z,extent0,extent1,extent2");
     EXPECT_EQ(lines[1],
-              "1,1200,3,4,50,61,-12.5,0.1,1234.0625,0.0,0.6,-0.8,1200.0,1300.5,0.0,0.6,-0.8,987.25,0.5,0.001,1,"
+              "1,1200,1100,3,4,50,61,-12.5,0.1,1234.0625,0.0,0.6,-0.8,1200.0,1300.5,0.0,0.6,-0.8,987.25,0.5,0.001,1,"
               "1.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,1.0,40.0,30.0,2.0");
 }
 
@@ -103,12 +107,13 @@ TEST(SegmentTable, AMasksMissingGeometryIsEmptyInCsvAndNullInJson) {
     segments[0].z_min = segments[0].z_max = segments[0].plane_offset = kNaN;
     segments[0].plane_rms = segments[0].curvature = kNaN;
     segments[0].planar = false;
+    segments[0].fillable_count = 0;
     segments[0].plane_normal.fill(kNaN);
     for (auto& axis : segments[0].axes) axis.fill(kNaN);
     segments[0].extents.fill(kNaN);
     write_segment_stats(dir.path() / "m.csv", segments, SegmentTable{});
     write_segment_stats(dir.path() / "m.json", segments, SegmentTable{});
-    EXPECT_NE(slurp(dir.path() / "m.csv").find("1,1200,3,4,50,61" + std::string(27, ',') + "\n"), std::string::npos);
+    EXPECT_NE(slurp(dir.path() / "m.csv").find("1,1200,0,3,4,50,61" + std::string(27, ',') + "\n"), std::string::npos);
     const nlohmann::json doc = nlohmann::json::parse(slurp(dir.path() / "m.json"));
     EXPECT_TRUE(doc["segments"][0]["centroid"][1].is_null());
     EXPECT_TRUE(doc["segments"][0]["plane"]["rms"].is_null());

@@ -125,7 +125,8 @@ def test_outputs_and_statistics(scene):
     for row in s[:3]:
         ys, xs = np.nonzero(r.labels == row["label"])
         assert (row["x_min"], row["y_min"], row["x_max"], row["y_max"]) == (xs.min(), ys.min(), xs.max(), ys.max())
-        pts = scene.points[ys, xs].astype(np.float64)
+        surface = r.fillable_mask[ys, xs] == 1  # the centroid is of the fillable pixels
+        pts = scene.points[ys[surface], xs[surface]].astype(np.float64)
         np.testing.assert_allclose(row["centroid"], np.nanmean(pts, axis=0), atol=0.1)
         assert abs(np.linalg.norm(row["mean_normal"]) - 1) < 1e-6
 
@@ -133,11 +134,12 @@ def test_outputs_and_statistics(scene):
 def test_segment_geometry_matches_numpy(scene):
     # The covariance, plane and box (docs/algorithm.md section 10b) against numpy on the labelled points.
     h, w, _ = scene.points.shape
-    r = pyrseg.Segmenter(w, h, "cpu", outputs=("segment_stats",)).segment(scene.points)
+    r = pyrseg.Segmenter(w, h, "cpu", outputs=("segment_stats", "fillable_mask")).segment(scene.points)
     s = r.segments
     assert r.segment_count > 3
     for row in s[np.argsort(s["pixel_count"])[::-1][:4]]:
-        ys, xs = np.nonzero(r.labels == row["label"])
+        ys, xs = np.nonzero((r.labels == row["label"]) & (r.fillable_mask == 1))  # the sums are of fillable pixels
+        assert row["fillable_count"] == len(ys) < row["pixel_count"]
         pts = scene.points[ys, xs].astype(np.float64)
         cov = np.cov(pts.T, bias=True)
         got = row["covariance"]

@@ -983,7 +983,9 @@ std::vector<Segment> segment_statistics(const Output& out, const float* points, 
         s.x_max = std::max(s.x_max, x);
         s.y_min = std::min(s.y_min, y);
         s.y_max = std::max(s.y_max, y);
-        if (points == nullptr) continue;
+        if (points == nullptr || out.fillable[i] == 0) continue;
+        const bool first = s.fillable_count == 0;
+        ++s.fillable_count;
         std::int64_t q[3];
         for (std::size_t c = 0; c < 3; ++c) {
             const float v = std::clamp(points[3 * i + c] * scale, -limit, limit);
@@ -995,8 +997,8 @@ std::vector<Segment> segment_statistics(const Output& out, const float* points, 
         for (std::size_t a = 0; a < 3; ++a) {
             for (std::size_t b = a; b < 3; ++b) s.product_sum[product++] += static_cast<Int128>(q[a] * q[b]);
         }
-        s.z_fixed_min = added ? q[2] : std::min(s.z_fixed_min, q[2]);
-        s.z_fixed_max = added ? q[2] : std::max(s.z_fixed_max, q[2]);
+        s.z_fixed_min = first ? q[2] : std::min(s.z_fixed_min, q[2]);
+        s.z_fixed_max = first ? q[2] : std::max(s.z_fixed_max, q[2]);
     }
     std::vector<Segment> segments;
     segments.reserve(by_raw.size());

@@ -56,12 +56,14 @@ struct Segment {
     std::uint32_t label = 0;  // as in Output::labels
     std::uint32_t pixel_count = 0;
     int x_min = 0, y_min = 0, x_max = 0, y_max = 0;
+    // Over the segment's fillable pixels:
     std::int64_t point_sum[3] = {0, 0, 0};   // sum of rint(clamp(p * 2^point_shift)), zero for a mask
     std::int64_t normal_sum[3] = {0, 0, 0};  // sum of qn, zero for a mask
     int point_shift = 0;
     // Sums of the products of the fixed-point coordinates (xx, xy, xz, yy, yz, zz), exact; zero for a mask.
     Int128 product_sum[6] = {0, 0, 0, 0, 0, 0};
     std::int64_t z_fixed_min = 0, z_fixed_max = 0;  // the fixed-point z's range; zero for a mask
+    std::uint32_t fillable_count = 0;               // the fillable pixels the sums run over; zero for a mask
 };
 
 struct Output {

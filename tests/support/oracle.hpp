@@ -106,6 +106,7 @@ inline ::testing::AssertionResult same_segments(const std::vector<SegmentStats>&
             return differ("bounding box", got.str(), want.str());
         }
         if (a.point_shift != e.point_shift) return differ("point_shift", a.point_shift, e.point_shift);
+        if (a.fillable_count != e.fillable_count) return differ("fillable_count", a.fillable_count, e.fillable_count);
         for (std::size_t c = 0; c < 3; ++c) {
             if (a.point_sum[c] != e.point_sum[c]) return differ("point_sum", a.point_sum[c], e.point_sum[c]);
             if (a.normal_sum[c] != e.normal_sum[c]) return differ("normal_sum", a.normal_sum[c], e.normal_sum[c]);

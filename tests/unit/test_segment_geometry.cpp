@@ -52,13 +52,15 @@ double dot(const std::array<double, 3>& a, const std::array<double, 3>& b) {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-TEST(SegmentGeometry, CovarianceAndDepthRangeMatchTheLabelledPoints) {
+TEST(SegmentGeometry, CovarianceAndDepthRangeMatchTheFillablePoints) {
     synthetic::SceneOptions o;
     o.width = 320;
     o.height = 240;
     o.seed = 11;
     const synthetic::Scene s = synthetic::generate(o);
-    Segmenter seg(s.width, s.height, {}, "cpu", stats_only());
+    Outputs with_mask = stats_only();
+    with_mask.fillable_mask = true;
+    Segmenter seg(s.width, s.height, {}, "cpu", with_mask);
     const Result r = seg.segment(CloudView{s.points.data(), s.normals.data(), s.width, s.height});
     ASSERT_GT(r.segment_count, 3u);
     // Two passes in double over the same pixels: the mean, then the centred products.
@@ -69,24 +71,25 @@ TEST(SegmentGeometry, CovarianceAndDepthRangeMatchTheLabelledPoints) {
     std::vector<double> z_max(k_count, -1e300);
     const std::size_t n = std::size_t(s.width) * std::size_t(s.height);
     for (std::size_t i = 0; i < n; ++i) {
-        if (r.labels[i] == 0) continue;
+        if (r.labels[i] == 0 || r.fillable_mask[i] == 0) continue;
         const std::size_t k = r.labels[i] - 1;
-        for (std::size_t c = 0; c < 3; ++c) mean[k][c] += double(s.points[3 * i + c]) / r.segments[k].pixel_count;
+        for (std::size_t c = 0; c < 3; ++c) mean[k][c] += double(s.points[3 * i + c]) / r.segments[k].fillable_count;
         z_min[k] = std::min(z_min[k], double(s.points[3 * i + 2]));
         z_max[k] = std::max(z_max[k], double(s.points[3 * i + 2]));
     }
     for (std::size_t i = 0; i < n; ++i) {
-        if (r.labels[i] == 0) continue;
+        if (r.labels[i] == 0 || r.fillable_mask[i] == 0) continue;
         const std::size_t k = r.labels[i] - 1;
         std::array<double, 3> d{};
         for (std::size_t c = 0; c < 3; ++c) d[c] = double(s.points[3 * i + c]) - mean[k][c];
         const std::array<double, 6> products = {d[0] * d[0], d[0] * d[1], d[0] * d[2],
                                                 d[1] * d[1], d[1] * d[2], d[2] * d[2]};
-        for (std::size_t j = 0; j < 6; ++j) cov[k][j] += products[j] / r.segments[k].pixel_count;
+        for (std::size_t j = 0; j < 6; ++j) cov[k][j] += products[j] / r.segments[k].fillable_count;
     }
     for (std::size_t k = 0; k < k_count; ++k) {
         const SegmentStats& got = r.segments[k];
-        SCOPED_TRACE("segment " + std::to_string(k + 1) + ", " + std::to_string(got.pixel_count) + " pixels");
+        SCOPED_TRACE("segment " + std::to_string(k + 1) + ", " + std::to_string(got.fillable_count) +
+                     " fillable pixels");
         // Each coordinate is rounded to 1/16 mm: a variance moves by less than about 2 * sigma / 32 + 1/256 mm^2.
         for (std::size_t j = 0; j < 6; ++j) {
             const double scale = std::sqrt(cov[k][0] + cov[k][3] + cov[k][5]);

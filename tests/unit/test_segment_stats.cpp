@@ -28,7 +28,9 @@ Outputs stats_only() {
 
 TEST(SegmentStats, DescribeTheLabelledPixelsOfEachSegment) {
     const synthetic::Scene s = test_scene();
-    Segmenter seg(s.width, s.height, {}, "cpu", stats_only());
+    Outputs with_mask = stats_only();
+    with_mask.fillable_mask = true;
+    Segmenter seg(s.width, s.height, {}, "cpu", with_mask);
     const Result r = seg.segment(CloudView{s.points.data(), s.normals.data(), s.width, s.height});
     ASSERT_GT(r.segment_count, 3u);
     ASSERT_EQ(r.segments.size(), r.segment_count);
@@ -36,6 +38,7 @@ TEST(SegmentStats, DescribeTheLabelledPixelsOfEachSegment) {
     // The exact means, in double, over the same pixels.
     struct Expected {
         std::uint32_t count = 0;
+        std::uint32_t fillable = 0;
         int x_min = 1 << 30, y_min = 1 << 30, x_max = -1, y_max = -1;
         double sum[3] = {0, 0, 0};
         double normal[3] = {0, 0, 0};
@@ -51,6 +54,8 @@ TEST(SegmentStats, DescribeTheLabelledPixelsOfEachSegment) {
             e.y_min = std::min(e.y_min, y);
             e.x_max = std::max(e.x_max, x);
             e.y_max = std::max(e.y_max, y);
+            if (r.fillable_mask[i] == 0) continue;  // the sums are of the fillable pixels
+            ++e.fillable;
             for (int c = 0; c < 3; ++c) {
                 e.sum[c] += double(s.points[3 * i + std::size_t(c)]);
                 e.normal[c] += double(s.normals[3 * i + std::size_t(c)]);
@@ -63,6 +68,8 @@ TEST(SegmentStats, DescribeTheLabelledPixelsOfEachSegment) {
         SCOPED_TRACE("segment " + std::to_string(k + 1));
         EXPECT_EQ(got.label, k + 1);
         EXPECT_EQ(got.pixel_count, e.count);
+        EXPECT_EQ(got.fillable_count, e.fillable);
+        EXPECT_LT(got.fillable_count, got.pixel_count) << "edge pixels are counted, not summed";
         EXPECT_EQ(got.x_min, e.x_min);
         EXPECT_EQ(got.y_min, e.y_min);
         EXPECT_EQ(got.x_max, e.x_max);
@@ -71,7 +78,7 @@ TEST(SegmentStats, DescribeTheLabelledPixelsOfEachSegment) {
         double length = 0;
         for (int c = 0; c < 3; ++c) {
             // Each point is rounded to the nearest 1/16 mm, so the mean is off by at most 1/32 mm.
-            EXPECT_NEAR(got.centroid[c], e.sum[c] / e.count, 1.0 / 32 + 1e-9) << "coordinate " << c;
+            EXPECT_NEAR(got.centroid[c], e.sum[c] / e.fillable, 1.0 / 32 + 1e-9) << "coordinate " << c;
             length += got.mean_normal[c] * got.mean_normal[c];
         }
         EXPECT_NEAR(length, 1.0, 1e-12);
