@@ -66,7 +66,7 @@ void check_metric_parameters(const Params& p) {
     }
 }
 
-void check_color_parameters(const Params& p) {
+void check_color_parameters(const Params& p, Thresholds& t) {
     if (p.color_edge_threshold < 0 || p.color_edge_threshold > kMaxColorEdgeThreshold) {
         bad_parameter("color_edge_threshold must be in 0.." + std::to_string(kMaxColorEdgeThreshold) +
                       " (a sum of R, G and B differences; " + std::to_string(kMaxColorEdgeThreshold) +
@@ -76,6 +76,17 @@ void check_color_parameters(const Params& p) {
         bad_parameter("color_edge_stride must be in 1.." + std::to_string(kMaxColorEdgeStride) + " pixels, got " +
                       std::to_string(p.color_edge_stride));
     }
+    if (!std::isfinite(p.color_edge_curvature_share) || p.color_edge_curvature_share < 0.0 ||
+        p.color_edge_curvature_share > 1.0) {
+        bad_parameter("color_edge_curvature_share must be in [0, 1] (a share of the curvature limit), got " +
+                      std::to_string(p.color_edge_curvature_share));
+    }
+    if (p.metric == Metric::paper && p.color_edge_curvature_share != 0.0) {
+        bad_parameter(
+            "color_edge_curvature_share belongs to the robust metric (metric = robust): it gates colour edges by "
+            "its curvature term");
+    }
+    t.color_curvature_gate = static_cast<std::uint32_t>(std::nearbyint(p.color_edge_curvature_share * 256.0));
 }
 
 void check_planar_parameters(const Params& p) {
@@ -165,7 +176,7 @@ Thresholds compute_thresholds(const Params& params) {
         }
     }
     check_merge_parameters(params, t);
-    check_color_parameters(params);
+    check_color_parameters(params, t);
     check_planar_parameters(params);
     return t;
 }

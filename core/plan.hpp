@@ -25,6 +25,8 @@ struct Thresholds {
     float merge_tolerance_base = 0;
     float merge_tolerance_growth = 0;
     std::uint32_t merge_share = 0;
+    // The colour edge's curvature gate G = rint(color_edge_curvature_share * 256), 0..256 (section 2c).
+    std::uint32_t color_curvature_gate = 0;
 };
 
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.

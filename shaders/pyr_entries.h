@@ -127,7 +127,8 @@ PYR_KERNEL_2D(metric_robust) {
 }
 #endif
 
-/* color_edges (2D, w x h): h, offset of level N, stride, threshold. Step 0c: the fillable pixels on a colour edge
+/* color_edges (2D, w x h): h, offset of level N, stride, threshold, curvature gate G, curvature stride, curvature
+ * base A, curvature growth Bc (the last two float). Step 0c: the fillable pixels on a colour edge that counts
  * cleared. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_COLOR_EDGES)
 PYR_KERNEL_2D(color_edges) {
@@ -137,7 +138,9 @@ PYR_KERNEL_2D(color_edges) {
     if (x >= PYR_W || y >= h) return;
     pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
     if ((PYR_MASK(i) & PYR_MASK_FILLABLE) != 0u &&
-        pyr_color_edge(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(2), PYR_ARG(3)) != 0u) {
+        pyr_color_edge(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(2), PYR_ARG(3)) != 0u &&
+        pyr_color_edge_counts(PYR_ENTRY_CTX, PYR_W, h, x, y, PYR_ARG(4), PYR_ARG(5), PYR_ARG_F32(6), PYR_ARG_F32(7)) !=
+            0u) {
         PYR_STORE_MASK(i, 0u);
     }
 }

@@ -175,6 +175,35 @@ PYR_FN pyr_i32 pyr_robust_dot(PYR_CTX_PARAM, pyr_u32 a, pyr_u32 b) {
     return PYR_QN(a, 0) * PYR_QN(b, 0) + PYR_QN(a, 1) * PYR_QN(b, 1) + PYR_QN(a, 2) * PYR_QN(b, 2);
 }
 
+/* The curvature pairs of pixel (x, y): the normals `stride` pixels before and after it along the 4 axes (horizontal,
+ * vertical, both diagonals), each pair whose two pixels exist and are valid. |sum| <= 4 * 3 * 2^26 < 2^31. */
+PYR_FN PyrCurvaturePairs pyr_robust_curvature_pairs(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y,
+                                                    pyr_u32 stride) {
+    PyrCurvaturePairs pairs;
+    pairs.sum = 0;
+    pairs.count = 0;
+    pyr_i32 st = PYR_I32(stride);
+    for (pyr_i32 axis = 0; axis < 4; ++axis) {
+        pyr_i32 dx = axis == 1 ? 0 : 1;
+        pyr_i32 dy = axis == 0 ? 0 : (axis == 3 ? -1 : 1);
+        pyr_i32 ax = PYR_I32(x) + dx * st;
+        pyr_i32 ay = PYR_I32(y) + dy * st;
+        pyr_i32 bx = PYR_I32(x) - dx * st;
+        pyr_i32 by = PYR_I32(y) - dy * st;
+        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, ax, ay) == 0u) continue;
+        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, bx, by) == 0u) continue;
+        pairs.sum += pyr_robust_dot(PYR_CTX_ARG, PYR_U32(ay) * w + PYR_U32(ax), PYR_U32(by) * w + PYR_U32(bx));
+        ++pairs.count;
+    }
+    return pairs;
+}
+
+/* Section 2b's curvature test with the limit L: 1 iff kp >= 1 and S >= kp * (2^26 - L). kp * (2^26 - L) lies in
+ * [-3 * 2^28, 2^28] since 0 <= L <= 2^28. */
+PYR_FN pyr_u32 pyr_robust_curvature_passes(PyrCurvaturePairs pairs, pyr_i32 limit) {
+    return pairs.count >= 1 && pairs.sum >= pairs.count * (PYR_I32(1 << 26) - limit) ? 1u : 0u;
+}
+
 PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, pyr_u32 x, pyr_u32 y, pyr_u32 stride,
                                           pyr_f32 curvature_base, pyr_f32 curvature_growth, pyr_f32 dt,
                                           pyr_f32 depth_growth) {
@@ -197,27 +226,11 @@ PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, p
             ++k1;
         }
     }
-    /* Curvature: the normals s pixels before and after the pixel along the 4 axes (horizontal, vertical, both
-     * diagonals), each pair whose two pixels exist and are valid. |s| <= 4 * 3 * 2^26 < 2^31. */
-    pyr_i32 kp = 0;
-    pyr_i32 s = 0;
-    pyr_i32 st = PYR_I32(stride);
-    for (pyr_i32 axis = 0; axis < 4; ++axis) {
-        pyr_i32 dx = axis == 1 ? 0 : 1;
-        pyr_i32 dy = axis == 0 ? 0 : (axis == 3 ? -1 : 1);
-        pyr_i32 ax = PYR_I32(x) + dx * st;
-        pyr_i32 ay = PYR_I32(y) + dy * st;
-        pyr_i32 bx = PYR_I32(x) - dx * st;
-        pyr_i32 by = PYR_I32(y) - dy * st;
-        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, ax, ay) == 0u) continue;
-        if (pyr_robust_valid_at(PYR_CTX_ARG, w, h, bx, by) == 0u) continue;
-        s += pyr_robust_dot(PYR_CTX_ARG, PYR_U32(ay) * w + PYR_U32(ax), PYR_U32(by) * w + PYR_U32(bx));
-        ++kp;
+    PyrCurvaturePairs pairs = pyr_robust_curvature_pairs(PYR_CTX_ARG, w, h, x, y, stride);
+    if (k1 == 0 || pairs.count == 0) return 0u;
+    if (pyr_robust_curvature_passes(pairs, pyr_robust_curvature_limit(z, curvature_base, curvature_growth)) == 0u) {
+        return 0u;
     }
-    if (k1 == 0 || kp == 0) return 0u;
-    /* kp * (2^26 - L) lies in [-3 * 2^28, 2^28] since 0 <= L <= 2^28. */
-    pyr_i32 limit = pyr_robust_curvature_limit(z, curvature_base, curvature_growth);
-    if (s < kp * (PYR_I32(1 << 26) - limit)) return 0u;
     PYR_PRECISE pyr_f32 d = dmax - dmin;
     return d <= pyr_robust_depth_limit(z, dt, depth_growth) ? 1u : 0u;
 }

@@ -55,6 +55,14 @@ struct PyrRobustTexel {
     PyrIVec3 tv;
 };
 
+/* The robust metric's curvature pairs across a pixel (docs/algorithm.md section 2b): the sum S of the dot products of
+ * their normals and their count kp. */
+PYR_TYPEDEF(PyrCurvaturePairs)
+struct PyrCurvaturePairs {
+    pyr_i32 sum;
+    pyr_i32 count;
+};
+
 /* A quantized pixel: validity and qn (contract section 2). */
 PYR_TYPEDEF(PyrQuant)
 struct PyrQuant {

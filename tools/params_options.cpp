@@ -49,9 +49,14 @@ const char* const kParameterHelp =
     "  --merge-min-crossings C   a boundary shorter than C crossings never joins (default 16).\n"
     "  --merge-max-bad S     the share of a boundary's crossings that may be concave or steps (0..1, default 0.05).\n"
     "  --color-edge-threshold T   with a colour image (--color), a pixel whose neighbours along its row or column\n"
-    "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (default and every\n"
-    "                        preset: 765, the colour unused).\n"
+    "                        differ by more than T (|dR| + |dG| + |dB|, 0..765) is an edge (default: 765, the\n"
+    "                        colour unused; realsense-d435: 100, with --color-edge-curvature 0.3).\n"
     "  --color-edge-stride S those neighbours lie S pixels either side of it (1..16, default 1).\n"
+    "  --color-edge-curvature G   a colour edge cuts only where the normals across the pixel turn by more than G\n"
+    "                        (0..1) of the curvature limit: a crease too weak for the metric, as where a stereo\n"
+    "                        camera rounds an object's foot into the table, but not print, grain or shadows on a\n"
+    "                        flat or smooth surface (--metric robust; default 0: every colour edge cuts;\n"
+    "                        realsense-d435: 0.3).\n"
     "  --planar-tolerance MM a segment is planar (--stats) when its points lie within MM RMS of their plane\n"
     "                        (default 2 mm), plus --planar-tolerance-per-m2 MM per square metre of depth.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
@@ -76,6 +81,7 @@ const std::set<std::string> kParameterValueOptions = {"ct",
                                                       "merge-max-bad",
                                                       "color-edge-threshold",
                                                       "color-edge-stride",
+                                                      "color-edge-curvature",
                                                       "planar-tolerance",
                                                       "planar-tolerance-per-m2"};
 const std::set<std::string> kParameterFlagOptions = {"no-label-edges", "raw", "merge", "no-merge"};
@@ -128,6 +134,7 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("merge-max-bad")) p.merge_max_bad_share = *v;
     if (auto v = args.integer("color-edge-threshold")) p.color_edge_threshold = *v;
     if (auto v = args.integer("color-edge-stride")) p.color_edge_stride = *v;
+    if (auto v = args.number("color-edge-curvature")) p.color_edge_curvature_share = *v;
     if (auto v = args.number("planar-tolerance")) p.planar_tolerance_mm = *v;
     if (auto v = args.number("planar-tolerance-per-m2")) p.planar_tolerance_per_m2 = *v;
     p.label_edges = !args.flag("no-label-edges");

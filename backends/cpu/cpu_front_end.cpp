@@ -161,14 +161,17 @@ inline uint32_t byte_difference(const std::uint8_t* a, const std::uint8_t* b) {
 
 }  // namespace
 
-// Step 0c: the fillable pixels on a colour edge cleared in level N. The columns whose row neighbours both lie in the
-// image read the caller's bytes directly; the few others go through the shared function (the same test).
+// Step 0c: the fillable pixels on a colour edge that counts (its curvature gate, the shared function) cleared in level
+// N. The columns whose row neighbours both lie in the image read the caller's bytes directly; the few others go
+// through the shared function (the same test).
 void CpuExecutor::color_edges() {
     const PassContext c = context();
     const auto w = uint32_t(plan_.width);
     const auto h = uint32_t(plan_.height);
     const auto s = uint32_t(plan_.params.color_edge_stride);
     const auto threshold = uint32_t(plan_.params.color_edge_threshold);
+    const core::Thresholds& t = plan_.thresholds;
+    const auto curvature_stride = uint32_t(plan_.params.curvature_stride);
     std::uint8_t* mask = mask_.data() + plan_.full().offset;
     rows(size_t(h), [&](size_t y) {
         std::uint8_t* row = mask + y * w;
@@ -186,7 +189,10 @@ void CpuExecutor::color_edges() {
             } else {
                 edge = pixel::pyr_color_edge(c, w, h, x, uint32_t(y), s, threshold) != 0u;
             }
-            if (edge) row[x] = std::uint8_t(row[x] & ~PYR_MASK_FILLABLE);
+            if (edge && pixel::pyr_color_edge_counts(c, w, h, x, uint32_t(y), t.color_curvature_gate, curvature_stride,
+                                                     t.curvature_base, t.curvature_growth) != 0u) {
+                row[x] = std::uint8_t(row[x] & ~PYR_MASK_FILLABLE);
+            }
         }
     });
 }

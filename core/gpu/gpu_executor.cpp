@@ -122,7 +122,9 @@ public:
     void color_edges() override {
         dispatch(Kernel::color_edges, width(), height(),
                  args({height(), plan_.full().offset, uint32_t(plan_.params.color_edge_stride),
-                       uint32_t(plan_.params.color_edge_threshold)}));
+                       uint32_t(plan_.params.color_edge_threshold), plan_.thresholds.color_curvature_gate,
+                       uint32_t(plan_.params.curvature_stride), bits(plan_.thresholds.curvature_base),
+                       bits(plan_.thresholds.curvature_growth)}));
     }
 
     void depth_to_points() override {

@@ -52,6 +52,11 @@ struct Params {
     // ignores the colour).
     int color_edge_threshold = 765;
     int color_edge_stride = 1;  // 1..16
+    // The colour edge's curvature gate (metric = robust only): 0 (the default) lets every colour edge cut; a share g in
+    // (0, 1] lets a colour edge cut only where the normals across the pixel turn by more than g of the curvature limit
+    // (a crease too weak for the metric alone, as where a stereo camera rounds an object's foot into its support), so
+    // that print, grain and shadows on a flat or smooth surface do not cut it.
+    double color_edge_curvature_share = 0.0;
     // Segment statistics (docs/algorithm.md section 10b): a segment is planar when its points' RMS distance to their
     // least-squares plane is at most planar_tolerance_mm + planar_tolerance_per_m2 * z_m^2 millimetres (z_m: its
     // centroid's depth in metres). Only the `planar` flag reads them.

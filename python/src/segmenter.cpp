@@ -123,6 +123,8 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.color_edge_threshold = whole();
     } else if (key == "color_edge_stride") {
         p.color_edge_stride = whole();
+    } else if (key == "color_edge_curvature_share") {
+        p.color_edge_curvature_share = number(kInit, name, v);
     } else if (key == "planar_tolerance_mm") {
         p.planar_tolerance_mm = number(kInit, name, v);
     } else if (key == "planar_tolerance_per_m2") {
@@ -181,7 +183,8 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
                                  "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
                                  "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
-                                 "color_edge_threshold, color_edge_stride, planar_tolerance_mm, "
+                                 "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
+                                 "planar_tolerance_mm, "
                                  "planar_tolerance_per_m2; and preset, "
                                  "outputs, cuda_stream");
         }
@@ -644,8 +647,8 @@ and .params is None until then.
 params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
-merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride (the colour edge term on frames
-given color=); planar_tolerance_mm, planar_tolerance_per_m2 (when a segment's statistics call it planar)
+merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride, color_edge_curvature_share (the
+colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when a segment's statistics call it planar)
 (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
@@ -840,6 +843,7 @@ py::dict params_to_dict(const Params& p) {
     d["merge_max_bad_share"] = p.merge_max_bad_share;
     d["color_edge_threshold"] = p.color_edge_threshold;
     d["color_edge_stride"] = p.color_edge_stride;
+    d["color_edge_curvature_share"] = p.color_edge_curvature_share;
     d["planar_tolerance_mm"] = p.planar_tolerance_mm;
     d["planar_tolerance_per_m2"] = p.planar_tolerance_per_m2;
     return d;

@@ -165,10 +165,12 @@ std::vector<ConformanceCase> build_merge_cases() {
 constexpr int kColorCaseCount = 24;
 
 // Robust scenes with a colour image (docs/algorithm.md section 2c), the merge on in half of them; the colour term's
-// parameters over their ranges, from a stream of their own.
+// parameters over their ranges, from a stream of their own, and its curvature gate from another (so that the scenes
+// and the other parameters stay those of the cases before the gate).
 std::vector<ConformanceCase> build_color_cases() {
     std::vector<ConformanceCase> cases;
     CaseRng rng(20261204);
+    CaseRng gate_rng(20261206);
     const int fixed[][2] = {{1, 1}, {3, 9}, {33, 17}, {640, 480}, {2064, 1544}, {64, 1}};
     for (int i = 0; i < kColorCaseCount; ++i) {
         const bool sized = i < int(std::size(fixed));
@@ -179,6 +181,7 @@ std::vector<ConformanceCase> build_color_cases() {
         c.params.color_edge_threshold = rng.pick({0, 20, 60, 120, 300, 764, kMaxColorEdgeThreshold});
         c.params.color_edge_stride = rng.pick({1, 1, 2, 3, kMaxColorEdgeStride});
         c.color_row_padding = rng.pick({0, 0, 1, 5});
+        c.params.color_edge_curvature_share = gate_rng.pick({0.0, 0.02, 0.1, 0.25, 0.25, 0.5, 0.999, 1.0});
         c.name = "color" + c.name.substr(std::string("robust").size());
         cases.push_back(c);
     }

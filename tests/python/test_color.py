@@ -84,3 +84,42 @@ def test_bad_colour_is_refused():
 def test_params_report_the_colour_term():
     seg = pyrseg.Segmenter(W, H, "cpu", color_edge_threshold=90, color_edge_stride=2)
     assert seg.params["color_edge_threshold"] == 90 and seg.params["color_edge_stride"] == 2
+
+
+def ridge_depth():
+    """Two planes meeting along column W/2 at about 33 degrees, nearest at the ridge: a crease a large ct keeps."""
+    u = np.arange(W, dtype=np.float64)
+    return np.tile(1000 + 3 * np.abs(u - W // 2), (H, 1)).astype(np.uint16)
+
+
+ROBUST = dict(metric="robust", ct=1.0, dt=10.0, color_edge_threshold=100)
+
+
+def test_curvature_gate_leaves_a_flat_surface_whole():
+    ungated = pyrseg.Segmenter(W, H, "cpu", **ROBUST)
+    gated = pyrseg.Segmenter(W, H, "cpu", color_edge_curvature_share=0.3, **ROBUST)
+    assert ungated.segment_depth(flat_depth(), **CAMERA, color=two_colours()).segment_count == 2
+    assert gated.segment_depth(flat_depth(), **CAMERA, color=two_colours()).segment_count == 1
+
+
+def test_curvature_gate_cuts_a_weak_crease_with_a_colour_change():
+    gated = pyrseg.Segmenter(W, H, "cpu", color_edge_curvature_share=0.1, outputs=["fillable_mask"], **ROBUST)
+    plain = gated.segment_depth(ridge_depth(), **CAMERA)
+    assert plain.segment_count == 1  # the metric alone keeps the crease
+    r = gated.segment_depth(ridge_depth(), **CAMERA, color=two_colours())
+    assert r.segment_count == 2
+    assert r.fillable_mask[H // 2, W // 2 - 1] == 0 and r.fillable_mask[H // 2, W // 2] == 0
+    everything_passes = pyrseg.Segmenter(W, H, "cpu", color_edge_curvature_share=1.0, **ROBUST)
+    assert everything_passes.segment_depth(ridge_depth(), **CAMERA, color=two_colours()).segment_count == 1
+
+
+def test_curvature_gate_is_checked():
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(pyrseg.Error) as e:
+            pyrseg.Segmenter(W, H, "cpu", metric="robust", color_edge_curvature_share=bad)
+        assert "color_edge_curvature_share" in e.value.message
+    with pytest.raises(pyrseg.Error) as e:
+        pyrseg.Segmenter(W, H, "cpu", color_edge_curvature_share=0.3)  # the paper metric has no curvature pairs
+    assert "robust" in e.value.message
+    seg = pyrseg.Segmenter(W, H, "cpu", preset="realsense-d435")
+    assert seg.params["color_edge_threshold"] == 100 and seg.params["color_edge_curvature_share"] == 0.3

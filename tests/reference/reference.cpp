@@ -146,6 +146,14 @@ std::string check_params(int width, int height, const Params& p) {
     if (std::string why = check_merge_params(p); !why.empty()) return why;
     if (p.color_edge_threshold < 0 || p.color_edge_threshold > 765) return "color_edge_threshold must be in 0..765";
     if (p.color_edge_stride < 1 || p.color_edge_stride > 16) return "color_edge_stride must be in 1..16";
+    // Written so that NaN fails too.
+    if (!(p.color_edge_curvature_share >= 0.0 && p.color_edge_curvature_share <= 1.0)) {
+        return "color_edge_curvature_share must be in [0, 1]";
+    }
+    // Robust only (section 2c). Compared as doubles on purpose: -0.0 equals the default 0.
+    if (p.metric != Metric::robust && !(p.color_edge_curvature_share == 0.0)) {
+        return "color_edge_curvature_share must keep its default (0) with metric paper";
+    }
     const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
     if (pixels > kMaxU32) return "image too large: W*H does not fit in 32 bits";
     return {};
@@ -523,12 +531,13 @@ DepthSpread depth_spread(const float* points, const std::vector<std::uint8_t>& v
     return out;
 }
 
-std::vector<std::uint8_t> metric(const float* points, const float* normals, const std::vector<std::uint8_t>& valid,
-                                 std::int64_t width, std::int64_t height, const Params& p) {
+// qn: section 2's quantization of the normals (quantize_normals).
+std::vector<std::uint8_t> metric(const float* points, const QuantizedNormals& qn,
+                                 const std::vector<std::uint8_t>& valid, std::int64_t width, std::int64_t height,
+                                 const Params& p) {
     const std::int64_t tc = curvature_threshold(p.ct);
     const auto dt_units = static_cast<float>(p.dt / p.unit_mm);
     const std::size_t count = valid.size();
-    const QuantizedNormals qn = quantize_normals(normals, valid);
     std::vector<std::uint8_t> fillable(count, 0);
     for (std::int64_t y = 0; y < height; ++y) {
         for (std::int64_t x = 0; x < width; ++x) {
@@ -589,11 +598,10 @@ float depth_limit(const RobustConstants& k, float z) {
     return d;
 }
 
-std::vector<std::uint8_t> robust_metric(const float* points, const float* normals,
+// qn: section 2's quantization of the normals (quantize_normals); k: robust_constants(p).
+std::vector<std::uint8_t> robust_metric(const float* points, const QuantizedNormals& qn,
                                         const std::vector<std::uint8_t>& valid, std::int64_t width, std::int64_t height,
-                                        const Params& p) {
-    const RobustConstants k = robust_constants(p);
-    const QuantizedNormals qn = quantize_normals(normals, valid);
+                                        const Params& p, const RobustConstants& k) {
     const std::int64_t two26 = std::int64_t{1} << 26;
     std::vector<std::uint8_t> fillable(valid.size(), 0);
     for (std::int64_t y = 0; y < height; ++y) {
@@ -1146,12 +1154,27 @@ std::vector<float> estimate_robust_normals(const float* points, int width, int h
     return normals_from_q(robust_normals_q(points, width, height, radius, window, unit_mm));
 }
 
-// Section 2c: B cleared at every colour edge (both pixels of an axis in the image, their colours more than T apart).
+namespace {
+
+// Section 2c's curvature gate: G = rint(g * 256), round half to even (std::nearbyint in the default rounding mode),
+// an integer 0..256.
+std::int64_t curvature_gate(const Params& p) {
+    return static_cast<std::int64_t>(std::nearbyint(p.color_edge_curvature_share * 256.0));
+}
+
+// Section 2c: B cleared at every colour edge (both pixels of an axis in the image, their colours more than T apart)
+// that counts. With G = 0 every colour edge counts. With G > 0 (robust metric only) a colour edge counts only where
+// it would fail section 2b's curvature test with the limit Lg = floor(L * G / 256) in place of L: the same L (from
+// the pixel's own depth), the same pairs at curvature_stride over the same quantized normals qn as the metric, with
+// k = robust_constants(params).
 void clear_color_edges(std::vector<std::uint8_t>& fillable, const std::uint8_t* color, int width, int height,
-                       const Params& params) {
+                       const Params& params, const float* points, const std::vector<std::uint8_t>& valid,
+                       const QuantizedNormals& qn, const RobustConstants& k) {
     const std::int64_t w = width;
     const std::int64_t h = height;
     const std::int64_t s = params.color_edge_stride;
+    const std::int64_t gate = curvature_gate(params);
+    const std::int64_t two26 = std::int64_t{1} << 26;
     const auto differ = [&](std::int64_t xa, std::int64_t ya, std::int64_t xb, std::int64_t yb) {
         const std::uint8_t* a = color + 3 * (ya * w + xa);
         const std::uint8_t* b = color + 3 * (yb * w + xb);
@@ -1159,14 +1182,28 @@ void clear_color_edges(std::vector<std::uint8_t>& fillable, const std::uint8_t* 
         for (int c = 0; c < 3; ++c) d += std::abs(std::int64_t(a[c]) - std::int64_t(b[c]));
         return d > params.color_edge_threshold;
     };
+    // Whether colour edge pixel (x, y) counts. Only asked of fillable pixels (so valid ones, with a finite depth > 0):
+    // clearing a pixel whose B is already 0 changes nothing.
+    const auto counts = [&](std::int64_t x, std::int64_t y) {
+        if (gate == 0) return true;
+        const auto i = static_cast<std::size_t>(y * w + x);
+        const std::int64_t l = curvature_limit(k, points[3 * i + 2]);
+        const std::int64_t lg = (l >> 8) * gate + (((l & 255) * gate) >> 8);  // floor(L * G / 256), exact
+        const CurvatureSum curv = pair_curvature_sum(qn, valid, w, h, x, y, params.curvature_stride);
+        return curv.k >= 1 && curv.s < curv.k * (two26 - lg);
+    };
     for (std::int64_t y = 0; y < h; ++y) {
         for (std::int64_t x = 0; x < w; ++x) {
+            const auto i = static_cast<std::size_t>(y * w + x);
+            if (fillable[i] == 0) continue;
             const bool along_x = x - s >= 0 && x + s <= w - 1 && differ(x - s, y, x + s, y);
             const bool along_y = y - s >= 0 && y + s <= h - 1 && differ(x, y - s, x, y + s);
-            if (along_x || along_y) fillable[std::size_t(y * w + x)] = 0;
+            if ((along_x || along_y) && counts(x, y)) fillable[i] = 0;
         }
     }
 }
+
+}  // namespace
 
 Output segment(const float* points, const float* normals, int width, int height, const Params& params,
                const std::uint8_t* color) {
@@ -1190,9 +1227,11 @@ Output segment(const float* points, const float* normals, int width, int height,
     for (std::size_t i = 0; i < count; ++i) {
         valid[i] = (point_valid(points + 3 * i) && normal_valid(used.data() + 3 * i)) ? 1 : 0;
     }
-    std::vector<std::uint8_t> fillable = robust ? robust_metric(points, used.data(), valid, width, height, params)
-                                                : metric(points, used.data(), valid, width, height, params);
-    if (color != nullptr) clear_color_edges(fillable, color, width, height, params);
+    const QuantizedNormals qn = quantize_normals(used.data(), valid);
+    const RobustConstants k = robust_constants(params);
+    std::vector<std::uint8_t> fillable = robust ? robust_metric(points, qn, valid, width, height, params, k)
+                                                : metric(points, qn, valid, width, height, params);
+    if (color != nullptr) clear_color_edges(fillable, color, width, height, params, points, valid, qn, k);
     Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan, points, used.data());
     out.segments = segment_statistics(out, points, used.data(), width, params);
     out.normals = std::move(used);

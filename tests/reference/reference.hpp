@@ -43,9 +43,11 @@ struct Params {
     double merge_tolerance_per_m2 = 0.0;  // t2, finite, >= 0: millimetres added to t0 per square metre of depth
     int merge_min_crossings = 16;         // C >= 1: crossings a pair needs to join
     double merge_max_bad_share = 0.05;    // f in [0, 1]: the largest share of bad crossings a joining pair may have
-    // Section 2c: the colour edge term, on frames given a colour image. Checked against their ranges always.
-    int color_edge_threshold = 765;  // T, 0..765; 765: no pixel is a colour edge
-    int color_edge_stride = 1;       // s, 1..16
+    // Section 2c: the colour edge term, on frames given a colour image. Checked against their ranges always; the
+    // curvature gate g must also keep its default (0) with Metric::paper.
+    int color_edge_threshold = 765;           // T, 0..765; 765: no pixel is a colour edge
+    int color_edge_stride = 1;                // s, 1..16
+    double color_edge_curvature_share = 0.0;  // g, finite, in [0, 1]; 0: every colour edge counts; robust only
 };
 
 // Exact sums of products (a product of two fixed-point coordinates is below 2^62 in magnitude).

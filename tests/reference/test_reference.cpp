@@ -2609,4 +2609,268 @@ TEST(ReferenceMerge, ParameterErrors) {
     EXPECT_TRUE(pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, Params{}).ok);
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// The colour edge term's curvature gate (docs/algorithm.md section 2c). G = rint(g * 256), round half to even. With
+// G > 0 a colour edge pixel counts (B cleared) iff kp >= 1 and S < kp * (2^26 - Lg), Lg = (L >> 8) * G +
+// (((L & 255) * G) >> 8) = floor(L * G / 256), with L, S and kp those of section 2b's curvature test.
+// ct = 0.25 (the default): L = 2086252 = 8149 * 256 + 108 while Bc = 0, so Lg = 8149 * G + ((108 * G) >> 8):
+//   G = 2: 16298, G = 3: 24448, G = 64: 521563, G = 128: 1043126, G = 192: 1564689, G = 256: 2086252 = L.
+//
+// The scenes: 13 x 7, robust metric at curvature_stride 2, colour (200, 40, 40) for x <= 6 and (40, 160, 40) for
+// x >= 7 (D = 160 + 120 = 280 > T = 100), colour_edge_stride 1: the colour edges are the pixels of columns 6 (c(5)
+// vs c(7)) and 7 (c(6) vs c(8)), every row, and no others (no vertical ones). A pixel has a horizontal pair iff
+// 2 <= x <= 10, a vertical one iff 2 <= y <= 4, diagonal ones only when it has both.
+
+Params gate_params(double g) {
+    Params p = robust_params();
+    p.curvature_stride = 2;
+    p.color_edge_threshold = 100;
+    p.color_edge_stride = 1;
+    p.color_edge_curvature_share = g;
+    return p;
+}
+
+// R, G, B per pixel: `left` for x <= last_left, `right` for the others, every row.
+std::vector<std::uint8_t> split_colors(int w, int h, int last_left, const std::vector<std::uint8_t>& left,
+                                       const std::vector<std::uint8_t>& right) {
+    std::vector<std::uint8_t> c;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const std::vector<std::uint8_t>& rgb = x <= last_left ? left : right;
+            c.insert(c.end(), rgb.begin(), rgb.end());
+        }
+    }
+    return c;
+}
+
+const std::vector<std::uint8_t> kRed = {200, 40, 40};
+const std::vector<std::uint8_t> kGreen = {40, 160, 40};
+
+// The fillable mask of segment() with the colour image; normals empty: estimated.
+std::vector<std::uint8_t> gated(const std::vector<float>& pts, const std::vector<float>& normals, int w, int h,
+                                const std::vector<std::uint8_t>& color, const Params& p) {
+    Output out = pyrseg_ref::segment(pts.data(), normals.empty() ? nullptr : normals.data(), w, h, p, color.data());
+    EXPECT_TRUE(out.ok) << out.error;
+    return out.fillable;
+}
+
+TEST(ReferenceColorGate, FlatTexturedPlaneKeepsItsColourEdgesFillable) {
+    // z = 1000, every normal frontal: every pair has S = 2^26 per pair, so every pixel with a pair is fillable (the
+    // plus below), and S = kp * 2^26 >= kp * (2^26 - Lg) for any Lg >= 0: with G > 0 no colour edge counts.
+    // G = 0 (g = 0, or g = 0.5 / 256, which rounds half to even to 0) clears columns 6 and 7; g = 1.5 / 256 rounds
+    // to G = 2 (Lg = 16298): nothing cleared, like g = 0.25 and g = 1. (Rounding half up would give G = 1 for
+    // 0.5 / 256, a gate, and keep the columns.)
+    const int w = 13;
+    const int h = 7;
+    const std::vector<float> pts = grid_points(w, h, [](int, int) { return 1000.0f; });
+    const std::vector<float> front = constant_normals(w * h, 0.0f, 0.0f, -1.0f);
+    const std::vector<std::uint8_t> color = split_colors(w, h, 6, kRed, kGreen);
+    const std::vector<std::uint8_t> plus = mask_of({
+        "..#########..",  //
+        "..#########..",  //
+        "#############",  //
+        "#############",  //
+        "#############",  //
+        "..#########..",  //
+        "..#########..",  //
+    });
+    const std::vector<std::uint8_t> cut = mask_of({
+        "..####..###..",  //
+        "..####..###..",  //
+        "######..#####",  //
+        "######..#####",  //
+        "######..#####",  //
+        "..####..###..",  //
+        "..####..###..",  //
+    });
+    // Without a colour image, or with T = 765: the metric's mask.
+    Output plain = pyrseg_ref::segment(pts.data(), front.data(), w, h, gate_params(0.0));
+    ASSERT_TRUE(plain.ok) << plain.error;
+    EXPECT_EQ(plain.fillable, plus);
+    Params t765 = gate_params(0.0);
+    t765.color_edge_threshold = 765;
+    EXPECT_EQ(gated(pts, front, w, h, color, t765), plus);
+
+    EXPECT_EQ(gated(pts, front, w, h, color, gate_params(0.0)), cut);
+    EXPECT_EQ(gated(pts, front, w, h, color, gate_params(0.5 / 256.0)), cut);
+    EXPECT_EQ(gated(pts, front, w, h, color, gate_params(1.5 / 256.0)), plus);
+    EXPECT_EQ(gated(pts, front, w, h, color, gate_params(0.25)), plus);
+    EXPECT_EQ(gated(pts, front, w, h, color, gate_params(1.0)), plus);
+
+    // The same with the normals estimated (section 8b): on the flat grid every one is (0, 0, -8192), so the gate
+    // reads the same pairs from the normals the metric used.
+    Output estimated = pyrseg_ref::segment(pts.data(), nullptr, w, h, gate_params(0.25), color.data());
+    ASSERT_TRUE(estimated.ok) << estimated.error;
+    EXPECT_EQ(estimated.normals, front);
+    EXPECT_EQ(estimated.fillable, plus);
+    EXPECT_EQ(gated(pts, {}, w, h, color, gate_params(0.0)), cut);
+}
+
+TEST(ReferenceColorGate, WeakCreaseWithAColourChangeIsCut) {
+    // Two planes meeting at column 6 at a shallow angle (each tilted by 1/8, z = 1000 + |x - 6| / 8): normals
+    // nL = (-1016, 0, -8129) for x <= 5, frontal (0, 0, -8192) at x = 6, nR = (1016, 0, -8129) for x >= 7 (given).
+    // Pair dot products: nL.nL = nR.nR = 67112897, nL.nC = nR.nC = 66592768, nL.nR = 8129^2 - 1016^2 = 65048385,
+    // each >= 2^26 - L = 65022612: the metric keeps every pixel with a pair (the plus of the flat scene), the crease
+    // too (1 - cos across it is 2060479 / 2^26 = 0.0307 at most, below ct's 1 - cos(0.25) = 0.0311). d <= 1/8.
+    // The colour edge pixels, columns 6 and 7, straddle the crease (their pairs at stride 2 reach x = 4..9):
+    //   rows 0, 1, 5, 6: only the horizontal pair, nR.nL: kp = 1, S = 65048385; counts iff Lg < 2060479.
+    //   rows 2..4, column 6: 3 * nR.nL + nC.nC = 262254019, kp = 4; counts iff 4 * Lg < 2^28 - S = 6181437.
+    //   rows 2..4, column 7: 3 * nR.nL + nR.nR = 262258052, kp = 4; counts iff 4 * Lg < 6177404.
+    // G = 64 (Lg = 521563) and G = 128 (1043126): every one counts. G = 192 (1564689): rows 0, 1, 5, 6 only (a gate
+    // that looked at stride 1 would see kp = 4 and S = 262254019 or 262258052 in rows 1 and 5 too, and keep them).
+    // G = 256 (Lg = L): none (they passed the metric's test with L).
+    const int w = 13;
+    const int h = 7;
+    const std::vector<float> pts =
+        grid_points(w, h, [](int x, int) { return 1000.0f + static_cast<float>(x > 6 ? x - 6 : 6 - x) / 8.0f; });
+    std::vector<float> nrm;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const std::vector<float> n =
+                x < 6 ? q13(-1016, 0, -8129) : (x == 6 ? q13(0, 0, -8192) : q13(1016, 0, -8129));
+            nrm.insert(nrm.end(), n.begin(), n.end());
+        }
+    }
+    const std::vector<std::uint8_t> color = split_colors(w, h, 6, kRed, kGreen);
+    const std::vector<std::uint8_t> plus = mask_of({
+        "..#########..",  //
+        "..#########..",  //
+        "#############",  //
+        "#############",  //
+        "#############",  //
+        "..#########..",  //
+        "..#########..",  //
+    });
+    const std::vector<std::uint8_t> cut = mask_of({
+        "..####..###..",  //
+        "..####..###..",  //
+        "######..#####",  //
+        "######..#####",  //
+        "######..#####",  //
+        "..####..###..",  //
+        "..####..###..",  //
+    });
+    const std::vector<std::uint8_t> outer_rows_cut = mask_of({
+        "..####..###..",  //
+        "..####..###..",  //
+        "#############",  //
+        "#############",  //
+        "#############",  //
+        "..####..###..",  //
+        "..####..###..",  //
+    });
+    Output plain = pyrseg_ref::segment(pts.data(), nrm.data(), w, h, gate_params(0.0));
+    ASSERT_TRUE(plain.ok) << plain.error;
+    EXPECT_EQ(plain.fillable, plus);  // the crease is too weak for the metric
+
+    EXPECT_EQ(gated(pts, nrm, w, h, color, gate_params(0.0)), cut);
+    EXPECT_EQ(gated(pts, nrm, w, h, color, gate_params(0.25)), cut);
+    EXPECT_EQ(gated(pts, nrm, w, h, color, gate_params(0.5)), cut);
+    EXPECT_EQ(gated(pts, nrm, w, h, color, gate_params(0.75)), outer_rows_cut);
+    EXPECT_EQ(gated(pts, nrm, w, h, color, gate_params(1.0)), plus);
+}
+
+// A W x 1 row at curvature_stride 1 with colour (0, 0, 0) but for the last pixel, (255, 255, 255): in a 3 x 1 row
+// pixel 1 is the only colour edge (D(c(0), c(2)) = 765 > T = 100) and the only pixel with a pair (0 and 2, kp = 1):
+// it is fillable iff S = qn_0 . qn_2 >= 2^26 - L, and then cleared iff S < 2^26 - Lg. Its own normal takes no part.
+std::vector<std::uint8_t> gated_row(const std::vector<float>& z, const std::vector<std::vector<float>>& normals,
+                                    Params p) {
+    p.metric = pyrseg_ref::Metric::robust;
+    p.curvature_stride = 1;
+    p.color_edge_threshold = 100;
+    p.color_edge_stride = 1;
+    const int w = static_cast<int>(z.size());
+    const std::vector<float> pts = grid_points(w, 1, [&](int x, int) { return z[static_cast<std::size_t>(x)]; });
+    std::vector<float> nrm;
+    for (const std::vector<float>& n : normals) nrm.insert(nrm.end(), n.begin(), n.end());
+    return gated(pts, nrm, w, 1, split_colors(w, 1, w - 2, {0, 0, 0}, {255, 255, 255}), p);
+}
+
+TEST(ReferenceColorGate, LimitIsFloorOfLTimesGOver256AndTheTestIsStrict) {
+    // qn_0 = (1, 0, -8192) and qn_2 = (c, 0, -d): S = c + 8192 d.
+    const std::vector<float> z(3, 1000.0f);
+    const std::vector<float> tilted = q13(1, 0, -8192);
+    const std::vector<std::uint8_t> kept = {0, 1, 0};
+    const std::vector<std::uint8_t> cleared = {0, 0, 0};
+    Params p;
+    p.color_edge_curvature_share = 0.25;  // G = 64, Lg = 521563, 2^26 - Lg = 66587301
+    // S = 2724 + 8192 * 8128 = 66587300 counts; 66587301 does not. (Lg without the low byte's share, 521536, would
+    // clear both; Lg rounded up, 521564, would clear neither.)
+    EXPECT_EQ(gated_row(z, {tilted, kFront, q13(2724, 0, -8128)}, p), cleared);
+    EXPECT_EQ(gated_row(z, {tilted, kFront, q13(2725, 0, -8128)}, p), kept);
+    // g = 2.5 / 256 rounds half to even to G = 2: Lg = 16298, 2^26 - Lg = 67092566. S = 85 + 8192 * 8190 =
+    // 67092565 counts, 67092566 does not. (G = 3, Lg = 24448, would count neither.)
+    p.color_edge_curvature_share = 2.5 / 256.0;
+    EXPECT_EQ(gated_row(z, {tilted, kFront, q13(85, 0, -8190)}, p), cleared);
+    EXPECT_EQ(gated_row(z, {tilted, kFront, q13(86, 0, -8190)}, p), kept);
+    p.color_edge_curvature_share = 3.0 / 256.0;
+    EXPECT_EQ(gated_row(z, {tilted, kFront, q13(85, 0, -8190)}, p), kept);
+
+    // L from the pixel's own depth (section 2b's growth): ct_growth_per_m2 = 0.01 gives L = 2274014 = 8882 * 256 +
+    // 222 at z = 3000 and L = 2091467 = 8169 * 256 + 203 at z = 500 (see CurvatureGrowthMakesANoisyFarSurfaceFillable).
+    // G = 128: Lg = 1137007 (2^26 - Lg = 65971857) at 3000, 1045733 (66063131) at 500; without the growth 1043126
+    // (66065738). S = kFront . (0, 0, -8060) = 66027520 (fillable in every case: >= 2^26 - 2086252) counts at 500 and
+    // without the growth, not at 3000.
+    const std::vector<std::vector<float>> weak = {kFront, kFront, q13(0, 0, -8060)};
+    p.color_edge_curvature_share = 0.5;
+    EXPECT_EQ(gated_row(std::vector<float>(3, 3000.0f), weak, p), cleared);
+    p.ct_growth_per_m2 = 0.01;
+    EXPECT_EQ(gated_row(std::vector<float>(3, 3000.0f), weak, p), kept);
+    EXPECT_EQ(gated_row(std::vector<float>(3, 500.0f), weak, p), cleared);
+    p.ct_growth_per_m2 = 0.0;
+
+    // ct >= pi: L = 2^28, and every pair passes the metric, even opposed ones: (1, 1, 1) . (-1, -1, -1) gives
+    // S = -3 * 2^26 = -201326592 = 2^26 - 2^28. G = 255: Lg = 2^20 * 255 = 267386880 (L * G itself overflows 32
+    // bits), 2^26 - Lg = -200278016 > S: counts. G = 256: Lg = L, S is not below 2^26 - L: kept.
+    p.ct = std::numbers::pi;
+    const std::vector<std::vector<float>> opposed = {{1.0f, 1.0f, 1.0f}, kFront, {-1.0f, -1.0f, -1.0f}};
+    p.color_edge_curvature_share = 255.0 / 256.0;
+    EXPECT_EQ(gated_row(z, opposed, p), cleared);
+    p.color_edge_curvature_share = 1.0;
+    EXPECT_EQ(gated_row(z, opposed, p), kept);
+    p.color_edge_curvature_share = 0.0;
+    EXPECT_EQ(gated_row(z, opposed, p), cleared);
+}
+
+TEST(ReferenceColorGate, ParameterErrors) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const std::vector<std::uint8_t> color(3 * 256, 0);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // Rejected by every entry point, colour image or none, with a message naming the parameter.
+    const auto rejected_for = [&](const Params& p, const std::string& name) {
+        const Output a = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+        const Output b = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p, color.data());
+        const Output c = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+        for (const Output* o : {&a, &b, &c}) {
+            if (o->ok || o->error.find(name) == std::string::npos) return false;
+        }
+        return true;
+    };
+    const auto accepted = [&](const Params& p) {
+        return pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok &&
+               pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p, color.data()).ok &&
+               pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p).ok;
+    };
+    const auto with = [](Params p, double g) {
+        p.color_edge_curvature_share = g;
+        return p;
+    };
+    const Params paper;
+    const Params robust = robust_params();
+    for (double bad : {-0.1, 1.5, nan, inf, -inf, std::nextafter(1.0, 2.0), -std::numeric_limits<double>::min()}) {
+        EXPECT_TRUE(rejected_for(with(robust, bad), "color_edge_curvature_share")) << bad;
+        EXPECT_TRUE(rejected_for(with(paper, bad), "color_edge_curvature_share")) << bad;
+    }
+    for (double good : {0.0, -0.0, 0.25, 0.5, 1.0}) EXPECT_TRUE(accepted(with(robust, good))) << good;
+    // Robust only: with the paper metric it must keep its default.
+    EXPECT_TRUE(rejected_for(with(paper, 0.5), "color_edge_curvature_share"));
+    EXPECT_TRUE(rejected_for(with(paper, 1.0), "color_edge_curvature_share"));
+    EXPECT_TRUE(rejected_for(with(paper, 1.0 / 1024.0), "color_edge_curvature_share"));  // G = 0, still not 0
+    EXPECT_TRUE(accepted(with(paper, 0.0)));
+    EXPECT_TRUE(accepted(with(paper, -0.0)));
+}
+
 }  // namespace

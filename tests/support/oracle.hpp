@@ -52,6 +52,7 @@ inline pyrseg_ref::Params to_reference(const Params& p) {
     r.merge_max_bad_share = p.merge_max_bad_share;
     r.color_edge_threshold = p.color_edge_threshold;
     r.color_edge_stride = p.color_edge_stride;
+    r.color_edge_curvature_share = p.color_edge_curvature_share;
     return r;
 }
 
