@@ -2,7 +2,8 @@
 // device) (with the paper's metric, and as pipeline_robust with the robust metric of
 // the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
 // pipeline_robust_merge with the preset's merge, as pipeline_robust_merge_stats with the segment statistics, and as
-// pipeline_robust_merge_color with a colour image and the colour edge term as well) (points, with estimated or given
+// pipeline_robust_merge_color with a colour image and the colour edge term as well, pipeline_robust_merge_color_gated
+// with its curvature gate) (points, with estimated or given
 // normals, to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame
 // size, next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers,
 // carry between machines.
@@ -170,6 +171,15 @@ int register_all() {
                 benchmark::RegisterBenchmark(
                     ("pipeline_robust_merge_color/" + b.name + "/" + suffix).c_str(),
                     [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, colored); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // And with the colour edges gated by curvature (as the realsense-d435 preset does): the difference to
+                // pipeline_robust_merge_color is the gate's cost and the segmentation it changes.
+                Params gated = colored;
+                gated.color_edge_curvature_share = 0.3;
+                benchmark::RegisterBenchmark(
+                    ("pipeline_robust_merge_color_gated/" + b.name + "/" + suffix).c_str(),
+                    [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, gated); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
             }

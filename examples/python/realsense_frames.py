@@ -5,7 +5,8 @@
     python3 realsense_frames.py --live [--frames 100]          # needs pyrealsense2 and a camera
 
 FOLDER holds the frames as the RealSense SDK or ROS record them: 16-bit PNGs in the camera's depth units (*_depth.png
-when the folder also holds colour images, else every .png). The intrinsics come from an OpenCV FileStorage file
+when the folder also holds colour images, else every .png); a frame NAME_depth.png segments with NAME_color.png, its
+colour image registered to the depth, when there is one. The intrinsics come from an OpenCV FileStorage file
 (--calib; FOLDER/camera.yml when there is one: fx fy cx cy, or a 3x3 camera matrix) or --intrinsics fx,fy,cx,cy;
 the depth scale from --metres-per-unit (the SDK's get_depth_scale(): 0.001 on the D400 series, 0.0001 on a D405).
 One Segmenter and one labels array serve every frame. Each frame's segments are written as a colour picture,
@@ -45,13 +46,13 @@ class FrameLoop:
         self.labels = None
         self.times = []
 
-    def segment(self, name, depth, k, metres_per_unit):
+    def segment(self, name, depth, k, metres_per_unit, color=None):
         if self.seg is None:
             h, w = depth.shape
             self.seg = pyrseg.Segmenter(w, h, self.args.backend, preset=self.args.preset)
             self.labels = np.empty((h, w), np.uint32)
         start = time.perf_counter()
-        r = self.seg.segment_depth(depth, *k, metres_per_unit=metres_per_unit, out=self.labels)
+        r = self.seg.segment_depth(depth, *k, metres_per_unit=metres_per_unit, color=color, out=self.labels)
         ms = (time.perf_counter() - start) * 1000
         self.times.append(ms)
         note = " (first frame: includes warm-up)" if len(self.times) == 1 else ""
@@ -78,7 +79,10 @@ def recorded(args):
     loop = FrameLoop(args)
     for path in files:
         depth = pyrseg.io.read_depth_image(path)  # H x W uint16, the camera's units: read in place
-        loop.segment(path.name, depth, k, args.metres_per_unit)
+        color_path = path.with_name(path.name.replace("_depth.png", "_color.png"))
+        # The registered colour image, where the folder has one: the preset's colour edges (docs/algorithm.md 2c).
+        color = pyrseg.io.read_png(color_path) if path.name.endswith("_depth.png") and color_path.exists() else None
+        loop.segment(path.name, depth, k, args.metres_per_unit, color)
         out = out_dir / (path.stem + ".segments.png")
         pyrseg.io.write_png_rgb(out, pyrseg.io.colorize_labels(loop.labels))
     loop.summary()
