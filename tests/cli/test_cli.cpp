@@ -25,6 +25,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A 640 x 480 labels file the CLI wrote (--labels OUT.npy), and the label at (x, y) in it.
+std::vector<std::uint32_t> realsense_labels(const fs::path& path) {
+    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(path);
+    EXPECT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
+    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
+    std::memcpy(labels.data(), npy.bytes.data(), std::min(labels.size() * 4, npy.bytes.size()));
+    return labels;
+}
+
+std::uint32_t label_at(const std::vector<std::uint32_t>& labels, int x, int y) {
+    return labels[std::size_t(y) * 640 + std::size_t(x)];
+}
+
 using pyrseg::cli_test::CliRun;
 using pyrseg::cli_test::run;
 using pyrseg::cli_test::run_with_env;
@@ -332,11 +345,8 @@ void expect_scene_segmented(const fs::path& scan, const std::string& options, co
     const fs::path labels_path = dir / "labels.npy";
     const CliRun r = run("segment " + scan.string() + " " + options + " --labels " + labels_path.string());
     ASSERT_EQ(r.status, 0) << r.output;
-    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
-    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
-    std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
-    const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
+    const std::vector<std::uint32_t> labels = realsense_labels(labels_path);
+    const auto at = [&](int x, int y) { return label_at(labels, x, y); };
     const std::uint32_t surface = at(e.surface[0].first, e.surface[0].second);
     ASSERT_NE(surface, 0u);
     for (const auto& [x, y] : e.surface) EXPECT_EQ(at(x, y), surface) << "surface point (" << x << ", " << y << ")";
@@ -418,32 +428,23 @@ TEST(Cli, RealSenseColourSeparatesTheWhiteBowlFromTheTable) {
     const fs::path dir = temp_dir();
     const std::string frame = (data / "wood_table_3_depth.png").string() + " --calib " +
                               (data / "camera.yml").string() + " --sensor realsense-d435 --labels ";
-    const auto labels_of = [](const fs::path& path) {
-        const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(path);
-        EXPECT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-        std::vector<std::uint32_t> labels(std::size_t{640} * 480);
-        std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
-        return labels;
-    };
-    const auto at = [](const std::vector<std::uint32_t>& labels, int x, int y) {
-        return labels[std::size_t(y) * 640 + std::size_t(x)];
-    };
     CliRun r = run("segment " + frame + (dir / "depth.npy").string());
     ASSERT_EQ(r.status, 0) << r.output;
-    const std::vector<std::uint32_t> depth_only = labels_of(dir / "depth.npy");
-    EXPECT_EQ(at(depth_only, 460, 290), at(depth_only, 200, 400)) << "without colour the bowl is the table's";
+    const std::vector<std::uint32_t> depth_only = realsense_labels(dir / "depth.npy");
+    EXPECT_EQ(label_at(depth_only, 460, 290), label_at(depth_only, 200, 400))
+        << "without colour the bowl is the table's";
     // The preset's colour term, as the README tells a RealSense user to run it.
     r = run("segment " + frame + (dir / "color.npy").string() + " --color " +
             (data / "wood_table_3_color.png").string());
     ASSERT_EQ(r.status, 0) << r.output;
-    const std::vector<std::uint32_t> labels = labels_of(dir / "color.npy");
-    const std::uint32_t bowl = at(labels, 460, 290);
+    const std::vector<std::uint32_t> labels = realsense_labels(dir / "color.npy");
+    const std::uint32_t bowl = label_at(labels, 460, 290);
     ASSERT_NE(bowl, 0u);
-    EXPECT_EQ(at(labels, 440, 300), bowl);
-    const std::uint32_t table = at(labels, 200, 400);
+    EXPECT_EQ(label_at(labels, 440, 300), bowl);
+    const std::uint32_t table = label_at(labels, 200, 400);
     EXPECT_NE(table, 0u);
     EXPECT_NE(table, bowl);
-    EXPECT_EQ(at(labels, 600, 450), table);
+    EXPECT_EQ(label_at(labels, 600, 450), table);
     std::size_t inside = 0, outside = 0;
     for (std::size_t i = 0; i < labels.size(); ++i) {
         if (labels[i] != bowl) continue;
@@ -457,6 +458,40 @@ TEST(Cli, RealSenseColourSeparatesTheWhiteBowlFromTheTable) {
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.output.find("8-bit RGB"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "bad.npy"));
+    fs::remove_all(dir);
+}
+
+// office_table_7's yellow toy brick: its foot is rounded into the table by the stereo matcher, so with the depth alone
+// it is the table's segment; with the colour image the preset's gated colour edges cut it out whole.
+TEST(Cli, RealSenseColourSeparatesTheToyBrickFromTheTable) {
+    const fs::path data = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
+    if (!fs::exists(data / "office_table_7_color.png")) GTEST_SKIP() << "RealSense frames not present: " << data;
+    const fs::path dir = temp_dir();
+    const std::string frame = (data / "office_table_7_depth.png").string() + " --calib " +
+                              (data / "camera.yml").string() + " --sensor realsense-d435 --labels ";
+    CliRun r = run("segment " + frame + (dir / "depth.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::vector<std::uint32_t> depth_only = realsense_labels(dir / "depth.npy");
+    EXPECT_EQ(label_at(depth_only, 97, 259), label_at(depth_only, 300, 400))
+        << "without colour the brick is the table's";
+    r = run("segment " + frame + (dir / "color.npy").string() + " --color " +
+            (data / "office_table_7_color.png").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::vector<std::uint32_t> labels = realsense_labels(dir / "color.npy");
+    const std::uint32_t brick = label_at(labels, 97, 259);
+    const std::uint32_t table = label_at(labels, 300, 400);
+    ASSERT_NE(brick, 0u);
+    EXPECT_NE(table, 0u);
+    EXPECT_NE(brick, table);
+    EXPECT_EQ(label_at(labels, 500, 300), table);
+    std::size_t inside = 0, outside = 0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != brick) continue;
+        const int x = int(i % 640), y = int(i / 640);
+        (x >= 5 && x <= 190 && y >= 195 && y <= 330 ? inside : outside) += 1;
+    }
+    EXPECT_GT(inside, 6000u);
+    EXPECT_EQ(outside, 0u);
     fs::remove_all(dir);
 }
 
@@ -475,11 +510,8 @@ TEST_P(CliRealSenseBox, IsOneSegmentApartFromTheTable) {
         run("segment " + (data / "wood_table_1_depth.png").string() + " --calib " + (data / "camera.yml").string() +
             " --sensor realsense-d435 --labels " + labels_path.string() + color);
     ASSERT_EQ(r.status, 0) << r.output;
-    const pyrseg::io::NpyArray npy = pyrseg::io::read_npy(labels_path);
-    ASSERT_EQ(npy.shape, (std::vector<std::size_t>{480, 640}));
-    std::vector<std::uint32_t> labels(std::size_t{640} * 480);
-    std::memcpy(labels.data(), npy.bytes.data(), labels.size() * 4);
-    const auto at = [&](int x, int y) { return labels[std::size_t(y) * 640 + std::size_t(x)]; };
+    const std::vector<std::uint32_t> labels = realsense_labels(labels_path);
+    const auto at = [&](int x, int y) { return label_at(labels, x, y); };
     const std::uint32_t box = at(490, 330);  // the front face
     ASSERT_NE(box, 0u);
     EXPECT_EQ(at(470, 240), box) << "the top face";
