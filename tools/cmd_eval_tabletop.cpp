@@ -66,8 +66,9 @@ constexpr const char* kTabletopUsage =
     "20, 30 mm x concavity 10, 20 degrees x colour importance 0, 0.2; the most objects whole, then the fewest\n"
     "merged; --lccp none leaves it out).\n"
     "\n"
-    "Writes DIR/tabletop.md (the tables) and DIR/tabletop_NAME.png (colour | ground truth | each preset) into\n"
-    "--out-dir (default pyrseg-eval-tabletop).\n";
+    "Writes DIR/tabletop.md (the tables: in sum, per frame, and per object, where each object lies and how each\n"
+    "method found it: whole, in N parts or not found, merged with the table, its best IoU and unlabelled share)\n"
+    "and DIR/tabletop_NAME.png (colour | ground truth | each preset) into --out-dir (default pyrseg-eval-tabletop).\n";
 
 // printf into a string (the tables' cells and head).
 template <class... Values>
@@ -292,6 +293,52 @@ PlaneError plane_error(const SegmentStats& table, const eval::SupportPlane& trut
     return e;
 }
 
+// How one method did on one object, for the per-object table: its verdict and best IoU, and its unlabelled share when
+// that is what hides it.
+std::string object_verdict(const eval::TabletopObjectScore& o) {
+    std::string v = o.whole ? std::string("whole") : o.in_parts ? printed("in %u parts", o.parts) : "not found";
+    if (o.merged_with_table) v += ", merged with the table";
+    v += printed(" (IoU %.2f", o.best_iou);
+    const double unlabelled = o.pixels == 0 ? 0.0 : double(o.unlabelled) / double(o.pixels);
+    if (unlabelled >= 0.2) v += printed(", %.0f%% unlabelled", 100.0 * unlabelled);
+    return v + ")";
+}
+
+// A frame's objects, one row each (its truth id, size and where it lies in the image), with each method's verdict.
+std::string object_table(const Frame& f, const std::vector<Method>& methods,
+                         const std::vector<eval::TabletopScores>& scores) {
+    const std::size_t w = std::size_t(f.depth.width);
+    const std::size_t count = std::size_t(f.truth.objects) + 2;
+    std::vector<double> sum_x(count, 0.0), sum_y(count, 0.0);
+    for (std::size_t i = 0; i < f.truth.labels.size(); ++i) {
+        const std::uint32_t id = f.truth.labels[i];
+        if (id < 2 || id >= count) continue;
+        const std::size_t row = i / w;  // the pixel's row: whole rows, on purpose
+        sum_x[id] += double(i - row * w);
+        sum_y[id] += double(row);
+    }
+    std::string out = "| object | pixels | centre (x, y) |";
+    std::string rule = "|---:|---:|---|";
+    for (const Method& m : methods) {
+        out += " `" + m.name + "` |";
+        rule += "---|";
+    }
+    out += "\n" + rule + "\n";
+    for (std::size_t k = 0; k < f.truth.objects; ++k) {
+        const eval::TabletopObjectScore& first = scores.front().objects[k];
+        const double n = double(std::max<std::uint64_t>(first.pixels, 1));
+        out += printed("| %u | %llu | (%.0f, %.0f) |", first.truth_id, static_cast<unsigned long long>(first.pixels),
+                       sum_x[first.truth_id] / n, sum_y[first.truth_id] / n);
+        for (const eval::TabletopScores& s : scores) {
+            out += ' ';
+            out += object_verdict(s.objects[k]);
+            out += " |";
+        }
+        out += "\n";
+    }
+    return out + "\n";
+}
+
 // Every method on every frame: a table per frame into per_frame, a picture per frame into out_dir, the table plane's
 // errors of pyrseg's methods into planes; the totals.
 std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std::vector<Method>& methods,
@@ -311,6 +358,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                     f.truth.found_plane ? "" : " (no support plane found)");
         per_frame << "### " << f.name << "\n\n" << printed(kTableHead, "method");
         std::vector<Panel> panels;
+        std::vector<eval::TabletopScores> frame_scores;
         if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
         panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
         for (std::size_t m = 0; m < methods.size(); ++m) {
@@ -348,6 +396,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 statistics = with_stats.segment(view);
             }
             const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
+            frame_scores.push_back(s);
             if (!statistics.segments.empty() && s.table_label != 0 && f.truth.found_plane && f.plane_known) {
                 const PlaneError e =
                     plane_error(statistics.segments[s.table_label - 1], f.truth.plane, metres_per_unit);
@@ -365,6 +414,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
             panels.push_back({methods[m].name, colorize(labels, w, h)});
         }
         per_frame << "\n";
+        if (f.truth.objects > 0) per_frame << "Per object:\n\n" << object_table(f, methods, frame_scores);
         if (f.picture) {
             per_frame << "![" << f.name << "](tabletop_" << f.name << ".png)\n\n";
             write_png((out_dir / ("tabletop_" + f.name + ".png")).string(), side_by_side(panels));

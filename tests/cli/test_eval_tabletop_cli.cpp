@@ -73,6 +73,36 @@ TEST(CliEvalTabletop, TheSharedRealsenseFramesGetTablesAndPictures) {
     }
     EXPECT_NE(md.str().find("| `realsense-d435` |"), std::string::npos) << md.str();
     EXPECT_NE(md.str().find("| `default` |"), std::string::npos) << md.str();
+    // A table per frame names each object and each method's verdict on it (whole, in N parts or not found, with its
+    // best IoU): one row per object in the truth, one verdict per method column.
+    const auto count = [](const std::string& text, const std::string& what) {
+        std::size_t n = 0;
+        for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+        return n;
+    };
+    std::size_t tables = 0, rows = 0;
+    for (std::size_t at = md.str().find("| object | pixels | centre (x, y) | `realsense-d435` | `default` |");
+         at != std::string::npos; at = md.str().find("| object | pixels |", at + 1)) {
+        ++tables;
+        std::istringstream lines(md.str().substr(at));
+        std::string head, line;
+        std::getline(lines, head);
+        const std::size_t methods = count(head, "`") / 2;
+        std::getline(lines, line);  // the rule
+        while (std::getline(lines, line) && !line.empty()) {
+            ++rows;
+            EXPECT_EQ(count(line, "(IoU "), methods) << line;
+            EXPECT_EQ(count(line, "whole") + count(line, " parts ") + count(line, "not found"), methods) << line;
+        }
+    }
+    EXPECT_EQ(tables, 4u) << md.str();
+    std::size_t objects = 0;  // from each frame's line "NAME: 640 x 480, N objects in the ground truth"
+    for (std::size_t at = r.output.find(": 640 x 480, "); at != std::string::npos;
+         at = r.output.find(": 640 x 480, ", at + 1)) {
+        objects += std::stoul(r.output.substr(at + std::string(": 640 x 480, ").size()));
+    }
+    EXPECT_GE(objects, 4u) << r.output;
+    EXPECT_EQ(rows, objects) << md.str();
     // PCL's peers beside pyrseg, or the reason they are left out.
     if (r.output.find("PCL left out") == std::string::npos) {
         EXPECT_NE(md.str().find("| `PCL organized (realsense-d435 settings)` |"), std::string::npos) << md.str();
