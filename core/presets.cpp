@@ -85,7 +85,8 @@ const char* sensor_kind_summary(SensorKind kind) {
             return "Kinect v1, Xtion, Orbbec Astra and other structured-light cameras with disparity steps: robust "
                    "metric";
         case SensorKind::realsense_d435:
-            return "RealSense D4xx and other active stereo cameras: robust metric";
+            return "RealSense D4xx and other active stereo cameras: robust metric; with a colour image, colour edges "
+                   "where the depth shows a crease";
         case SensorKind::azure_kinect:
             return "Azure Kinect, Kinect v2 and other time-of-flight cameras: robust metric, thresholds that grow "
                    "more slowly with depth";
