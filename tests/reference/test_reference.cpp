@@ -2654,6 +2654,32 @@ std::vector<std::uint8_t> gated(const std::vector<float>& pts, const std::vector
     return out.fillable;
 }
 
+// The 13 x 7 gate scenes' fillable mask (the robust metric at stride 2 keeps the corners out), and the same mask with
+// the colour edge's columns 6 and 7 cleared.
+std::vector<std::uint8_t> gate_scene_mask() {
+    return mask_of({
+        "..#########..",  //
+        "..#########..",  //
+        "#############",  //
+        "#############",  //
+        "#############",  //
+        "..#########..",  //
+        "..#########..",  //
+    });
+}
+
+std::vector<std::uint8_t> gate_scene_mask_cut() {
+    return mask_of({
+        "..####..###..",  //
+        "..####..###..",  //
+        "######..#####",  //
+        "######..#####",  //
+        "######..#####",  //
+        "..####..###..",  //
+        "..####..###..",  //
+    });
+}
+
 TEST(ReferenceColorGate, FlatTexturedPlaneKeepsItsColourEdgesFillable) {
     // z = 1000, every normal frontal: every pair has S = 2^26 per pair, so every pixel with a pair is fillable (the
     // plus below), and S = kp * 2^26 >= kp * (2^26 - Lg) for any Lg >= 0: with G > 0 no colour edge counts.
@@ -2665,24 +2691,8 @@ TEST(ReferenceColorGate, FlatTexturedPlaneKeepsItsColourEdgesFillable) {
     const std::vector<float> pts = grid_points(w, h, [](int, int) { return 1000.0f; });
     const std::vector<float> front = constant_normals(w * h, 0.0f, 0.0f, -1.0f);
     const std::vector<std::uint8_t> color = split_colors(w, h, 6, kRed, kGreen);
-    const std::vector<std::uint8_t> plus = mask_of({
-        "..#########..",  //
-        "..#########..",  //
-        "#############",  //
-        "#############",  //
-        "#############",  //
-        "..#########..",  //
-        "..#########..",  //
-    });
-    const std::vector<std::uint8_t> cut = mask_of({
-        "..####..###..",  //
-        "..####..###..",  //
-        "######..#####",  //
-        "######..#####",  //
-        "######..#####",  //
-        "..####..###..",  //
-        "..####..###..",  //
-    });
+    const std::vector<std::uint8_t> plus = gate_scene_mask();
+    const std::vector<std::uint8_t> cut = gate_scene_mask_cut();
     // Without a colour image, or with T = 765: the metric's mask.
     Output plain = pyrseg_ref::segment(pts.data(), front.data(), w, h, gate_params(0.0));
     ASSERT_TRUE(plain.ok) << plain.error;
@@ -2732,24 +2742,8 @@ TEST(ReferenceColorGate, WeakCreaseWithAColourChangeIsCut) {
         }
     }
     const std::vector<std::uint8_t> color = split_colors(w, h, 6, kRed, kGreen);
-    const std::vector<std::uint8_t> plus = mask_of({
-        "..#########..",  //
-        "..#########..",  //
-        "#############",  //
-        "#############",  //
-        "#############",  //
-        "..#########..",  //
-        "..#########..",  //
-    });
-    const std::vector<std::uint8_t> cut = mask_of({
-        "..####..###..",  //
-        "..####..###..",  //
-        "######..#####",  //
-        "######..#####",  //
-        "######..#####",  //
-        "..####..###..",  //
-        "..####..###..",  //
-    });
+    const std::vector<std::uint8_t> plus = gate_scene_mask();
+    const std::vector<std::uint8_t> cut = gate_scene_mask_cut();
     const std::vector<std::uint8_t> outer_rows_cut = mask_of({
         "..####..###..",  //
         "..####..###..",  //
