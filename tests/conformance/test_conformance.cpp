@@ -407,6 +407,13 @@ TEST_P(RealTabletops, MatchTheReferenceWithTheMerge) {
         params.merge = true;
         SCOPED_TRACE(name);
         expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params);
+        // With the frame's colour image: the preset's colour edges and their curvature gate (section 2c) on real data.
+        const io::Image rgb = io::read_png(dir / (std::string(name) + "_color.png"));
+        ASSERT_EQ(rgb.channels, 3);
+        ASSERT_EQ(rgb.bit_depth, 8);
+        SCOPED_TRACE("with colour");
+        expect_conformance(GetParam(), cloud.points.data(), nullptr, cloud.width, cloud.height, params, nullptr,
+                           &rgb.data);
     }
 }
 
