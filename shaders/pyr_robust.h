@@ -226,10 +226,10 @@ PYR_FN pyr_u32 pyr_metric_robust_fillable(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 h, p
             ++k1;
         }
     }
+    if (k1 == 0) return 0u;
     PyrCurvaturePairs pairs = pyr_robust_curvature_pairs(PYR_CTX_ARG, w, h, x, y, stride);
-    if (k1 == 0 || pairs.count == 0) return 0u;
     if (pyr_robust_curvature_passes(pairs, pyr_robust_curvature_limit(z, curvature_base, curvature_growth)) == 0u) {
-        return 0u;
+        return 0u; /* no pair (kp = 0) fails too */
     }
     PYR_PRECISE pyr_f32 d = dmax - dmin;
     return d <= pyr_robust_depth_limit(z, dt, depth_growth) ? 1u : 0u;

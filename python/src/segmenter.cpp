@@ -184,8 +184,7 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
                                  "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
                                  "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
-                                 "planar_tolerance_mm, "
-                                 "planar_tolerance_per_m2; and preset, "
+                                 "planar_tolerance_mm, planar_tolerance_per_m2; and preset, "
                                  "outputs, cuda_stream");
         }
     }
@@ -648,8 +647,8 @@ params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds
 metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
 merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride, color_edge_curvature_share (the
-colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when a segment's statistics call it planar)
-(docs/algorithm.md).
+colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when
+a segment's statistics call it planar) (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
