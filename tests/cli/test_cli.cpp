@@ -38,6 +38,21 @@ std::uint32_t label_at(const std::vector<std::uint32_t>& labels, int x, int y) {
     return labels[std::size_t(y) * 640 + std::size_t(x)];
 }
 
+// The pixels carrying `label` inside the box x0..x1, y0..y1 (inclusive) and outside it.
+struct BoxCount {
+    std::size_t inside = 0;
+    std::size_t outside = 0;
+};
+BoxCount count_in_box(const std::vector<std::uint32_t>& labels, std::uint32_t label, int x0, int y0, int x1, int y1) {
+    BoxCount n;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != label) continue;
+        const int x = int(i % 640), y = int(i / 640);
+        (x >= x0 && x <= x1 && y >= y0 && y <= y1 ? n.inside : n.outside) += 1;
+    }
+    return n;
+}
+
 using pyrseg::cli_test::CliRun;
 using pyrseg::cli_test::run;
 using pyrseg::cli_test::run_with_env;
@@ -420,7 +435,7 @@ TEST(Cli, RealSenseFramesAutoChoosesTheStereoPresetOncePerBatch) {
 }
 
 // The white bowl of wood_table_3 makes no depth step and only a weak crease at its rim: from depth alone it shares
-// the table's segment; with the colour image (--color, a colour edge threshold) it is a segment of its own, within
+// the table's segment; with the colour image (--color: the preset's colour edges) it is a segment of its own, within
 // the bowl's outline and apart from the table.
 TEST(Cli, RealSenseColourSeparatesTheWhiteBowlFromTheTable) {
     const fs::path data = fs::path(PYRSEG_SHARED_DATA_DIR) / "realsense";
@@ -445,12 +460,7 @@ TEST(Cli, RealSenseColourSeparatesTheWhiteBowlFromTheTable) {
     EXPECT_NE(table, 0u);
     EXPECT_NE(table, bowl);
     EXPECT_EQ(label_at(labels, 600, 450), table);
-    std::size_t inside = 0, outside = 0;
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        if (labels[i] != bowl) continue;
-        const int x = int(i % 640), y = int(i / 640);
-        (x >= 390 && x <= 535 && y >= 205 && y <= 325 ? inside : outside) += 1;
-    }
+    const auto [inside, outside] = count_in_box(labels, bowl, 390, 205, 535, 325);
     EXPECT_GT(inside, 5000u);
     EXPECT_EQ(outside, 0u);
     // A colour image of another size, or a depth image given as the colour, is refused with the reason.
@@ -484,12 +494,7 @@ TEST(Cli, RealSenseColourSeparatesTheToyBrickFromTheTable) {
     EXPECT_NE(table, 0u);
     EXPECT_NE(brick, table);
     EXPECT_EQ(label_at(labels, 500, 300), table);
-    std::size_t inside = 0, outside = 0;
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        if (labels[i] != brick) continue;
-        const int x = int(i % 640), y = int(i / 640);
-        (x >= 5 && x <= 190 && y >= 195 && y <= 330 ? inside : outside) += 1;
-    }
+    const auto [inside, outside] = count_in_box(labels, brick, 5, 195, 190, 330);
     EXPECT_GT(inside, 6000u);
     EXPECT_EQ(outside, 0u);
     fs::remove_all(dir);
@@ -520,12 +525,7 @@ TEST_P(CliRealSenseBox, IsOneSegmentApartFromTheTable) {
     EXPECT_NE(table, 0u);
     EXPECT_NE(table, box);
     EXPECT_EQ(at(600, 300), table);
-    std::size_t inside = 0, outside = 0;
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        if (labels[i] != box) continue;
-        const int x = int(i % 640), y = int(i / 640);
-        (x >= 375 && x <= 580 && y >= 215 && y <= 420 ? inside : outside) += 1;
-    }
+    const auto [inside, outside] = count_in_box(labels, box, 375, 215, 580, 420);
     EXPECT_EQ(outside, 0u) << inside << " inside";
     EXPECT_GT(inside, 20000u);
     fs::remove_all(dir);
