@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -16,16 +17,19 @@
 
 #include "pyrseg/io.hpp"
 #include "pyrseg/presets.hpp"
+#include "pyrseg/scene.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "tools/args.hpp"
 #include "tools/commands.hpp"
+#include "tools/eval/tabletop_boxes.hpp"
 #include "tools/eval/tabletop_scores.hpp"
 #include "tools/eval/tabletop_truth.hpp"
 #include "tools/figures.hpp"
 #include "tools/output_files.hpp"
 #include "tools/pcl_peer.hpp"
 #include "tools/printable.hpp"
+#include "tools/scene_picture.hpp"
 
 namespace pyrseg::cli {
 namespace {
@@ -339,17 +343,73 @@ std::string object_table(const Frame& f, const std::vector<Method>& methods,
     return out + "\n";
 }
 
+// The frame's points in depth units (the statistics' units), 3 per pixel, NaN where there is no depth.
+std::vector<float> frame_points(const Frame& f, double metres_per_unit) {
+    const std::size_t w = std::size_t(f.depth.width);
+    std::vector<float> points(3 * f.metres.size(), std::numeric_limits<float>::quiet_NaN());
+    for (std::size_t i = 0; i < f.metres.size(); ++i) {
+        const double z = double(f.metres[i]) / metres_per_unit;
+        if (!(z > 0) || !std::isfinite(z)) continue;
+        const double u = double(i % w);
+        const double v = double(i / w);
+        points[3 * i] = float((u - f.camera.cx) * z / f.camera.fx);
+        points[3 * i + 1] = float((v - f.camera.cy) * z / f.camera.fy);
+        points[3 * i + 2] = float(z);
+    }
+    return points;
+}
+
+// One row of the scenes' table: the scene summary (docs/algorithm.md section 10c) of pyrseg's segments against the
+// truth: its supports, whether the table's segment is one, the objects resting on it, and how much of each truth
+// object its segment's box holds.
+std::string scene_row(const Frame& f, const Method& method, const Result& statistics,
+                      const eval::TabletopScores& scores, double metres_per_unit, std::vector<double>& inside_all,
+                      Scene& scene) {
+    describe_scene(statistics.segments, method.params, SceneParams{}, scene);
+    int table_support = -1;
+    for (std::size_t j = 0; j < scene.supports.size(); ++j) {
+        if (scene.supports[j].label == scores.table_label) table_support = int(j);
+    }
+    const std::vector<float> points = frame_points(f, metres_per_unit);
+    fit_object_boxes(points, statistics.labels, scene);
+    std::size_t on_table = 0;
+    std::vector<eval::OrientedBox> boxes;
+    for (const SceneObject& o : scene.objects) {
+        if (table_support >= 0 && o.support == table_support) ++on_table;
+        boxes.push_back({o.label, o.box_centre, o.axes, o.extents});
+    }
+    const std::vector<eval::ObjectBoxScore> held =
+        eval::score_boxes(f.truth.labels, f.truth.objects, statistics.labels, points, boxes);
+    std::string shares;
+    std::size_t ninety = 0;
+    for (const eval::ObjectBoxScore& b : held) {
+        shares += (shares.empty() ? "" : ", ") + printed("%.0f%%", 100.0 * b.inside);
+        if (b.inside >= 0.9) ++ninety;
+        inside_all.push_back(b.inside);
+    }
+    return "| " + f.name + " | `" + method.name + "` | " + std::to_string(scene.supports.size()) + " | " +
+           (table_support >= 0 ? "yes" : "no") + " | " + std::to_string(on_table) + " | " + std::to_string(ninety) +
+           " of " + std::to_string(held.size()) + " | " + shares + " |\n";
+}
+
 // Every method on every frame: a table per frame into per_frame, a picture per frame into out_dir, the table plane's
 // errors of pyrseg's methods into planes; the totals.
 std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std::vector<Method>& methods,
                                     double metres_per_unit, const fs::path& out_dir, std::ostringstream& per_frame,
-                                    std::ostringstream& planes) {
+                                    std::ostringstream& planes, std::ostringstream& scenes) {
     std::vector<PlaneError> worst(methods.size());
     std::vector<bool> measured(methods.size(), false);
     planes << "## The table's plane\n\nThe plane of the segment that holds most of the table (its statistics) against "
               "the ground truth's support plane: the angle between the normals, and the truth plane's distance from "
               "the segment's centroid.\n\n| frame | method | angle (degrees) | distance (mm) | RMS to its plane (mm) | "
               "planar |\n|---|---|---:|---:|---:|---|\n";
+    scenes << "## Scenes\n\nThe scene summary of each frame (supports and the objects resting on them, from the "
+              "segment statistics: docs/algorithm.md section 10c): how many supports, whether the table's segment is "
+              "one, how many objects rest on it, and for each truth object the share of its points inside the box of "
+              "the segment holding most of it (0% where that segment is no object).\n\n| frame | method | supports | "
+              "table a support | objects on the table | boxes holding >= 90% | each truth object's share |\n"
+              "|---|---|---:|---|---:|---:|---|\n";
+    std::vector<double> inside_all;
     std::vector<Totals> totals(methods.size());
     for (const Frame& f : frames) {
         const int w = f.depth.width;
@@ -364,6 +424,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
         for (std::size_t m = 0; m < methods.size(); ++m) {
             std::vector<std::uint32_t> labels;
             Result statistics;
+            Scene scene;
             double ms = 0;
             if (methods[m].lccp) {
                 const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, metres_per_unit);
@@ -407,11 +468,19 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 worst[m].mm = std::max(worst[m].mm, e.mm);
                 measured[m] = true;
             }
+            if (!statistics.segments.empty() && f.truth.found_plane && f.plane_known) {
+                scenes << scene_row(f, methods[m], statistics, s, metres_per_unit, inside_all, scene);
+            }
             Totals one;
             one.add(s, ms);
             totals[m].add(s, ms);
             per_frame << row("`" + methods[m].name + "`", one);
             panels.push_back({methods[m].name, colorize(labels, w, h)});
+            if (!scene.supports.empty()) {
+                const PinholeCamera camera{f.camera.fx, f.camera.fy, f.camera.cx, f.camera.cy};
+                panels.push_back({methods[m].name + " scene",
+                                  scene_picture(f.color.rgb.empty() ? panels.back().image : f.color, scene, camera)});
+            }
         }
         per_frame << "\n";
         if (f.truth.objects > 0) per_frame << "Per object:\n\n" << object_table(f, methods, frame_scores);
@@ -428,6 +497,12 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
         }
     }
     planes << "\n\n";
+    if (!inside_all.empty()) {
+        const auto ninety = std::count_if(inside_all.begin(), inside_all.end(), [](double v) { return v >= 0.9; });
+        std::sort(inside_all.begin(), inside_all.end());
+        scenes << "\nIn all: " << ninety << " of " << inside_all.size() << " boxes hold at least 90% of their object's "
+               << "points; median " << printed("%.0f%%", 100.0 * inside_all[inside_all.size() / 2]) << ".\n\n";
+    }
     return totals;
 }
 
@@ -517,7 +592,9 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
             methods.push_back({"PCL organized (" + name + " settings)", Params{}, kind, std::nullopt});
         }
         std::ostringstream no_planes;
-        const std::vector<Totals> totals = evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes);
+        std::ostringstream no_scenes;
+        const std::vector<Totals> totals =
+            evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes, no_scenes);
         for (std::size_t m = 0; m < methods.size(); ++m) md << row(name + ": `" + methods[m].name + "`", totals[m]);
     }
     md << "\n" << per_frame.str();
@@ -588,7 +665,9 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
     std::ostringstream per_frame;
     per_frame << "## Per frame\n\n";
     std::ostringstream planes;
-    const std::vector<Totals> totals = evaluate_frames(frames, methods, metres_per_unit, out_dir, per_frame, planes);
+    std::ostringstream scenes;
+    const std::vector<Totals> totals =
+        evaluate_frames(frames, methods, metres_per_unit, out_dir, per_frame, planes, scenes);
 
     std::string command = "pyrseg eval";
     for (const std::string& a : argv) command += " " + a;
@@ -599,7 +678,7 @@ int cmd_eval_tabletop(const std::vector<std::string>& argv) {
        << "(`pyrseg eval --tabletop --help`).\n\n## In sum\n\n"
        << printed(kTableHead, "method");
     for (std::size_t m = 0; m < methods.size(); ++m) md << row("`" + methods[m].name + "`", totals[m]);
-    md << "\n" << planes.str() << per_frame.str();
+    md << "\n" << planes.str() << scenes.str() << per_frame.str();
     const fs::path report = out_dir / "tabletop.md";
     write_text_file(report, md.str());
     std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);

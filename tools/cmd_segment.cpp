@@ -17,6 +17,7 @@
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
+#include "pyrseg/scene.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "tools/batch_plan.hpp"
 #include "tools/cloud_stats.hpp"
@@ -35,7 +36,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,scene]\n"
     "                      [--progress auto|bar|lines|none] [--backend NAME] [input options] [parameters]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
@@ -59,6 +60,11 @@ constexpr const char* kSegmentUsage =
     "                        planar or not) and oriented box (axes, side lengths), from exact sums the backend\n"
     "                        computes over the segment's fillable pixels (fillable_count; not its edge pixels);\n"
     "                        JSON or CSV, as the extension says\n"
+    "  --scene OUT.json      the scene: the support surfaces (large flat segments: floor, table, wall; plane and\n"
+    "                        outline) and the objects resting on them, each with its support, its height above it\n"
+    "                        and a box standing on it that holds the object's points (docs/algorithm.md 10c)\n"
+    "  --scene OUT.ply       or the objects' boxes and the supports' outlines as a mesh, coloured as --png colours\n"
+    "                        the segments, to open beside --ply OUT.ply in CloudCompare or MeshLab\n"
     "  --pcl-png OUT.png     PCL's organized segmentation of the same frame in colour, to compare (builds with\n"
     "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
     "                        PCL's defaults\n"
@@ -74,7 +80,8 @@ constexpr const char* kSegmentUsage =
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply, NAME.labels.pcd, NAME.stats.json as --write asks (default labels,png); NAME_2, NAME_3 ... when\n"
+    "NAME.ply, NAME.labels.pcd, NAME.stats.json, NAME.scene.json as --write asks (default labels,png); NAME_2, NAME_3 "
+    "... when\n"
     "another frame's output has that name already. An output that would be one of the batch's inputs is refused\n"
     "before anything is read. A frame that fails (also one an input option does not apply to: --intrinsics on a\n"
     "cloud, --unit-mm on a depth image) is reported and skipped (none of its outputs is left); the exit status is 1\n"
@@ -84,8 +91,10 @@ constexpr const char* kSegmentUsage =
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, pcl_png;
-    [[nodiscard]] bool any() const { return labels || png || mask || figure || ply || pcd || stats || pcl_png; }
+    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, scene, pcl_png;
+    [[nodiscard]] bool any() const {
+        return labels || png || mask || figure || ply || pcd || stats || scene || pcl_png;
+    }
 };
 
 // The output options, the extensions their files may have, and what they write (for the message refusing another
@@ -108,6 +117,7 @@ const std::vector<OutputOption>& output_options() {
         {"ply", &OutputPaths::ply, {".ply"}, "the coloured cloud, as PLY"},
         {"pcd", &OutputPaths::pcd, {".pcd"}, "the cloud with a label field, as PCD"},
         {"stats", &OutputPaths::stats, {".json", ".csv"}, "the statistics, as JSON or CSV"},
+        {"scene", &OutputPaths::scene, {".json", ".ply"}, "the scene, as JSON or a PLY mesh of its boxes"},
         {"pcl-png", &OutputPaths::pcl_png, {".png"}, "PCL's segmentation in colour, as PNG"},
     };
     return options;
@@ -320,7 +330,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (warm_up) {
         Outputs outputs;
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
-        outputs.segment_stats = out.stats.has_value();
+        outputs.segment_stats = out.stats.has_value() || out.scene.has_value();
         segmenter =
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
@@ -369,6 +379,14 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         files.stage(*out.stats, [&](const fs::path& to) {
             io::write_segment_stats(to, result.segments,
                                     io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+        });
+    }
+    if (out.scene) {
+        Scene scene;
+        describe_scene(result.segments, params, SceneParams{}, scene);
+        fit_object_boxes(cloud.points, result.labels, scene);
+        files.stage(*out.scene, [&](const fs::path& to) {
+            io::write_scene(to, scene, io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
         });
     }
     files.commit();
@@ -427,13 +445,15 @@ std::set<std::string> parse_write_list(const std::string& text) {
     std::string item;
     while (std::getline(in, item, ',')) {
         if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" && item != "pcd" &&
-            item != "stats") {
-            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, pcd, stats; got '" + item +
-                             "'"};
+            item != "stats" && item != "scene") {
+            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, pcd, stats, scene; got '" +
+                             item + "'"};
         }
         kinds.insert(item);
     }
-    if (kinds.empty()) throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats"};
+    if (kinds.empty()) {
+        throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats, scene"};
+    }
     return kinds;
 }
 
@@ -505,6 +525,7 @@ int run_batch(const Args& args, const Params& params, RunNotes& notes) {
         out.ply = planned("ply");
         out.pcd = planned("pcd");
         out.stats = planned("stats");
+        out.scene = planned("scene");
         std::string failure;
         try {
             const FrameReport r = segment_frame(frame.input, args, params, out, segmenter, notes);

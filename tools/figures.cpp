@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 
 #include "pyrseg/io.hpp"
 #include "tools/eval/bridges.hpp"
@@ -89,6 +90,34 @@ RgbImage comparison_figure(const Result& r) {
 
 void write_png(const std::string& path, const RgbImage& image) {
     io::write_png_rgb(path, image.rgb.data(), image.width, image.height);
+}
+
+void draw_line(RgbImage& image, int x0, int y0, int x1, int y1, int thickness, std::array<std::uint8_t, 3> color) {
+    const int dx = std::abs(x1 - x0);
+    const int dy = -std::abs(y1 - y0);
+    const int sx = x0 < x1 ? 1 : -1;
+    const int sy = y0 < y1 ? 1 : -1;
+    int err = dx + dy;
+    const int lo = -(thickness - 1) / 2;
+    const int hi = thickness / 2;
+    for (;;) {
+        for (int y = y0 + lo; y <= y0 + hi; ++y) {
+            for (int x = x0 + lo; x <= x0 + hi; ++x) {
+                if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+                std::copy(color.begin(), color.end(), image.rgb.begin() + 3 * (std::ptrdiff_t(y) * image.width + x));
+            }
+        }
+        if (x0 == x1 && y0 == y1) break;
+        const int e2 = 2 * err;
+        if (e2 >= dy) {
+            err += dy;
+            x0 += sx;
+        }
+        if (e2 <= dx) {
+            err += dx;
+            y0 += sy;
+        }
+    }
 }
 
 }  // namespace pyrseg::cli

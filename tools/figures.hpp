@@ -1,6 +1,7 @@
 #pragma once
 // Pictures for people: coloured labels, the fillable mask, plain connected components for comparison, and
 // captioned side-by-side figures (like the paper's Figure 3).
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -29,5 +30,9 @@ struct Panel {
 [[nodiscard]] RgbImage comparison_figure(const Result& result);
 
 void write_png(const std::string& path, const RgbImage& image);
+
+// A line of the given thickness from (x0, y0) to (x1, y1) (a square brush moved along a Bresenham line), clipped to
+// the image.
+void draw_line(RgbImage& image, int x0, int y0, int x1, int y1, int thickness, std::array<std::uint8_t, 3> color);
 
 }  // namespace pyrseg::cli

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "tools/figures.hpp"
 #include "tools/font5x7.hpp"
 
 namespace pyrseg::cli {
@@ -42,29 +43,7 @@ public:
         }
     }
 
-    // A line of the given thickness (a square brush moved along a Bresenham line).
-    void line(int x0, int y0, int x1, int y1, int thickness, Rgb c) {
-        const int dx = std::abs(x1 - x0);
-        const int dy = -std::abs(y1 - y0);
-        const int sx = x0 < x1 ? 1 : -1;
-        const int sy = y0 < y1 ? 1 : -1;
-        int err = dx + dy;
-        const int lo = -(thickness - 1) / 2;
-        const int hi = thickness / 2;
-        for (;;) {
-            rect(x0 + lo, y0 + lo, x0 + hi, y0 + hi, c);
-            if (x0 == x1 && y0 == y1) break;
-            const int e2 = 2 * err;
-            if (e2 >= dy) {
-                err += dy;
-                x0 += sx;
-            }
-            if (e2 <= dx) {
-                err += dx;
-                y0 += sy;
-            }
-        }
-    }
+    void line(int x0, int y0, int x1, int y1, int thickness, Rgb c) { draw_line(img_, x0, y0, x1, y1, thickness, c); }
 
     void text(int x, int y, const std::string& s, Rgb c) {
         for (const char ch : s) {

@@ -18,6 +18,7 @@
 #include "pyrseg/depth.hpp"
 #include "pyrseg/io_export.hpp"
 #include "pyrseg/result.hpp"
+#include "pyrseg/scene.hpp"
 
 namespace pyrseg::io {
 
@@ -146,5 +147,11 @@ struct SegmentTable {
 };
 PYRSEG_IO_EXPORT void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
                                           const SegmentTable& frame);
+
+// The scene summary (pyrseg/scene.hpp): JSON with the frame's size and units, its supports (plane, box) and objects
+// (support, height, box), lengths in the cloud's units; or, when the path ends in .ply, an ASCII PLY mesh of each
+// object's box (12 triangles) and each support's outline (its box's rectangle in its plane, 2 triangles), coloured
+// as label_color colours the segments, for CloudCompare or MeshLab beside the cloud's PLY.
+PYRSEG_IO_EXPORT void write_scene(const std::filesystem::path& path, const Scene& scene, const SegmentTable& frame);
 
 }  // namespace pyrseg::io
