@@ -8,6 +8,7 @@ set(PYRSEG_PYTHON_BINDINGS_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/src/arrays.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/args.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/io.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/src/scene.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/synthetic.cpp
     ${CMAKE_CURRENT_LIST_DIR}/src/device.cpp)
 set(PYRSEG_PYTHON_MODULE_SOURCES ${CMAKE_CURRENT_LIST_DIR}/src/module.cpp)

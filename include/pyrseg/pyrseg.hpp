@@ -7,6 +7,7 @@
 #include "pyrseg/params.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/result.hpp"
+#include "pyrseg/scene.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/version.hpp"
 // The file formats (pyrseg::io; link pyrseg::io, or pkg-config pyrseg-io), where this install has them.

@@ -21,6 +21,8 @@ void bind_segmenter(py::module_& m);
 py::dict params_to_dict(const Params& p);
 // pyrseg.segment_stats_dtype: SegmentStats as numpy sees it (Result.segments).
 py::dtype segment_stats_dtype();
+// pyrseg.describe_scene, scene_support_dtype, scene_object_dtype, Scene (scene.cpp).
+void bind_scene(py::module_& m);
 void bind_io(py::module_& io);
 void bind_synthetic(py::module_& synthetic);
 

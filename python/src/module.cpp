@@ -17,6 +17,7 @@ PYBIND11_MODULE(PYRSEG_PYTHON_MODULE_NAME, m) {
     m.doc() = "pyrseg: fast bridgeless pyramid segmentation of organized point clouds and depth images.";
     python::bind_errors(m);
     python::bind_segmenter(m);
+    python::bind_scene(m);
     auto io = m.def_submodule("io");
     python::bind_io(io);
     auto synthetic = m.def_submodule("synthetic");
