@@ -181,11 +181,17 @@ void describe_scene(const std::vector<SegmentStats>& segments, const Params& par
 
 namespace pyrseg {
 
-void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels, Scene& scene) {
+void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels,
+                      std::span<const std::uint8_t> fillable, Scene& scene) {
     if (points.size() != 3 * labels.size()) {
         throw Error(ErrorCode::invalid_argument, "fit_object_boxes: " + std::to_string(points.size()) +
                                                      " point coordinates for " + std::to_string(labels.size()) +
                                                      " labels (3 per pixel expected)");
+    }
+    if (!fillable.empty() && fillable.size() != labels.size()) {
+        throw Error(ErrorCode::invalid_argument, "fit_object_boxes: a fillable mask of " +
+                                                     std::to_string(fillable.size()) + " pixels for " +
+                                                     std::to_string(labels.size()) + " labels");
     }
     // Each object's box centre and extents hold, during the pass, the least and the greatest coordinate along its
     // axes (no scratch to allocate). Objects are sorted by label: a pixel finds its object by binary search.
@@ -198,7 +204,7 @@ void fit_object_boxes(std::span<const float> points, std::span<const std::uint32
     std::size_t last = scene.objects.size();
     for (std::size_t i = 0; i < labels.size(); ++i) {
         const std::uint32_t l = labels[i];
-        if (l == 0) continue;
+        if (l == 0 || (!fillable.empty() && fillable[i] == 0)) continue;
         if (l != last_label) {
             last_label = l;
             const auto it = std::lower_bound(scene.objects.begin(), scene.objects.end(), l,

@@ -282,6 +282,7 @@ struct PlaneError {
     bool planar = false;
 };
 
+// The statistics are in the Segmenter's unit (unit_mm millimetres), whatever the depth image's sample unit.
 PlaneError plane_error(const SegmentStats& table, const eval::SupportPlane& truth, double metres_per_unit) {
     PlaneError e;
     double cosine = 0;
@@ -343,20 +344,15 @@ std::string object_table(const Frame& f, const std::vector<Method>& methods,
     return out + "\n";
 }
 
-// The frame's points in depth units (the statistics' units), 3 per pixel, NaN where there is no depth.
-std::vector<float> frame_points(const Frame& f, double metres_per_unit) {
-    const std::size_t w = std::size_t(f.depth.width);
-    std::vector<float> points(3 * f.metres.size(), std::numeric_limits<float>::quiet_NaN());
-    for (std::size_t i = 0; i < f.metres.size(); ++i) {
-        const double z = double(f.metres[i]) / metres_per_unit;
-        if (!(z > 0) || !std::isfinite(z)) continue;
-        const double u = double(i % w);
-        const double v = double(i / w);
-        points[3 * i] = float((u - f.camera.cx) * z / f.camera.fx);
-        points[3 * i + 1] = float((v - f.camera.cy) * z / f.camera.fy);
-        points[3 * i + 2] = float(z);
+// The picture in gray, darkened: what the scene's boxes are drawn over.
+RgbImage dimmed_gray(const RgbImage& image) {
+    RgbImage out = image;
+    for (std::size_t i = 0; i + 2 < out.rgb.size(); i += 3) {
+        const int gray = (int(image.rgb[i]) + int(image.rgb[i + 1]) + int(image.rgb[i + 2])) / 3;
+        const auto v = std::uint8_t(24 + gray / 2);
+        out.rgb[i] = out.rgb[i + 1] = out.rgb[i + 2] = v;
     }
-    return points;
+    return out;
 }
 
 // One row of the scenes' table: the scene summary (docs/algorithm.md section 10c) of pyrseg's segments against the
@@ -364,14 +360,16 @@ std::vector<float> frame_points(const Frame& f, double metres_per_unit) {
 // object its segment's box holds.
 std::string scene_row(const Frame& f, const Method& method, const Result& statistics,
                       const eval::TabletopScores& scores, double metres_per_unit, std::vector<double>& inside_all,
-                      Scene& scene) {
+                      std::vector<double>& inside_whole, Scene& scene) {
     describe_scene(statistics.segments, method.params, SceneParams{}, scene);
     int table_support = -1;
     for (std::size_t j = 0; j < scene.supports.size(); ++j) {
         if (scene.supports[j].label == scores.table_label) table_support = int(j);
     }
-    const std::vector<float> points = frame_points(f, metres_per_unit);
-    fit_object_boxes(points, statistics.labels, scene);
+    // The frame's points in the statistics' unit (the Segmenter's unit_mm; depth_to_cloud gives millimetres).
+    std::vector<float> points = io::depth_to_cloud(f.depth, f.camera, metres_per_unit).points;
+    for (float& c : points) c = float(double(c) / method.params.unit_mm);
+    fit_object_boxes(points, statistics.labels, statistics.fillable_mask, scene);
     std::size_t on_table = 0;
     std::vector<eval::OrientedBox> boxes;
     for (const SceneObject& o : scene.objects) {
@@ -382,10 +380,13 @@ std::string scene_row(const Frame& f, const Method& method, const Result& statis
         eval::score_boxes(f.truth.labels, f.truth.objects, statistics.labels, points, boxes);
     std::string shares;
     std::size_t ninety = 0;
-    for (const eval::ObjectBoxScore& b : held) {
+    for (std::size_t k = 0; k < held.size(); ++k) {
+        const eval::ObjectBoxScore& b = held[k];
         shares += (shares.empty() ? "" : ", ") + printed("%.0f%%", 100.0 * b.inside);
+        if (scores.objects[k].whole) shares += " (whole)";
         if (b.inside >= 0.9) ++ninety;
         inside_all.push_back(b.inside);
+        if (scores.objects[k].whole) inside_whole.push_back(b.inside);
     }
     return "| " + f.name + " | `" + method.name + "` | " + std::to_string(scene.supports.size()) + " | " +
            (table_support >= 0 ? "yes" : "no") + " | " + std::to_string(on_table) + " | " + std::to_string(ninety) +
@@ -403,13 +404,14 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
               "the ground truth's support plane: the angle between the normals, and the truth plane's distance from "
               "the segment's centroid.\n\n| frame | method | angle (degrees) | distance (mm) | RMS to its plane (mm) | "
               "planar |\n|---|---|---:|---:|---:|---|\n";
-    scenes << "## Scenes\n\nThe scene summary of each frame (supports and the objects resting on them, from the "
-              "segment statistics: docs/algorithm.md section 10c): how many supports, whether the table's segment is "
-              "one, how many objects rest on it, and for each truth object the share of its points inside the box of "
-              "the segment holding most of it (0% where that segment is no object).\n\n| frame | method | supports | "
-              "table a support | objects on the table | boxes holding >= 90% | each truth object's share |\n"
-              "|---|---|---:|---|---:|---:|---|\n";
-    std::vector<double> inside_all;
+    scenes
+        << "## Scenes\n\nThe scene summary of each frame (supports and the objects standing over them, from the "
+           "segment statistics: docs/algorithm.md section 10c): how many supports, whether the table's segment is "
+           "one, how many objects stand over it, and for each truth object the share of its points inside the box of "
+           "the segment holding most of it (0% where that segment is no object).\n\n| frame | method | supports | "
+           "table a support | objects on the table | boxes holding >= 90% | each truth object's share |\n"
+           "|---|---|---:|---|---:|---:|---|\n";
+    std::vector<double> inside_all, inside_whole;
     std::vector<Totals> totals(methods.size());
     for (const Frame& f : frames) {
         const int w = f.depth.width;
@@ -419,6 +421,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
         per_frame << "### " << f.name << "\n\n" << printed(kTableHead, "method");
         std::vector<Panel> panels;
         std::vector<eval::TabletopScores> frame_scores;
+        bool scene_written = false;  // scene_NAME.png: the first of pyrseg's methods
         if (!f.color.rgb.empty()) panels.push_back({"colour", f.color});
         panels.push_back({"ground truth", truth_picture(f.truth, w, h)});
         for (std::size_t m = 0; m < methods.size(); ++m) {
@@ -453,14 +456,15 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 ms = median_ms(times);
                 Outputs stats;
                 stats.segment_stats = true;
+                stats.fillable_mask = true;
                 Segmenter with_stats(w, h, methods[m].params, "cpu", stats);
                 statistics = with_stats.segment(view);
             }
             const eval::TabletopScores s = eval::score_tabletop(f.truth.labels, labels);
             frame_scores.push_back(s);
             if (!statistics.segments.empty() && s.table_label != 0 && f.truth.found_plane && f.plane_known) {
-                const PlaneError e =
-                    plane_error(statistics.segments[s.table_label - 1], f.truth.plane, metres_per_unit);
+                const PlaneError e = plane_error(statistics.segments[s.table_label - 1], f.truth.plane,
+                                                 methods[m].params.unit_mm / 1000.0);
                 planes << "| " << f.name << " | `" << methods[m].name << "` | " << printed("%.2f", e.degrees) << " | "
                        << printed("%.1f", e.mm) << " | " << printed("%.1f", e.rms_mm) << " | "
                        << (e.planar ? "yes" : "no") << " |\n";
@@ -469,7 +473,7 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 measured[m] = true;
             }
             if (!statistics.segments.empty() && f.truth.found_plane && f.plane_known) {
-                scenes << scene_row(f, methods[m], statistics, s, metres_per_unit, inside_all, scene);
+                scenes << scene_row(f, methods[m], statistics, s, metres_per_unit, inside_all, inside_whole, scene);
             }
             Totals one;
             one.add(s, ms);
@@ -480,6 +484,12 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 const PinholeCamera camera{f.camera.fx, f.camera.fy, f.camera.cx, f.camera.cy};
                 panels.push_back({methods[m].name + " scene",
                                   scene_picture(f.color.rgb.empty() ? panels.back().image : f.color, scene, camera)});
+                if (f.picture && !scene_written && !f.color.rgb.empty()) {
+                    // The scene alone, over the colour image in gray so that the boxes stand out.
+                    write_png((out_dir / ("scene_" + f.name + ".png")).string(),
+                              scene_picture(dimmed_gray(f.color), scene, camera));
+                    scene_written = true;
+                }
             }
         }
         per_frame << "\n";
@@ -497,12 +507,15 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
         }
     }
     planes << "\n\n";
-    if (!inside_all.empty()) {
-        const auto ninety = std::count_if(inside_all.begin(), inside_all.end(), [](double v) { return v >= 0.9; });
-        std::sort(inside_all.begin(), inside_all.end());
-        scenes << "\nIn all: " << ninety << " of " << inside_all.size() << " boxes hold at least 90% of their object's "
-               << "points; median " << printed("%.0f%%", 100.0 * inside_all[inside_all.size() / 2]) << ".\n\n";
-    }
+    const auto summary = [](std::vector<double> shares) {
+        const auto ninety = std::count_if(shares.begin(), shares.end(), [](double v) { return v >= 0.9; });
+        std::sort(shares.begin(), shares.end());
+        return std::to_string(ninety) + " of " + std::to_string(shares.size()) + " boxes hold at least 90% of their " +
+               "object's points, median " + printed("%.0f%%", 100.0 * shares[shares.size() / 2]);
+    };
+    if (!inside_all.empty()) scenes << "\nIn all: " << summary(inside_all);
+    if (!inside_whole.empty()) scenes << "; of the objects found whole: " << summary(inside_whole);
+    if (!inside_all.empty()) scenes << ".\n\n";
     return totals;
 }
 

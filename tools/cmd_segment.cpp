@@ -329,7 +329,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
                          !same_params(segmenter->params(), params);
     if (warm_up) {
         Outputs outputs;
-        outputs.fillable_mask = out.mask.has_value() || out.figure.has_value();
+        outputs.fillable_mask = out.mask.has_value() || out.figure.has_value() || out.scene.has_value();
         outputs.segment_stats = out.stats.has_value() || out.scene.has_value();
         segmenter =
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
@@ -384,7 +384,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.scene) {
         Scene scene;
         describe_scene(result.segments, params, SceneParams{}, scene);
-        fit_object_boxes(cloud.points, result.labels, scene);
+        fit_object_boxes(cloud.points, result.labels, result.fillable_mask, scene);
         files.stage(*out.scene, [&](const fs::path& to) {
             io::write_scene(to, scene, io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
         });

@@ -50,7 +50,7 @@ RgbImage scene_picture(const RgbImage& base, const Scene& scene, const PinholeCa
         }
     }
     for (const SceneObject& o : scene.objects) {
-        if (!o.touches) continue;  // not on a support: background, parts in the air
+        if (o.support < 0) continue;  // over no support: walls, background
         const std::array<std::uint8_t, 3> color = io::label_color(o.label);
         for (int bits = 0; bits < 8; ++bits) {
             for (int a = 0; a < 3; ++a) {

@@ -75,9 +75,13 @@ namespace pyrseg {
 // The boxes of the moments hold a uniformly covered block exactly, but less of a disc or a cylinder's side, whose
 // points crowd towards the rims. Where the caller has the frame's points on the host, this tightens every object's
 // box to them: along each of its axes, from the least to the greatest coordinate of the object's points (from the
-// support's plane up, for an object resting on one), in one pass over the frame. points: 3 floats per pixel (x, y,
-// z in the units the statistics came in; a non-finite coordinate: no point), labels: Result::labels of the same
-// frame. Throws pyrseg::Error (invalid_argument) when the sizes disagree.
-PYRSEG_EXPORT void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels, Scene& scene);
+// support's plane up, for an object over one), in one pass over the frame. points: 3 floats per pixel (x, y, z in
+// the units the statistics came in; a non-finite coordinate: no point); labels: Result::labels of the same frame;
+// fillable: Result::fillable_mask (Outputs::fillable_mask), or empty for every labelled pixel. With the mask, only
+// the fillable pixels count, as in the statistics: the edge pixels of step 6c are mixed pixels, halfway between an
+// object and what lies behind it, and would stretch a box towards the background. Throws pyrseg::Error
+// (invalid_argument) when the sizes disagree.
+PYRSEG_EXPORT void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels,
+                                    std::span<const std::uint8_t> fillable, Scene& scene);
 
 }  // namespace pyrseg

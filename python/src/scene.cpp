@@ -2,6 +2,7 @@
 // Result.segments, with the boxes fitted to the points when the caller gives them.
 #include <cstddef>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include "bindings.hpp"
@@ -78,9 +79,9 @@ void bind_scene(py::module_& m) {
     m.def(
         "describe_scene",
         [supports, objects, scene_type](const py::object& segments, double unit_mm, const py::object& points,
-                                        const py::object& labels, double support_min_share, double support_flatness,
-                                        double contact_mm, double max_height_mm, double level_degrees,
-                                        std::uint32_t object_min_pixels) {
+                                        const py::object& labels, const py::object& fillable, double support_min_share,
+                                        double support_flatness, double contact_mm, double max_height_mm,
+                                        double level_degrees, std::uint32_t object_min_pixels) {
             const py::dtype stats = segment_stats_dtype();
             if (!py::isinstance<py::array>(segments) || !py::dtype(segments.attr("dtype")).equal(stats)) {
                 throw py::type_error(
@@ -120,19 +121,35 @@ void bind_scene(py::module_& m) {
                         "describe_scene(): labels must be Result.labels, H x W uint32 of the "
                         "points' size");
                 }
-                fit_object_boxes({xyz.data(), std::size_t(xyz.size())}, {ids.data(), std::size_t(ids.size())}, scene);
+                std::span<const std::uint8_t> mask;
+                py::array_t<std::uint8_t, py::array::c_style> fillable_array;
+                if (!fillable.is_none()) {
+                    fillable_array = py::array_t<std::uint8_t, py::array::c_style>::ensure(fillable);
+                    if (!py::isinstance<py::array>(fillable) || !fillable_array || fillable_array.ndim() != 2 ||
+                        fillable_array.shape(0) != ids.shape(0) || fillable_array.shape(1) != ids.shape(1)) {
+                        throw py::value_error(
+                            "describe_scene(): fillable must be Result.fillable_mask, H x W uint8 "
+                            "of the labels' size");
+                    }
+                    mask = {fillable_array.data(), std::size_t(fillable_array.size())};
+                }
+                fit_object_boxes({xyz.data(), std::size_t(xyz.size())}, {ids.data(), std::size_t(ids.size())}, mask,
+                                 scene);
             }
             return scene_type(to_array(scene.supports, supports), to_array(scene.objects, objects));
         },
         py::arg("segments"), py::kw_only(), py::arg("unit_mm") = 1.0, py::arg("points") = py::none(),
-        py::arg("labels") = py::none(), py::arg("support_min_share") = SceneParams{}.support_min_share,
+        py::arg("labels") = py::none(), py::arg("fillable") = py::none(),
+        py::arg("support_min_share") = SceneParams{}.support_min_share,
         py::arg("support_flatness") = SceneParams{}.support_flatness, py::arg("contact_mm") = SceneParams{}.contact_mm,
         py::arg("max_height_mm") = SceneParams{}.max_height_mm, py::arg("level_degrees") = SceneParams{}.level_degrees,
         py::arg("object_min_pixels") = SceneParams{}.object_min_pixels,
         R"(The scene of one frame (docs/algorithm.md section 10c): its supports (large flat segments; level ones
 parallel to the largest: a table, a floor) and the objects standing over them, each with a box from its support's
 plane to its top. From Result.segments (outputs=('segment_stats',)) alone; with points (H x W x 3, the frame's xyz in
-the units the statistics came in) and labels (Result.labels), each object's box is fitted to its points. unit_mm:
+the units the statistics came in) and labels (Result.labels), each object's box is fitted to its points; with
+fillable (Result.fillable_mask, outputs=('fillable_mask',)) too, to its fillable pixels' points only (edge pixels are
+mixed pixels that stretch a box towards the background). unit_mm:
 the frame's unit (the Segmenter's unit_mm). Returns Scene(supports, objects), numpy structured arrays of
 scene_support_dtype and scene_object_dtype; lengths in the frame's units.)");
 }

@@ -508,8 +508,7 @@ TEST(Cli, RealSenseSceneHasTheTableAndTheCrackerBoxStandingOnIt) {
     const fs::path dir = temp_dir();
     const std::string frame = "segment " + (data / "wood_table_1_depth.png").string() + " --calib " +
                               (data / "camera.yml").string() + " --sensor realsense-d435 --color " +
-                              (data / "wood_table_1_color.png").string() + " --labels " +
-                              (dir / "labels.npy").string();
+                              (data / "wood_table_1_color.png").string() + " --labels " + (dir / "labels.npy").string();
     CliRun r = run(frame + " --scene " + (dir / "scene.json").string());
     ASSERT_EQ(r.status, 0) << r.output;
     const std::vector<std::uint32_t> labels = realsense_labels(dir / "labels.npy");

@@ -9,7 +9,7 @@ def tabletop(seed=3):
     s = pyrseg.synthetic.generate(
         seed=seed, object_count=8, bin=False, touching=False, sensor="realsense-d435", camera_distance_mm=1000.0
     )
-    seg = pyrseg.Segmenter(640, 480, "cpu", preset="realsense-d435", outputs=["segment_stats"])
+    seg = pyrseg.Segmenter(640, 480, "cpu", preset="realsense-d435", outputs=["segment_stats", "fillable_mask"])
     return s, seg.segment(s.points)
 
 
@@ -34,9 +34,10 @@ def test_the_floor_is_the_support_and_objects_stand_on_it():
 
 def test_fitted_boxes_hold_their_points():
     s, r = tabletop()
-    scene = pyrseg.describe_scene(r.segments, points=s.points, labels=r.labels)
+    scene = pyrseg.describe_scene(r.segments, points=s.points, labels=r.labels, fillable=r.fillable_mask)
     for o in scene.objects:
-        pts = s.points[(r.labels == o["label"]) & np.isfinite(s.points[..., 2])].astype(np.float64)
+        pts = s.points[(r.labels == o["label"]) & (r.fillable_mask != 0) & np.isfinite(s.points[..., 2])]
+        pts = pts.astype(np.float64)
         along = (pts - o["box_centre"]) @ o["axes"].T
         assert np.all(np.abs(along) <= 0.5 * o["extents"] + 1e-6 * o["extents"].sum()), o["label"]
     # The same scene as the statistics alone gives, but boxes the points' own size.
@@ -55,6 +56,8 @@ def test_bad_arguments_name_the_problem():
         pyrseg.describe_scene(r.segments, points=s.points, labels=r.labels[:10])
     with pytest.raises(ValueError, match="labels must be Result.labels"):
         pyrseg.describe_scene(r.segments, points=s.points, labels=r.labels.astype(np.int64))
+    with pytest.raises(ValueError, match="fillable must be Result.fillable_mask"):
+        pyrseg.describe_scene(r.segments, points=s.points, labels=r.labels, fillable=r.fillable_mask[:, :5])
     with pytest.raises(pyrseg.Error, match="support_min_share"):
         pyrseg.describe_scene(r.segments, support_min_share=2.0)
     with pytest.raises(pyrseg.Error, match="unit_mm"):

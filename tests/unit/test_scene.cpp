@@ -129,7 +129,7 @@ TEST(Scene, UnitsAndThresholds) {
     EXPECT_THROW(describe_scene({table}, Params{}, bad, scene), Error);
     std::vector<float> points(6);
     std::vector<std::uint32_t> labels(3);
-    EXPECT_THROW(fit_object_boxes(points, labels, scene), Error);
+    EXPECT_THROW(fit_object_boxes(points, labels, {}, scene), Error);
 }
 
 // A synthetic tabletop: objects apart on a plain floor, seen by a RealSense model from 1 m.
@@ -149,6 +149,7 @@ Tabletop tabletop(std::uint64_t seed) {
     Tabletop t{synthetic::generate(o), {}};
     Outputs outputs;
     outputs.segment_stats = true;
+    outputs.fillable_mask = true;
     Segmenter segmenter(o.width, o.height, sensor_preset(SensorKind::realsense_d435), "cpu", outputs);
     t.result = segmenter.segment(CloudView{t.frame.points.data(), nullptr, o.width, o.height});
     return t;
@@ -198,7 +199,7 @@ TEST(Scene, SyntheticTabletopsTheFloorIsTheSupportAndTheBoxesFitTheGeneratorsBox
         const Tabletop t = tabletop(seed);
         Scene scene;
         describe_scene(t.result.segments, sensor_preset(SensorKind::realsense_d435), SceneParams{}, scene);
-        fit_object_boxes(t.frame.points, t.result.labels, scene);
+        fit_object_boxes(t.frame.points, t.result.labels, t.result.fillable_mask, scene);
         ASSERT_FALSE(scene.supports.empty());
         // The largest support is the floor: most of its pixels are the floor's.
         std::map<std::uint32_t, std::map<std::uint32_t, std::size_t>> overlap;  // label -> object id -> pixels
@@ -238,18 +239,18 @@ TEST(Scene, SyntheticTabletopsTheFloorIsTheSupportAndTheBoxesFitTheGeneratorsBox
     EXPECT_GE(ious[ious.size() / 2], 0.6) << "median box IoU over " << ious.size() << " boxes";
 }
 
-TEST(Scene, FittedBoxesHoldEveryPointOfTheirSegment) {
+TEST(Scene, FittedBoxesHoldEveryFillablePointOfTheirSegment) {
     const Tabletop t = tabletop(5);
     Scene scene;
     describe_scene(t.result.segments, sensor_preset(SensorKind::realsense_d435), SceneParams{}, scene);
-    fit_object_boxes(t.frame.points, t.result.labels, scene);
+    fit_object_boxes(t.frame.points, t.result.labels, t.result.fillable_mask, scene);
     ASSERT_FALSE(scene.objects.empty());
     std::map<std::uint32_t, const SceneObject*> by_label;
     for (const SceneObject& o : scene.objects) by_label[o.label] = &o;
     std::size_t checked = 0;
     for (std::size_t i = 0; i < t.result.labels.size(); ++i) {
         const auto it = by_label.find(t.result.labels[i]);
-        if (it == by_label.end()) continue;
+        if (it == by_label.end() || t.result.fillable_mask[i] == 0) continue;
         const Vec3 p = {t.frame.points[3 * i], t.frame.points[3 * i + 1], t.frame.points[3 * i + 2]};
         if (!std::isfinite(p[2])) continue;
         const SceneObject& o = *it->second;
