@@ -3,7 +3,8 @@
 // the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
 // pipeline_robust_merge with the preset's merge, as pipeline_robust_merge_stats with the segment statistics, and as
 // pipeline_robust_merge_color with a colour image and the colour edge term as well, pipeline_robust_merge_color_gated
-// with its curvature gate) (points, with estimated or given
+// with its curvature gate, pipeline_robust_merge_scene with the statistics and the scene summary of section 10c)
+// (points, with estimated or given
 // normals, to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame
 // size, next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers,
 // carry between machines.
@@ -22,6 +23,7 @@
 #include "bench/bench_scenes.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/presets.hpp"
+#include "pyrseg/scene.hpp"
 
 namespace pyrseg::bench {
 namespace {
@@ -33,6 +35,25 @@ void pipeline(benchmark::State& state, const std::string& backend, int width, in
     time_frames(
         state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
         [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params, outputs);
+}
+
+// The kinect-v1 preset with its merge and the statistics, then the scene of each frame (describe_scene and
+// fit_object_boxes on the host, into a Scene reused frame after frame).
+void scene_pipeline(benchmark::State& state, const std::string& backend, int width, int height, bool given_normals) {
+    const synthetic::Scene& s = scene(width, height);
+    const CloudView view{s.points.data(), given_normals ? s.normals.data() : nullptr, width, height};
+    Outputs outputs;
+    outputs.segment_stats = outputs.fillable_mask = true;
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Scene summary;
+    time_frames(
+        state, backend, width, height, std::size_t(width) * std::size_t(height) * 12 * (given_normals ? 2 : 1),
+        [&](Segmenter& segmenter, Result& result) {
+            segmenter.segment(view, result);
+            describe_scene(result.segments, params, SceneParams{}, summary);
+            fit_object_boxes(s.points, result.labels, result.fillable_mask, summary);
+        },
+        params, outputs);
 }
 
 // A colour image for the scene: each object its own colour, stripes across every other object (colour edges inside
@@ -162,6 +183,12 @@ int register_all() {
                 benchmark::RegisterBenchmark(
                     ("pipeline_robust_merge_stats/" + b.name + "/" + suffix).c_str(),
                     [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, stats); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // And the scene (section 10c) on the host from those statistics, its boxes fitted to the fillable
+                // points: the difference to pipeline_robust_merge is what statistics and scene cost together.
+                benchmark::RegisterBenchmark(("pipeline_robust_merge_scene/" + b.name + "/" + suffix).c_str(),
+                                             [=](benchmark::State& st) { scene_pipeline(st, b.name, w, h, given); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
                 // And with a colour image and the colour edge term (step 0c): the difference to

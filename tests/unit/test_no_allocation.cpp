@@ -13,6 +13,7 @@
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/presets.hpp"
+#include "pyrseg/scene.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 
@@ -169,6 +170,41 @@ TEST_P(NoAllocation, WarmFramesAllocateNothing) {
                   }),
                   0);
     }
+}
+
+// The scene of a warm frame (describe_scene and fit_object_boxes into a Scene that has seen as many segments)
+// allocates nothing; a fresh Scene does.
+TEST(NoAllocationScene, WarmScenesAllocateNothing) {
+    synthetic::SceneOptions o;
+    o.width = 320;
+    o.height = 240;
+    o.bin = false;
+    const synthetic::Scene a = synthetic::generate(o);
+    o.seed = 2;
+    const synthetic::Scene b = synthetic::generate(o);
+    Outputs outputs;
+    outputs.segment_stats = outputs.fillable_mask = true;
+    Segmenter segmenter(320, 240, {}, "cpu", outputs);
+    const Result ra = segmenter.segment(CloudView{a.points.data(), a.normals.data(), 320, 240});
+    const Result rb = segmenter.segment(CloudView{b.points.data(), b.normals.data(), 320, 240});
+    Scene scene;
+    const auto describe = [&](const synthetic::Scene& s, const Result& r) {
+        describe_scene(r.segments, segmenter.params(), SceneParams{}, scene);
+        fit_object_boxes(s.points, r.labels, r.fillable_mask, scene);
+    };
+    describe(a, ra);
+    describe(b, rb);
+    ASSERT_FALSE(scene.supports.empty());
+    ASSERT_FALSE(scene.objects.empty());
+    EXPECT_EQ(allocations_during([&] {
+                  for (int frame = 0; frame < 4; ++frame) frame % 2 ? describe(a, ra) : describe(b, rb);
+              }),
+              0);
+    EXPECT_GT(allocations_during([&] {
+                  Scene fresh;
+                  describe_scene(ra.segments, segmenter.params(), SceneParams{}, fresh);
+              }),
+              0);
 }
 
 // The same for the robust metric (texels, edge rounds) and for depth frames (their tables and packed samples).
