@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -30,6 +31,7 @@
 #include "tools/pcl_peer.hpp"
 #include "tools/printable.hpp"
 #include "tools/scene_picture.hpp"
+#include "tools/synthetic_scene_scores.hpp"
 
 namespace pyrseg::cli {
 namespace {
@@ -99,6 +101,7 @@ struct Frame {
     RgbImage color;           // empty without NAME_color.png
     bool picture = true;      // a picture of it is written
     bool plane_known = true;  // truth.plane is the support's (the synthetic frames' truth has no plane)
+    std::shared_ptr<const synthetic::Scene> generated;  // a synthetic frame's own scene (its primitives)
 };
 
 // Each name a preset (or `default`), NAME+merge with the merge on, NAME+nomerge with it off; the segment parameter
@@ -344,6 +347,27 @@ std::string object_table(const Frame& f, const std::vector<Method>& methods,
     return out + "\n";
 }
 
+// The q-quantile (nearest rank) of v; NaN when v is empty.
+double quantile(std::vector<double> v, double q) {
+    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, std::size_t(q * double(v.size())))];
+}
+
+std::string scene_scores_row(const std::string& first, const SyntheticSceneScores& s) {
+    const std::size_t flagged = s.planar_faces_flagged + s.cylinder_sides_flagged;
+    return "| " + first + " | " + std::to_string(s.floor_largest) + " of " + std::to_string(s.frames) + " | " +
+           std::to_string(s.box_iou.size()) + " | " +
+           printed("%.2f (%.2f)", quantile(s.box_iou, 0.5), quantile(s.box_iou, 0.25)) + " | " +
+           printed("%.2f / %.2f", quantile(s.plane_degrees, 0.5), quantile(s.plane_degrees, 0.95)) + " | " +
+           printed("%.1f / %.1f", quantile(s.plane_mm, 0.5), quantile(s.plane_mm, 0.95)) + " | " +
+           (flagged == 0 ? std::string("-") : printed("%.2f", double(s.planar_faces_flagged) / double(flagged))) +
+           " (" + std::to_string(s.planar_faces_flagged) + " of " + std::to_string(flagged) + ") | " +
+           (s.planar_faces == 0 ? std::string("-")
+                                : printed("%.2f", double(s.planar_faces_flagged) / double(s.planar_faces))) +
+           " (" + std::to_string(s.planar_faces_flagged) + " of " + std::to_string(s.planar_faces) + ") |\n";
+}
+
 // The picture in gray, darkened: what the scene's boxes are drawn over.
 RgbImage dimmed_gray(const RgbImage& image) {
     RgbImage out = image;
@@ -397,7 +421,8 @@ std::string scene_row(const Frame& f, const Method& method, const Result& statis
 // errors of pyrseg's methods into planes; the totals.
 std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std::vector<Method>& methods,
                                     double metres_per_unit, const fs::path& out_dir, std::ostringstream& per_frame,
-                                    std::ostringstream& planes, std::ostringstream& scenes) {
+                                    std::ostringstream& planes, std::ostringstream& scenes,
+                                    std::vector<SyntheticSceneScores>* synthetic_scenes = nullptr) {
     std::vector<PlaneError> worst(methods.size());
     std::vector<bool> measured(methods.size(), false);
     planes << "## The table's plane\n\nThe plane of the segment that holds most of the table (its statistics) against "
@@ -471,6 +496,15 @@ std::vector<Totals> evaluate_frames(const std::vector<Frame>& frames, const std:
                 worst[m].degrees = std::max(worst[m].degrees, e.degrees);
                 worst[m].mm = std::max(worst[m].mm, e.mm);
                 measured[m] = true;
+            }
+            if (f.generated && synthetic_scenes != nullptr && !statistics.segments.empty()) {
+                const std::vector<float> mm = io::depth_to_cloud(f.depth, f.camera, metres_per_unit).points;
+                std::vector<float> units = mm;
+                for (float& c : units) c = float(double(c) / methods[m].params.unit_mm);
+                describe_scene(statistics.segments, methods[m].params, SceneParams{}, scene);
+                fit_object_boxes(units, statistics.labels, statistics.fillable_mask, scene);
+                score_synthetic_scene(*f.generated, mm, statistics, scene, methods[m].params.unit_mm,
+                                      (*synthetic_scenes)[m]);
             }
             if (!statistics.segments.empty() && f.truth.found_plane && f.plane_known) {
                 scenes << scene_row(f, methods[m], statistics, s, metres_per_unit, inside_all, inside_whole, scene);
@@ -563,6 +597,7 @@ Frame synthetic_frame(synthetic::Sensor sensor, double distance_mm, std::uint64_
     f.truth.found_plane = true;
     f.plane_known = false;
     f.picture = seed == 1;
+    f.generated = std::make_shared<const synthetic::Scene>(scene);
     return f;
 }
 
@@ -587,6 +622,16 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
        << std::thread::hardware_concurrency() << " hardware threads. Ground truth: the generator's.\n\n## In sum\n\n"
        << printed(kTableHead, "sensor model: method");
     per_frame << "## Per frame\n\n";
+    std::ostringstream scenes;
+    scenes << "## Scenes\n\nThe scene summary (docs/algorithm.md section 10c) against the generator's scene: the "
+              "frames whose largest support is the floor; the 3D IoU of each box object's box with the generator's "
+              "box (boxes found whole: one segment holding 80% of the box's pixels and lying 80% on it); the plane "
+              "of each segment lying 80% on one flat part (a box face, the floor) against the part's plane (angle, "
+              "and the part's plane's distance from the segment's centroid); the `planar` flag on segments lying 80% "
+              "on a box face (planar) against a cylinder's side (not planar).\n\n| sensor model: method | floor "
+              "the largest support | boxes | box IoU median (25th percentile) | plane angle median / 95th "
+              "(degrees) | plane offset median / 95th (mm) | planar precision | planar recall |\n"
+              "|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const SensorKind kind : sensors) {
         const std::string name = sensor_kind_name(kind);
         std::vector<Frame> frames;
@@ -606,11 +651,16 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
         }
         std::ostringstream no_planes;
         std::ostringstream no_scenes;
+        std::vector<SyntheticSceneScores> scene_scores(methods.size());
         const std::vector<Totals> totals =
-            evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes, no_scenes);
-        for (std::size_t m = 0; m < methods.size(); ++m) md << row(name + ": `" + methods[m].name + "`", totals[m]);
+            evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes, no_scenes, &scene_scores);
+        for (std::size_t m = 0; m < methods.size(); ++m) {
+            md << row(name + ": `" + methods[m].name + "`", totals[m]);
+            if (scene_scores[m].frames > 0)
+                scenes << scene_scores_row(name + ": `" + methods[m].name + "`", scene_scores[m]);
+        }
     }
-    md << "\n" << per_frame.str();
+    md << "\n" << scenes.str() << "\n" << per_frame.str();
     const fs::path report = out_dir / "tabletop_synthetic.md";
     write_text_file(report, md.str());
     std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);

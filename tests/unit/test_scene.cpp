@@ -17,6 +17,7 @@
 #include "pyrseg/scene.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "tools/eval/tabletop_boxes.hpp"
 
 namespace pyrseg {
 namespace {
@@ -163,34 +164,10 @@ bool inside(const Vec3& centre, const std::array<Vec3, 3>& axes, const Vec3& ext
     return true;
 }
 
-// The 3D IoU of an object's box with a generator box, from a 24^3 lattice of points in each box.
+// The 3D IoU of an object's box with a generator box.
 double box_iou(const SceneObject& o, const synthetic::Primitive& p) {
-    const Vec3 truth_extents = {2 * p.half_size[0], 2 * p.half_size[1], 2 * p.half_size[2]};
-    auto share_inside = [](const Vec3& c, const std::array<Vec3, 3>& axes, const Vec3& e, const Vec3& oc,
-                           const std::array<Vec3, 3>& oaxes, const Vec3& oe) {
-        constexpr int kSteps = 24;
-        int held = 0;
-        for (int i = 0; i < kSteps; ++i) {
-            for (int j = 0; j < kSteps; ++j) {
-                for (int k = 0; k < kSteps; ++k) {
-                    const std::array<double, 3> f = {(i + 0.5) / kSteps - 0.5, (j + 0.5) / kSteps - 0.5,
-                                                     (k + 0.5) / kSteps - 0.5};
-                    Vec3 q = c;
-                    for (std::size_t a = 0; a < 3; ++a) {
-                        for (std::size_t d = 0; d < 3; ++d) q[d] += f[a] * e[a] * axes[a][d];
-                    }
-                    if (inside(oc, oaxes, oe, q)) ++held;
-                }
-            }
-        }
-        return double(held) / (kSteps * kSteps * kSteps);
-    };
-    const double truth_volume = truth_extents[0] * truth_extents[1] * truth_extents[2];
-    const double ours_volume = o.extents[0] * o.extents[1] * o.extents[2];
-    const double a = share_inside(p.center, p.axes, truth_extents, o.box_centre, o.axes, o.extents) * truth_volume;
-    const double b = share_inside(o.box_centre, o.axes, o.extents, p.center, p.axes, truth_extents) * ours_volume;
-    const double intersection = 0.5 * (a + b);
-    return intersection / (truth_volume + ours_volume - intersection);
+    return eval::box_iou({o.label, o.box_centre, o.axes, o.extents},
+                         {p.id, p.center, p.axes, {2 * p.half_size[0], 2 * p.half_size[1], 2 * p.half_size[2]}});
 }
 
 TEST(Scene, SyntheticTabletopsTheFloorIsTheSupportAndTheBoxesFitTheGeneratorsBoxes) {

@@ -16,6 +16,40 @@ bool box_holds(const OrientedBox& box, const std::array<double, 3>& p) {
     return true;
 }
 
+namespace {
+
+// The share of a lattice of points filling `box` that lies inside `other`.
+double lattice_share_inside(const OrientedBox& box, const OrientedBox& other) {
+    constexpr int kSteps = 24;
+    int held = 0;
+    for (int i = 0; i < kSteps; ++i) {
+        for (int j = 0; j < kSteps; ++j) {
+            for (int k = 0; k < kSteps; ++k) {
+                const std::array<double, 3> f = {(i + 0.5) / kSteps - 0.5, (j + 0.5) / kSteps - 0.5,
+                                                 (k + 0.5) / kSteps - 0.5};
+                std::array<double, 3> q = box.centre;
+                for (std::size_t a = 0; a < 3; ++a) {
+                    for (std::size_t c = 0; c < 3; ++c) q[c] += f[a] * box.extents[a] * box.axes[a][c];
+                }
+                if (box_holds(other, q)) ++held;
+            }
+        }
+    }
+    return double(held) / (kSteps * kSteps * kSteps);
+}
+
+double volume(const OrientedBox& b) {
+    return b.extents[0] * b.extents[1] * b.extents[2];
+}
+
+}  // namespace
+
+double box_iou(const OrientedBox& a, const OrientedBox& b) {
+    const double intersection = 0.5 * (lattice_share_inside(a, b) * volume(a) + lattice_share_inside(b, a) * volume(b));
+    const double union_volume = volume(a) + volume(b) - intersection;
+    return union_volume > 0 ? intersection / union_volume : 0.0;
+}
+
 std::vector<ObjectBoxScore> score_boxes(std::span<const std::uint32_t> truth, std::uint32_t objects,
                                         std::span<const std::uint32_t> predicted, std::span<const float> points,
                                         std::span<const OrientedBox> boxes) {

@@ -27,6 +27,10 @@ struct ObjectBoxScore {
 // Whether point p lies inside the box (on its faces included).
 [[nodiscard]] bool box_holds(const OrientedBox& box, const std::array<double, 3>& p);
 
+// The 3D IoU of two oriented boxes, from a lattice of 24^3 points in each: the share of a's lattice inside b times
+// a's volume, and the other way round, averaged, is the intersection's volume (within about 1% of a box's volume).
+[[nodiscard]] double box_iou(const OrientedBox& a, const OrientedBox& b);
+
 // truth: kTruthNone, kTruthTable or an object id (2 .. objects + 1) per pixel; predicted: the segment labels;
 // points: 3 per pixel in the boxes' units (NaN where there is none). One score per truth object, in id order.
 // Throws std::invalid_argument when the lengths disagree.

@@ -1,0 +1,31 @@
+#pragma once
+// How the scene summary (docs/algorithm.md section 10c) of a synthetic frame compares with the generator's own
+// scene: whether the largest support is the floor; the 3D IoU of each box object's box with the generator's box
+// (objects the segmentation finds whole: one segment holding 80% of the object's pixels and lying 80% on it); the
+// plane of each segment lying 80% on one flat part (a box face, the floor) against that part's plane; and the
+// `planar` flag on segments lying 80% on a box face (planar) or a cylinder's side (not).
+#include <cstdint>
+#include <vector>
+
+#include "pyrseg/result.hpp"
+#include "pyrseg/scene.hpp"
+#include "pyrseg/synthetic.hpp"
+
+namespace pyrseg::cli {
+
+struct SyntheticSceneScores {
+    std::size_t frames = 0;
+    std::size_t floor_largest = 0;  // frames whose largest support lies 90% on the floor
+    std::vector<double> box_iou;
+    std::vector<double> plane_degrees;  // the angle between a flat part's segment's plane and the part's
+    std::vector<double> plane_mm;       // the part's plane's distance from the segment's centroid
+    std::size_t planar_faces = 0, planar_faces_flagged = 0;  // segments on a box face; of them, flagged planar
+    std::size_t cylinder_sides = 0, cylinder_sides_flagged = 0;
+};
+
+// points: the frame's points in millimetres (3 per pixel, NaN where none); result: labels and segments of a frame
+// segmented with unit_mm; scene: its scene with the boxes fitted.
+void score_synthetic_scene(const synthetic::Scene& truth, const std::vector<float>& points, const Result& result,
+                           const Scene& scene, double unit_mm, SyntheticSceneScores& out);
+
+}  // namespace pyrseg::cli
