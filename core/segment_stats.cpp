@@ -36,6 +36,10 @@ std::int32_t z_from_key(std::uint32_t key) {
     return static_cast<std::int32_t>(key ^ 0x80000000u);
 }
 
+// A planar segment's second variance is at least this many times its smallest (its second side at least 4 times its
+// thickness).
+constexpr double kPlanarSpread = 16.0;
+
 // Section 10b: the covariance from the exact sums, then the plane, the box and the planar flag.
 void derive_geometry(const Params& params, double unit, SegmentStats& s) {
     const auto n = Int128(s.fillable_count);
@@ -77,7 +81,9 @@ void derive_geometry(const Params& params, double unit, SegmentStats& s) {
     for (std::size_t i = 0; i < 3; ++i) s.extents[i] = 2.0 * std::sqrt(3.0 * std::max(e.values[i], 0.0));
     const double z_m = std::fabs(s.centroid[2]) * params.unit_mm * 1e-3;
     const double tolerance_mm = params.planar_tolerance_mm + params.planar_tolerance_per_m2 * z_m * z_m;
-    s.planar = s.fillable_count >= 3 && s.plane_rms * params.unit_mm <= tolerance_mm;
+    // Spread in two dimensions, not along a line: a sliver's plane is any plane through it.
+    const bool two_dimensional = std::max(e.values[1], 0.0) >= kPlanarSpread * smallest;
+    s.planar = s.fillable_count >= 3 && two_dimensional && s.plane_rms * params.unit_mm <= tolerance_mm;
 }
 
 void no_geometry(SegmentStats& s) {

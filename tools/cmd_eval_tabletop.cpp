@@ -359,6 +359,7 @@ std::string scene_scores_row(const std::string& first, const SyntheticSceneScore
     return "| " + first + " | " + std::to_string(s.floor_largest) + " of " + std::to_string(s.frames) + " | " +
            std::to_string(s.box_iou.size()) + " | " +
            printed("%.2f (%.2f)", quantile(s.box_iou, 0.5), quantile(s.box_iou, 0.25)) + " | " +
+           std::to_string(s.plane_degrees.size()) + ": " +
            printed("%.2f / %.2f", quantile(s.plane_degrees, 0.5), quantile(s.plane_degrees, 0.95)) + " | " +
            printed("%.1f / %.1f", quantile(s.plane_mm, 0.5), quantile(s.plane_mm, 0.95)) + " | " +
            (flagged == 0 ? std::string("-") : printed("%.2f", double(s.planar_faces_flagged) / double(flagged))) +
@@ -626,8 +627,10 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
     scenes << "## Scenes\n\nThe scene summary (docs/algorithm.md section 10c) against the generator's scene: the "
               "frames whose largest support is the floor; the 3D IoU of each box object's box with the generator's "
               "box (boxes found whole: one segment holding 80% of the box's pixels and lying 80% on it); the plane "
-              "of each segment lying 80% on one flat part (a box face, the floor) against the part's plane (angle, "
-              "and the part's plane's distance from the segment's centroid); the `planar` flag on segments lying 80% "
+              "of each segment flagged planar that lies 80% on one flat part (a box face, the floor) against the "
+              "part's plane (how many, the angle, and the part's plane's distance from the segment's centroid; for "
+              "PCL's OrganizedMultiPlaneSegmentation its planes whose inliers lie 80% on one flat part); the `planar` "
+              "flag on segments lying 80% "
               "on a box face (planar) against a cylinder's side (not planar).\n\n| sensor model: method | floor "
               "the largest support | boxes | box IoU median (25th percentile) | plane angle median / 95th "
               "(degrees) | plane offset median / 95th (mm) | planar precision | planar recall |\n"
@@ -654,6 +657,37 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
         std::vector<SyntheticSceneScores> scene_scores(methods.size());
         const std::vector<Totals> totals =
             evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes, no_scenes, &scene_scores);
+        if (pcl_peer_missing().empty()) {
+            // PCL's OrganizedMultiPlaneSegmentation, its maximum curvature picked from a small grid by the median
+            // plane angle over these frames (the smallest wins; the first of equals).
+            SyntheticSceneScores best;
+            std::string best_settings;
+            for (const float curvature : {0.001f, 0.01f, 0.05f}) {
+                SyntheticSceneScores peer;
+                std::string settings;
+                for (const Frame& f : frames) {
+                    const io::PointCloud cloud = io::depth_to_cloud(f.depth, f.camera, 0.001);
+                    const std::vector<peers::PclPlane> planes = pcl_planes(cloud, kind, curvature, &settings);
+                    std::vector<PeerPlane> scored;
+                    scored.reserve(planes.size());
+                    for (const peers::PclPlane& plane : planes) scored.push_back({plane.normal, &plane.inliers});
+                    score_peer_planes(*f.generated, cloud.points, scored, peer);
+                }
+                if (!peer.plane_degrees.empty() &&
+                    (best.plane_degrees.empty() ||
+                     quantile(peer.plane_degrees, 0.5) < quantile(best.plane_degrees, 0.5))) {
+                    best = std::move(peer);
+                    best_settings = settings;
+                }
+            }
+            if (!best.plane_degrees.empty()) {
+                scenes << "| " << name << ": PCL OMPS (" << best_settings << ") | - | - | - | "
+                       << best.plane_degrees.size() << ": "
+                       << printed("%.2f / %.2f", quantile(best.plane_degrees, 0.5), quantile(best.plane_degrees, 0.95))
+                       << " | " << printed("%.1f / %.1f", quantile(best.plane_mm, 0.5), quantile(best.plane_mm, 0.95))
+                       << " | - | - |\n";
+            }
+        }
         for (std::size_t m = 0; m < methods.size(); ++m) {
             md << row(name + ": `" + methods[m].name + "`", totals[m]);
             if (scene_scores[m].frames > 0)

@@ -1,6 +1,7 @@
 #include "tools/pcl_peer.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "pyrseg/error.hpp"
 #ifdef PYRSEG_HAVE_PCL_PEER
@@ -82,7 +83,31 @@ PclRun lccp_segment(const io::PointCloud& cloud_mm, const std::uint8_t* rgb, con
     run.settings = std::string("PCL ") + peers::pcl_version() + " supervoxels + LCCP, " + peers::describe(settings);
     return run;
 }
+std::vector<peers::PclPlane> pcl_planes(const io::PointCloud& cloud_mm, std::optional<SensorKind> kind,
+                                        float maximum_curvature, std::string* settings) {
+    peers::PclPlaneSettings s;
+    s.normals = settings_for(kind);
+    s.angular_threshold_rad = s.normals.angular_threshold_rad;
+    s.distance_threshold_mm = s.normals.distance_threshold_mm;
+    s.maximum_curvature = maximum_curvature;
+    s.min_inliers = 100;
+    if (settings != nullptr) {
+        char text[160];
+        std::snprintf(text, sizeof text, ", %g rad, %g mm, curvature <= %g, >= %u inliers",
+                      double(s.angular_threshold_rad), double(s.distance_threshold_mm), double(s.maximum_curvature),
+                      unsigned(s.min_inliers));
+        *settings = std::string("PCL ") + peers::pcl_version() + " OrganizedMultiPlaneSegmentation, " +
+                    peers::pcl_normal_method_name(s.normals.normal_method) + " normals, smoothing " +
+                    std::to_string(int(s.normals.normal_smoothing_size)) + text;
+    }
+    return peers::pcl_multi_plane(cloud_mm.points.data(), cloud_mm.width, cloud_mm.height, s);
+}
 #else
+std::vector<peers::PclPlane> pcl_planes(const io::PointCloud& /*cloud_mm*/, std::optional<SensorKind> /*kind*/,
+                                        float /*maximum_curvature*/, std::string* /*settings*/) {
+    throw Error(ErrorCode::invalid_argument, "OrganizedMultiPlaneSegmentation: " + pcl_peer_missing());
+}
+
 PclRun lccp_segment(const io::PointCloud& /*cloud_mm*/, const std::uint8_t* /*rgb*/,
                     const peers::LccpSettings& /*settings*/) {
     throw Error(ErrorCode::invalid_argument, "LCCP: " + pcl_peer_missing());

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "peers/pcl_lccp.hpp"
+#include "peers/pcl_planes.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/presets.hpp"
 
@@ -30,6 +31,14 @@ struct PclRun {
 // or null); the settings in words in `settings`. Throws pyrseg::Error when this build has no PCL peer.
 [[nodiscard]] PclRun lccp_segment(const io::PointCloud& cloud_mm, const std::uint8_t* rgb,
                                   const peers::LccpSettings& settings);
+// PCL's OrganizedMultiPlaneSegmentation (peers/pcl_planes.hpp) of a cloud in millimetres: its integral-image normals,
+// angular and distance thresholds those `pyrseg eval` tuned PCL's organized segmentation with for `kind`, at least 100
+// inliers (the scene's object_min_pixels), and the given maximum curvature (PCL's default 0.001 keeps no plane of a
+// noisy sensor: `pyrseg eval --tabletop-synthetic` picks it per sensor from a small grid). Throws pyrseg::Error when
+// this build has no PCL peer.
+[[nodiscard]] std::vector<peers::PclPlane> pcl_planes(const io::PointCloud& cloud_mm, std::optional<SensorKind> kind,
+                                                      float maximum_curvature, std::string* settings = nullptr);
+
 // The small grid `pyrseg eval --tabletop` tunes LCCP over: seed resolution 20 and 30 mm x concavity tolerance 10 and
 // 20 degrees x colour importance 0 and 0.2, the rest PCL's LCCP example's (voxels of 7.5 mm, spatial importance 1,
 // normal importance 4, smoothness check 0.1, sanity check, one camera's transform).

@@ -62,7 +62,45 @@ bool flat_part_plane(const synthetic::Primitive& p, int part, Vec3& point, Vec3&
     return true;
 }
 
+// The angle between a plane's normal and the part's, and the part's plane's distance from the plane's centroid (mm).
+void add_plane_error(const synthetic::Primitive& p, const Part& part, const Vec3& normal, const Vec3& centroid_mm,
+                     SyntheticSceneScores& out) {
+    Vec3 point{}, truth_normal{};
+    if (!flat_part_plane(p, part.part, point, truth_normal)) return;
+    const double cosine = std::min(1.0, std::fabs(dot(truth_normal, normal)));
+    out.plane_degrees.push_back(std::acos(cosine) * 180.0 / std::numbers::pi);
+    const Vec3 c = {centroid_mm[0] - point[0], centroid_mm[1] - point[1], centroid_mm[2] - point[2]};
+    out.plane_mm.push_back(std::fabs(dot(truth_normal, c)));
+}
+
 }  // namespace
+
+void score_peer_planes(const synthetic::Scene& truth, const std::vector<float>& points,
+                       const std::vector<PeerPlane>& planes, SyntheticSceneScores& out) {
+    std::map<std::uint32_t, const synthetic::Primitive*> primitive;
+    for (const synthetic::Primitive& p : truth.primitives) primitive[p.id] = &p;
+    ++out.frames;
+    for (const PeerPlane& plane : planes) {
+        std::map<Part, std::size_t> on;
+        Vec3 sum{};
+        std::size_t n = 0;
+        for (const std::uint32_t index : *plane.inliers) {
+            const std::size_t i = index;
+            const Vec3 pt = {points[3 * i], points[3 * i + 1], points[3 * i + 2]};
+            const auto p = primitive.find(truth.object_id[i]);
+            if (p == primitive.end() || !std::isfinite(pt[2])) continue;
+            ++on[{p->first, part_of(*p->second, pt)}];
+            for (std::size_t c = 0; c < 3; ++c) sum[c] += pt[c];
+            ++n;
+        }
+        if (n == 0) continue;
+        for (const auto& [part, count] : on) {
+            if (count * 10 < n * 8) continue;
+            const Vec3 centroid = {sum[0] / double(n), sum[1] / double(n), sum[2] / double(n)};
+            add_plane_error(*primitive.at(part.id), part, plane.normal, centroid, out);
+        }
+    }
+}
 
 void score_synthetic_scene(const synthetic::Scene& truth, const std::vector<float>& points, const Result& result,
                            const Scene& scene, double unit_mm, SyntheticSceneScores& out) {
@@ -107,13 +145,9 @@ void score_synthetic_scene(const synthetic::Scene& truth, const std::vector<floa
             ++out.cylinder_sides;
             if (s.planar) ++out.cylinder_sides_flagged;
         }
-        Vec3 point{}, normal{};
-        if (!flat_part_plane(p, d->second.part, point, normal)) continue;
-        const double cosine = std::min(1.0, std::fabs(dot(normal, s.plane_normal)));
-        out.plane_degrees.push_back(std::acos(cosine) * 180.0 / std::numbers::pi);
-        const Vec3 c = {s.centroid[0] * unit_mm - point[0], s.centroid[1] * unit_mm - point[1],
-                        s.centroid[2] * unit_mm - point[2]};
-        out.plane_mm.push_back(std::fabs(dot(normal, c)));
+        if (!s.planar) continue;  // the plane models: segments flagged planar, as a peer returns only planes
+        add_plane_error(p, d->second, s.plane_normal,
+                        {s.centroid[0] * unit_mm, s.centroid[1] * unit_mm, s.centroid[2] * unit_mm}, out);
     }
     for (const SceneObject& o : scene.objects) {
         const auto held = object_in_segment.find(o.label);

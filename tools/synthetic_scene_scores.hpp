@@ -4,6 +4,7 @@
 // (objects the segmentation finds whole: one segment holding 80% of the object's pixels and lying 80% on it); the
 // plane of each segment lying 80% on one flat part (a box face, the floor) against that part's plane; and the
 // `planar` flag on segments lying 80% on a box face (planar) or a cylinder's side (not).
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -27,5 +28,15 @@ struct SyntheticSceneScores {
 // segmented with unit_mm; scene: its scene with the boxes fitted.
 void score_synthetic_scene(const synthetic::Scene& truth, const std::vector<float>& points, const Result& result,
                            const Scene& scene, double unit_mm, SyntheticSceneScores& out);
+
+// A peer's planes (PCL's OrganizedMultiPlaneSegmentation) on the same frame, scored as the segments' planes are:
+// each plane whose inliers lie 80% on one flat part, against that part's plane (the distance from its inliers'
+// centroid). normals[k] and offsets don't matter beyond the normal: the angle is the normal's.
+struct PeerPlane {
+    std::array<double, 3> normal{};
+    const std::vector<std::uint32_t>* inliers = nullptr;  // pixel indices
+};
+void score_peer_planes(const synthetic::Scene& truth, const std::vector<float>& points,
+                       const std::vector<PeerPlane>& planes, SyntheticSceneScores& out);
 
 }  // namespace pyrseg::cli

@@ -192,6 +192,29 @@ TEST(SegmentGeometry, ThePlanarToleranceGrowsWithDepth) {
     EXPECT_TRUE(lenient.segment(c.view()).segments[0].planar);
 }
 
+TEST(SegmentGeometry, ANoisySliverIsNotPlanar) {
+    // A strip 128 mm long and 4 mm across (16 rows 0.25 mm apart) with a 0.5 mm ripple: its RMS is well within the
+    // 2 mm tolerance, but its plane is any plane through a line (second variance 1.3 mm^2, smallest 0.25); the same
+    // ripple on a 128 mm square is planar.
+    for (const bool sliver : {true, false}) {
+        const int w = 64;
+        const int h = sliver ? 16 : 64;
+        Cloud c = plane_patch(w, h, {-64, -64, 1000}, {1, 0, 0}, {0, 1, 0}, 2.0);
+        for (std::size_t i = 0; i < std::size_t(w) * std::size_t(h); ++i) {
+            if (sliver) c.points[3 * i + 1] = float(-64.0 + 0.25 * double(i / std::size_t(w)));
+            c.points[3 * i + 2] += i % 2 ? 0.5f : -0.5f;
+        }
+        Params p;
+        p.dt = 1e9;
+        p.ct = std::numbers::pi;
+        Segmenter seg(w, h, p, "cpu", stats_only());
+        const Result r = seg.segment(c.view());
+        ASSERT_EQ(r.segment_count, 1u) << sliver;
+        EXPECT_NEAR(r.segments[0].plane_rms, 0.5, 0.01) << sliver;
+        EXPECT_EQ(r.segments[0].planar, !sliver) << sliver;
+    }
+}
+
 TEST(SegmentGeometry, OfAMaskIsNaN) {
     const int w = 40;
     const int h = 30;
