@@ -181,6 +181,16 @@ void describe_scene(const std::vector<SegmentStats>& segments, const Params& par
 
 namespace pyrseg {
 
+std::array<double, 3> box_corner(const std::array<double, 3>& centre, const std::array<std::array<double, 3>, 3>& axes,
+                                 const std::array<double, 3>& extents, int bits) {
+    Vec3 p = centre;
+    for (std::size_t a = 0; a < 3; ++a) {
+        const double half = ((bits >> a) & 1) != 0 ? 0.5 * extents[a] : -0.5 * extents[a];
+        for (std::size_t c = 0; c < 3; ++c) p[c] += half * axes[a][c];
+    }
+    return p;
+}
+
 void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels,
                       std::span<const std::uint8_t> fillable, Scene& scene) {
     if (points.size() != 3 * labels.size()) {

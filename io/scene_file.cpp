@@ -59,15 +59,6 @@ std::string to_json(const Scene& scene, const SegmentTable& frame) {
     return doc.dump(1) + "\n";
 }
 
-Vec3 corner(const Vec3& centre, const std::array<Vec3, 3>& axes, const Vec3& extents, int sx, int sy, int sz) {
-    Vec3 p = centre;
-    const int signs[3] = {sx, sy, sz};
-    for (std::size_t a = 0; a < 3; ++a) {
-        for (std::size_t c = 0; c < 3; ++c) p[c] += 0.5 * signs[a] * extents[a] * axes[a][c];
-    }
-    return p;
-}
-
 // ASCII PLY: each object's box as 8 vertices and 12 triangles in its segment's colour; each support's outline (its
 // box's rectangle in its plane) as 4 vertices and 2 triangles, in its colour.
 std::string to_ply(const Scene& scene) {
@@ -94,20 +85,14 @@ std::string to_ply(const Scene& scene) {
     for (const SceneSupport& s : scene.supports) {
         const std::size_t first = vertex_count;
         const Vec3 flat = {s.extents[0], s.extents[1], 0.0};
-        add_vertex(corner(s.centroid, s.axes, flat, -1, -1, 0), s.label);
-        add_vertex(corner(s.centroid, s.axes, flat, 1, -1, 0), s.label);
-        add_vertex(corner(s.centroid, s.axes, flat, 1, 1, 0), s.label);
-        add_vertex(corner(s.centroid, s.axes, flat, -1, 1, 0), s.label);
+        for (const int bits : {0, 1, 3, 2}) add_vertex(box_corner(s.centroid, s.axes, flat, bits), s.label);
         add_quad(first, 0, 1, 2, 3);
     }
     for (const SceneObject& o : scene.objects) {
         if (!std::isfinite(o.extents[0]) || !std::isfinite(o.extents[1]) || !std::isfinite(o.extents[2])) continue;
         const std::size_t first = vertex_count;
-        // Vertex i has signs (bit 0: x, bit 1: y, bit 2: z), minus for a clear bit.
-        for (int i = 0; i < 8; ++i) {
-            add_vertex(corner(o.box_centre, o.axes, o.extents, (i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1),
-                       o.label);
-        }
+        // Vertex i is box_corner i (bit a set: the positive side of axis a).
+        for (int i = 0; i < 8; ++i) add_vertex(box_corner(o.box_centre, o.axes, o.extents, i), o.label);
         add_quad(first, 0, 2, 3, 1);  // z-
         add_quad(first, 4, 5, 7, 6);  // z+
         add_quad(first, 0, 1, 5, 4);  // y-

@@ -11,15 +11,6 @@ namespace {
 
 using Vec3 = std::array<double, 3>;
 
-Vec3 corner(const Vec3& centre, const std::array<Vec3, 3>& axes, const Vec3& extents, int bits) {
-    Vec3 p = centre;
-    for (std::size_t a = 0; a < 3; ++a) {
-        const double half = ((bits >> a) & 1) != 0 ? 0.5 * extents[a] : -0.5 * extents[a];
-        for (std::size_t c = 0; c < 3; ++c) p[c] += half * axes[a][c];
-    }
-    return p;
-}
-
 std::optional<std::array<int, 2>> project(const Vec3& p, const PinholeCamera& k) {
     constexpr double kFar = 1e6;  // pixels: far enough off the picture, small enough for int
     if (!(p[2] > 0)) return std::nullopt;
@@ -45,8 +36,8 @@ RgbImage scene_picture(const RgbImage& base, const Scene& scene, const PinholeCa
         const Vec3 flat = {s.extents[0], s.extents[1], 0.0};
         const int ring[4] = {0, 1, 3, 2};
         for (int i = 0; i < 4; ++i) {
-            edge(image, corner(s.centroid, s.axes, flat, ring[i]), corner(s.centroid, s.axes, flat, ring[(i + 1) % 4]),
-                 camera, kWhite);
+            edge(image, box_corner(s.centroid, s.axes, flat, ring[i]),
+                 box_corner(s.centroid, s.axes, flat, ring[(i + 1) % 4]), camera, kWhite);
         }
     }
     for (const SceneObject& o : scene.objects) {
@@ -56,8 +47,8 @@ RgbImage scene_picture(const RgbImage& base, const Scene& scene, const PinholeCa
             for (int a = 0; a < 3; ++a) {
                 const int other = bits | (1 << a);
                 if (other != bits) {
-                    edge(image, corner(o.box_centre, o.axes, o.extents, bits),
-                         corner(o.box_centre, o.axes, o.extents, other), camera, color);
+                    edge(image, box_corner(o.box_centre, o.axes, o.extents, bits),
+                         box_corner(o.box_centre, o.axes, o.extents, other), camera, color);
                 }
             }
         }

@@ -72,6 +72,13 @@ PYRSEG_EXPORT void describe_scene(const std::vector<SegmentStats>& segments, con
 
 namespace pyrseg {
 
+// Corner `bits` (0..7) of a box (a SceneObject's box_centre, axes, extents, or a support's centroid, axes, extents):
+// bit a set puts it on the positive side of axes[a]. With extents[2] = 0, corners 0, 1, 3, 2 go round the rectangle
+// of the first two axes (a support's outline).
+[[nodiscard]] PYRSEG_EXPORT std::array<double, 3> box_corner(const std::array<double, 3>& centre,
+                                                             const std::array<std::array<double, 3>, 3>& axes,
+                                                             const std::array<double, 3>& extents, int bits);
+
 // The boxes of the moments hold a uniformly covered block exactly, but less of a disc or a cylinder's side, whose
 // points crowd towards the rims. Where the caller has the frame's points on the host, this tightens every object's
 // box to them: along each of its axes, from the least to the greatest coordinate of the object's points (from the

@@ -156,14 +156,6 @@ Tabletop tabletop(std::uint64_t seed) {
     return t;
 }
 
-bool inside(const Vec3& centre, const std::array<Vec3, 3>& axes, const Vec3& extents, const Vec3& p) {
-    const Vec3 d = {p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
-    for (std::size_t a = 0; a < 3; ++a) {
-        if (std::fabs(dot(d, axes[a])) > 0.5 * extents[a] + 1e-9) return false;
-    }
-    return true;
-}
-
 // The 3D IoU of an object's box with a generator box.
 double box_iou(const SceneObject& o, const synthetic::Primitive& p) {
     return eval::box_iou({o.label, o.box_centre, o.axes, o.extents},
@@ -233,8 +225,9 @@ TEST(Scene, FittedBoxesHoldEveryFillablePointOfTheirSegment) {
         const SceneObject& o = *it->second;
         // A millionth of the box's size for the rounding of its centre.
         const double slack = 1e-6 * (o.extents[0] + o.extents[1] + o.extents[2]);
-        const Vec3 grown = {o.extents[0] + slack, o.extents[1] + slack, o.extents[2] + slack};
-        ASSERT_TRUE(inside(o.box_centre, o.axes, grown, p)) << "pixel " << i << " of segment " << o.label;
+        const eval::OrientedBox grown{
+            o.label, o.box_centre, o.axes, {o.extents[0] + slack, o.extents[1] + slack, o.extents[2] + slack}};
+        ASSERT_TRUE(eval::box_holds(grown, p)) << "pixel " << i << " of segment " << o.label;
         ++checked;
     }
     EXPECT_GT(checked, 1000u);
