@@ -3,7 +3,8 @@
 // the kinect-v1 preset without its merge on the same frames, so that its cost shows per pass, and as
 // pipeline_robust_merge with the preset's merge, as pipeline_robust_merge_stats with the segment statistics, and as
 // pipeline_robust_merge_color with a colour image and the colour edge term as well, pipeline_robust_merge_color_gated
-// with its curvature gate, pipeline_robust_merge_scene with the statistics and the scene summary of section 10c)
+// with its curvature gate, pipeline_robust_merge_graph with the segment graph of section 10d,
+// pipeline_robust_merge_scene with the statistics and the scene summary of section 10c)
 // (points, with estimated or given
 // normals, to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame
 // size, next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers,
@@ -183,6 +184,14 @@ int register_all() {
                 benchmark::RegisterBenchmark(
                     ("pipeline_robust_merge_stats/" + b.name + "/" + suffix).c_str(),
                     [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, stats); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+                // And with the segment graph (section 10d): the difference to pipeline_robust_merge is its cost.
+                Outputs graph;
+                graph.segment_graph = true;
+                benchmark::RegisterBenchmark(
+                    ("pipeline_robust_merge_graph/" + b.name + "/" + suffix).c_str(),
+                    [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, graph); })
                     ->Unit(benchmark::kMillisecond)
                     ->UseRealTime();
                 // And the scene (section 10c) on the host from those statistics, its boxes fitted to the fillable

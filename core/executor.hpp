@@ -75,6 +75,9 @@ public:
     // Per-segment statistics into plan.stats_slots slots (docs/algorithm.md section 10), after compact; read_back
     // returns them (core/segment_stats.hpp decodes the words).
     virtual void segment_stats() = 0;
+    // The segment graph into plan.graph_slots slots (docs/algorithm.md section 10d), after compact; read_back
+    // returns it (core/segment_graph.hpp sorts the pairs).
+    virtual void segment_graph() = 0;
     // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
     // Device-resident frames (core/device_frame.hpp), on a GPU backend made on the caller's context: the input

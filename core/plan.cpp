@@ -264,6 +264,18 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         plan.merge_slots = std::uint32_t(slots);
     }
     plan.keep_normals = outputs.normals;
+    if (outputs.segment_graph) {
+        // The final labels are 4-connected too (the merge joins touching labels), so their pairs are the edges of a
+        // planar graph on at most K of them (K bounded as for the statistics below).
+        const PyrLevel& lm = plan.small_image ? plan.full() : plan.level(m);
+        const std::uint64_t pairs = 3 * std::uint64_t(lm.width) * lm.height + 3;
+        const std::uint64_t slots = std::uint64_t(1) << ceil_log2(2 * pairs + 1);
+        if (1 + std::uint64_t(PYR_GRAPH_SLOT_WORDS) * (slots + slots / 2) > kMax32) {
+            throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                        " is too large for the segment graph's 32-bit pair table");
+        }
+        plan.graph_slots = std::uint32_t(slots);
+    }
     if (outputs.segment_stats) {
         // Steps 3 to 6 only copy labels, so every final label lies on a fillable texel of level M and
         // K <= w_M * h_M; the fallback's labels are pixels.

@@ -56,6 +56,9 @@ struct Plan {
     // The merge's pair table (shaders/pyr_merge_table.h, every backend): a power of two above twice the pairs a
     // frame can have; 0 without the merge.
     std::uint32_t merge_slots = 0;
+    // The segment graph's pair table (Outputs::segment_graph; shaders/pyr_graph.h): a power of two above twice the
+    // pairs a frame can have; 0 when not asked for.
+    std::uint32_t graph_slots = 0;
     // Outputs::normals: the frame returns the normals the metric used, so a backend must keep them per pixel.
     bool keep_normals = false;
 
@@ -74,6 +77,12 @@ struct Plan {
         return (std::uint32_t(width) + PYR_STATS_RUN - 1) / PYR_STATS_RUN;
     }
     [[nodiscard]] float stats_point_scale() const;
+    // The segment graph's words: the pairs' counter, the table, and the dense list of at most half as many pairs
+    // (shaders/pyr_graph.h); where the list starts.
+    [[nodiscard]] std::size_t graph_words() const {
+        return graph_slots == 0 ? 0 : 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * (graph_slots + graph_slots / 2);
+    }
+    [[nodiscard]] std::size_t graph_list_word() const { return 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * graph_slots; }
 };
 
 // Validates everything before anything is allocated. Throws pyrseg::Error.

@@ -12,12 +12,13 @@
  *    PYR_NORMAL(k) (float k of the xyz arrays), PYR_STORE_POINT(k, v), PYR_STORE_NORMAL(k, v), PYR_STORE_MASK(i, v)
  *    and PYR_MASK_INPUT(i) (bind_mask's packed word per pixel, in the points buffer); PYR_UF_LOAD, PYR_UF_STORE
  *    and PYR_UF_MIN over the fill scratch buffer (shaders/pyr_uf.h), and PYR_UF_CAS and PYR_UF_ADD there for the
- *    merge (shaders/pyr_merge_table.h);
+ *    merge (shaders/pyr_merge_table.h) and the segment graph (shaders/pyr_graph.h);
  *  - PYR_ENTRY_ALL to compile every entry point, or PYR_ENTRY_<NAME> for one (GLSL: one module per kernel).
  * The host side of every dispatch is core/gpu/gpu_executor.cpp; the argument words of each kernel are listed
  * above it. */
 #ifndef PYR_ENTRIES_H
 #define PYR_ENTRIES_H
+#include "pyr_graph.h"
 #include "pyr_kernels.h"
 #include "pyr_merge_table.h"
 #include "pyr_uf.h"
@@ -496,6 +497,30 @@ PYR_KERNEL_1D(stats) {
     if (run >= PYR_ARG(2)) return;
     pyr_stats_run(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), run, PYR_ARG(3), PYR_ARG_F32(4), PYR_ARG(5),
                   PYR_ARG(6));
+}
+#endif
+
+/* The segment graph (shaders/pyr_graph.h), after compact; the host zeroes its words first. graph_count (2D,
+ * w x h): h, offset of level N, flags (bit 0: with points, bit 1: the labels compacted), reach, point scale (float),
+ * tolerance base and growth (floats), slots (a power of two). The table starts at word 1 (see graph_gather). */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_GRAPH_COUNT)
+PYR_KERNEL_2D(graph_count) {
+    pyr_u32 x = PYR_X;
+    pyr_u32 y = PYR_Y;
+    if (x >= PYR_W || y >= PYR_ARG(0)) return;
+    pyr_u32 slots = PYR_ARG(7);
+    pyr_graph_count(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, PYR_ARG(2) & 1u,
+                    (PYR_ARG(2) >> 1u) & 1u, PYR_ARG(3), PYR_ARG_F32(4), PYR_ARG_F32(5), PYR_ARG_F32(6), 1u,
+                    slots - 1u);
+}
+#endif
+
+/* graph_gather (1D, slots): slots. The counter is word 0, the table starts at word 1 and the list after it. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_GRAPH_GATHER)
+PYR_KERNEL_1D(graph_gather) {
+    pyr_u32 s = PYR_I;
+    if (s >= PYR_ARG(0)) return;
+    pyr_graph_gather(PYR_ENTRY_CTX, 1u, s, 1u + PYR_GRAPH_SLOT_WORDS * PYR_ARG(0), 0u);
 }
 #endif
 

@@ -42,7 +42,9 @@
     K(scan_sums, SCAN_SUMS, 1)           \
     K(scan_number, SCAN_NUMBER, 1)       \
     K(compact, COMPACT, 1)               \
-    K(stats, STATS, 1)
+    K(stats, STATS, 1)                   \
+    K(graph_count, GRAPH_COUNT, 2)       \
+    K(graph_gather, GRAPH_GATHER, 1)
 
 /* Per-dispatch argument words (uint32; ints and floats by their bits). */
 #define PYR_ARG_WORDS 8

@@ -52,9 +52,8 @@ PYR_FN pyr_i32 pyr_merge_tolerance(pyr_f32 z, pyr_f32 base, pyr_f32 growth) {
     return t >= PYR_F32(PYR_MERGE_TOLERANCE_MAX) ? PYR_MERGE_TOLERANCE_MAX : PYR_I32(t);
 }
 
-/* 1 if the pair of pixels a, b (both labelled, so valid) is good: each lies at most the tolerance above the other's
- * tangent plane; 0 if not. */
-PYR_FN pyr_u32 pyr_merge_pair_good(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 xa, pyr_u32 ya, pyr_u32 xb, pyr_u32 yb,
+/* The kind of boundary between the pixels a, b (both labelled, so valid). */
+PYR_FN pyr_u32 pyr_merge_pair_kind(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 xa, pyr_u32 ya, pyr_u32 xb, pyr_u32 yb,
                                    pyr_f32 scale, pyr_f32 tolerance_base, pyr_f32 tolerance_growth) {
     PyrIVec3 d;
     d.x = pyr_robust_tangent(PYR_CTX_ARG, xb, yb, xa, ya, 0u, scale);
@@ -62,7 +61,7 @@ PYR_FN pyr_u32 pyr_merge_pair_good(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 xa, pyr_u32
     d.z = pyr_robust_tangent(PYR_CTX_ARG, xb, yb, xa, ya, 2u, scale);
     if (pyr_iabs(d.x) > PYR_MERGE_SPAN_LIMIT || pyr_iabs(d.y) > PYR_MERGE_SPAN_LIMIT ||
         pyr_iabs(d.z) > PYR_MERGE_SPAN_LIMIT) {
-        return 0u;
+        return PYR_BOUNDARY_STEP;
     }
     PyrIVec3 na = pyr_merge_normal(PYR_CTX_ARG, w, xa, ya);
     PyrIVec3 nb = pyr_merge_normal(PYR_CTX_ARG, w, xb, yb);
@@ -71,13 +70,16 @@ PYR_FN pyr_u32 pyr_merge_pair_good(PYR_CTX_PARAM, pyr_u32 w, pyr_u32 xa, pyr_u32
     pyr_f32 za = PYR_PT(xa, ya, 2u);
     pyr_f32 zb = PYR_PT(xb, yb, 2u);
     pyr_i32 tolerance = pyr_merge_tolerance(za < zb ? za : zb, tolerance_base, tolerance_growth);
-    return (above_a <= tolerance && above_b <= tolerance) ? 1u : 0u;
+    pyr_i32 high = above_a > above_b ? above_a : above_b;
+    pyr_i32 low = above_a > above_b ? above_b : above_a;
+    if (high <= tolerance) return low < -tolerance ? PYR_BOUNDARY_CONVEX : PYR_BOUNDARY_FLAT;
+    return low < -tolerance ? PYR_BOUNDARY_STEP : PYR_BOUNDARY_CONCAVE;
 }
 
 /* The crossing from pixel (x, y) to its neighbour (x + dx, y + dy), dx + dy == 1, on level N: PYR_MERGE_NONE when
- * there is none (the neighbour does not exist, or either label is 0, or they are equal), else whether it is good. */
-PYR_FN pyr_u32 pyr_merge_crossing(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, pyr_u32 dx, pyr_u32 dy,
-                                  pyr_u32 reach, pyr_f32 scale, pyr_f32 tolerance_base, pyr_f32 tolerance_growth) {
+ * there is none (the neighbour does not exist, or either label is 0, or they are equal), else its kind. */
+PYR_FN pyr_u32 pyr_merge_crossing_kind(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, pyr_u32 dx, pyr_u32 dy,
+                                       pyr_u32 reach, pyr_f32 scale, pyr_f32 tolerance_base, pyr_f32 tolerance_growth) {
     pyr_u32 qx = x + dx;
     pyr_u32 qy = y + dy;
     if (qx >= lv.width || qy >= lv.height) return PYR_MERGE_NONE;
@@ -88,9 +90,18 @@ PYR_FN pyr_u32 pyr_merge_crossing(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32
     pyr_i32 sy = PYR_I32(dy);
     pyr_i32 ka = pyr_merge_reach(PYR_CTX_ARG, lv, PYR_I32(x), PYR_I32(y), -sx, -sy, a, reach);
     pyr_i32 kb = pyr_merge_reach(PYR_CTX_ARG, lv, PYR_I32(qx), PYR_I32(qy), sx, sy, b, reach);
-    return pyr_merge_pair_good(PYR_CTX_ARG, lv.width, PYR_U32(PYR_I32(x) - ka * sx), PYR_U32(PYR_I32(y) - ka * sy),
+    return pyr_merge_pair_kind(PYR_CTX_ARG, lv.width, PYR_U32(PYR_I32(x) - ka * sx), PYR_U32(PYR_I32(y) - ka * sy),
                                PYR_U32(PYR_I32(qx) + kb * sx), PYR_U32(PYR_I32(qy) + kb * sy), scale, tolerance_base,
                                tolerance_growth);
+}
+
+/* The same crossing for the merge: PYR_MERGE_NONE, else 1 if it is good (flat or convex), 0 if bad. */
+PYR_FN pyr_u32 pyr_merge_crossing(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, pyr_u32 dx, pyr_u32 dy,
+                                  pyr_u32 reach, pyr_f32 scale, pyr_f32 tolerance_base, pyr_f32 tolerance_growth) {
+    pyr_u32 kind =
+        pyr_merge_crossing_kind(PYR_CTX_ARG, lv, x, y, dx, dy, reach, scale, tolerance_base, tolerance_growth);
+    if (kind == PYR_MERGE_NONE) return PYR_MERGE_NONE;
+    return kind <= PYR_BOUNDARY_CONVEX ? 1u : 0u;
 }
 
 /* Whether a boundary with `good` and `bad` crossings joins its two segments: at least min_crossings of them, and

@@ -15,15 +15,16 @@ PYR_FN pyr_u32 pyr_merge_hash(pyr_u32 a, pyr_u32 b) {
     return h ^ (h >> 15u);
 }
 
-/* The first word of pair (a, b)'s slot (a < b), claimed if the pair has none yet. Every invocation with the pair
+/* The first word of pair (a, b)'s slot (a < b) in a table of `stride` words a slot, claimed if the pair has none
+ * yet (the segment graph's table, shaders/pyr_graph.h, is another). Every invocation with the pair
  * walks the same probe sequence and stops at the first slot that holds the pair or that it claims; a slot's words
  * are set once, by compare-and-swap from 0, and whoever sets a slot's first word goes on to its second, so no
  * invocation passes a slot that ends up holding its pair: one pair, one slot, whatever the schedule. The table has
  * more than twice as many slots as a frame can have pairs (core/plan.cpp), so a free slot always comes. */
-PYR_FN pyr_u32 pyr_merge_slot(PYR_CTX_PARAM, pyr_u32 table, pyr_u32 slot_mask, pyr_u32 a, pyr_u32 b) {
+PYR_FN pyr_u32 pyr_merge_slot(PYR_CTX_PARAM, pyr_u32 table, pyr_u32 stride, pyr_u32 slot_mask, pyr_u32 a, pyr_u32 b) {
     pyr_u32 s = pyr_merge_hash(a, b) & slot_mask;
     for (pyr_u32 probe = 0u; probe <= slot_mask; ++probe) {
-        pyr_u32 w = table + PYR_MERGE_SLOT_WORDS * s;
+        pyr_u32 w = table + stride * s;
         pyr_u32 first = PYR_UF_CAS(w, 0u, a);
         if (first == 0u || first == a) {
             pyr_u32 second = PYR_UF_CAS(w + 1u, 0u, b);
@@ -43,7 +44,7 @@ PYR_FN void pyr_merge_count(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, py
         if (good == PYR_MERGE_NONE) continue;
         pyr_u32 a = PYR_LABEL(lv.offset + y * lv.width + x);
         pyr_u32 b = PYR_LABEL(lv.offset + (y + down) * lv.width + x + 1u - down);
-        pyr_u32 w = pyr_merge_slot(PYR_CTX_ARG, table, slot_mask, a < b ? a : b, a < b ? b : a);
+        pyr_u32 w = pyr_merge_slot(PYR_CTX_ARG, table, PYR_MERGE_SLOT_WORDS, slot_mask, a < b ? a : b, a < b ? b : a);
         if (w != PYR_MERGE_NONE) PYR_UF_ADD(w + (good != 0u ? 2u : 3u), 1u);
     }
 }

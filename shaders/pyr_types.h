@@ -121,6 +121,21 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 
 /* The merge's pair table on GPUs (shaders/pyr_merge_table.h): words per slot. */
 #define PYR_MERGE_SLOT_WORDS 4u
+/* The kind of boundary a crossing shows (shaders/pyr_merge.h: pyr_merge_pair_kind; docs/algorithm.md sections 5b
+ * and 10d): flat (each side within the tolerance of the other's tangent plane), convex (neither side above the
+ * other's plane, one clearly below it), concave (one side clearly above the other's plane, neither clearly below) or
+ * a depth step (one clearly above and the other clearly below, or too far apart). The merge's good crossings are the
+ * flat and convex ones. */
+#define PYR_BOUNDARY_FLAT 0u
+#define PYR_BOUNDARY_CONVEX 1u
+#define PYR_BOUNDARY_CONCAVE 2u
+#define PYR_BOUNDARY_STEP 3u
+/* The segment graph's pair table (shaders/pyr_graph.h, docs/algorithm.md section 10d): words per slot, and where
+ * each word is: the pair's smaller and larger label (as in the output; 0: a free slot), its crossings, and its
+ * crossings of each kind (PYR_BOUNDARY_*, shaders/pyr_merge.h; zero for a caller's mask). */
+#define PYR_GRAPH_SLOT_WORDS 7u
+#define PYR_GRAPH_LENGTH 2u
+#define PYR_GRAPH_KINDS 3u
 /* The statistics pass walks rows in runs of this many pixels, one invocation per run. */
 #define PYR_STATS_RUN 32u
 /* Points are clamped to +-(2^31 - 128), the largest float magnitude below 2^31, before rounding to int32. */

@@ -10,8 +10,9 @@ namespace fs = std::filesystem;
 
 const std::map<std::string, std::string>& batch_output_suffixes() {
     static const std::map<std::string, std::string> suffixes = {
-        {"labels", ".labels.npy"}, {"png", ".png"},        {"mask", ".mask.png"},    {"figure", ".figure.png"},
-        {"ply", ".ply"},           {"pcd", ".labels.pcd"}, {"stats", ".stats.json"}, {"scene", ".scene.json"},
+        {"labels", ".labels.npy"}, {"png", ".png"},          {"mask", ".mask.png"},
+        {"figure", ".figure.png"}, {"ply", ".ply"},          {"pcd", ".labels.pcd"},
+        {"stats", ".stats.json"},  {"graph", ".graph.json"}, {"scene", ".scene.json"},
     };
     return suffixes;
 }

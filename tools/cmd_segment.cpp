@@ -36,7 +36,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,scene]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,graph,scene]\n"
     "                      [--progress auto|bar|lines|none] [--backend NAME] [input options] [parameters]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
@@ -60,6 +60,9 @@ constexpr const char* kSegmentUsage =
     "                        planar or not) and oriented box (axes, side lengths), from exact sums the backend\n"
     "                        computes over the segment's fillable pixels (fillable_count; not its edge pixels);\n"
     "                        JSON or CSV, as the extension says\n"
+    "  --graph OUT.json      which segments touch which: per pair, its boundary's length in pixel sides and how many\n"
+    "  --graph OUT.csv       of them are flat, a convex crease, a concave crease or a depth step (docs/algorithm.md\n"
+    "                        10d), counted exactly by the backend; JSON or CSV, as the extension says\n"
     "  --scene OUT.json      the scene: the support surfaces (large flat segments: floor, table, wall; plane and\n"
     "                        outline) and the objects resting on them, each with its support, its height above it\n"
     "                        and a box standing on it that holds the object's points (docs/algorithm.md 10c)\n"
@@ -80,7 +83,8 @@ constexpr const char* kSegmentUsage =
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply, NAME.labels.pcd, NAME.stats.json, NAME.scene.json as --write asks (default labels,png); NAME_2, NAME_3 "
+    "NAME.ply, NAME.labels.pcd, NAME.stats.json, NAME.graph.json, NAME.scene.json as --write asks (default "
+    "labels,png); NAME_2, NAME_3 "
     "... when\n"
     "another frame's output has that name already. An output that would be one of the batch's inputs is refused\n"
     "before anything is read. A frame that fails (also one an input option does not apply to: --intrinsics on a\n"
@@ -91,9 +95,9 @@ constexpr const char* kSegmentUsage =
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, scene, pcl_png;
+    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, graph, scene, pcl_png;
     [[nodiscard]] bool any() const {
-        return labels || png || mask || figure || ply || pcd || stats || scene || pcl_png;
+        return labels || png || mask || figure || ply || pcd || stats || graph || scene || pcl_png;
     }
 };
 
@@ -117,6 +121,7 @@ const std::vector<OutputOption>& output_options() {
         {"ply", &OutputPaths::ply, {".ply"}, "the coloured cloud, as PLY"},
         {"pcd", &OutputPaths::pcd, {".pcd"}, "the cloud with a label field, as PCD"},
         {"stats", &OutputPaths::stats, {".json", ".csv"}, "the statistics, as JSON or CSV"},
+        {"graph", &OutputPaths::graph, {".json", ".csv"}, "the segment graph, as JSON or CSV"},
         {"scene", &OutputPaths::scene, {".json", ".ply"}, "the scene, as JSON or a PLY mesh of its boxes"},
         {"pcl-png", &OutputPaths::pcl_png, {".png"}, "PCL's segmentation in colour, as PNG"},
     };
@@ -331,6 +336,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         Outputs outputs;
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value() || out.scene.has_value();
         outputs.segment_stats = out.stats.has_value() || out.scene.has_value();
+        outputs.segment_graph = out.graph.has_value();
         segmenter =
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
     }
@@ -378,6 +384,12 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     if (out.stats) {
         files.stage(*out.stats, [&](const fs::path& to) {
             io::write_segment_stats(to, result.segments,
+                                    io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+        });
+    }
+    if (out.graph) {
+        files.stage(*out.graph, [&](const fs::path& to) {
+            io::write_segment_graph(to, result.graph,
                                     io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
         });
     }
@@ -445,14 +457,15 @@ std::set<std::string> parse_write_list(const std::string& text) {
     std::string item;
     while (std::getline(in, item, ',')) {
         if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" && item != "pcd" &&
-            item != "stats" && item != "scene") {
-            throw UsageError{"--write expects a list of labels, png, mask, figure, ply, pcd, stats, scene; got '" +
-                             item + "'"};
+            item != "stats" && item != "graph" && item != "scene") {
+            throw UsageError{
+                "--write expects a list of labels, png, mask, figure, ply, pcd, stats, graph, scene; got '" + item +
+                "'"};
         }
         kinds.insert(item);
     }
     if (kinds.empty()) {
-        throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats, scene"};
+        throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats, graph, scene"};
     }
     return kinds;
 }
@@ -525,6 +538,7 @@ int run_batch(const Args& args, const Params& params, RunNotes& notes) {
         out.ply = planned("ply");
         out.pcd = planned("pcd");
         out.stats = planned("stats");
+        out.graph = planned("graph");
         out.scene = planned("scene");
         std::string failure;
         try {

@@ -38,6 +38,7 @@ CpuExecutor::CpuExecutor(const core::Plan& plan)
       lut_(plan.lut_size()),
       fill_scratch_(fill_scratch_size(plan)),
       stats_(plan.stats_words()),
+      graph_words_(plan.graph_words()),
       simd_(simd::rows_from_environment()),
       sweeps_(use_sweeps_for_fixed_points()) {}
 

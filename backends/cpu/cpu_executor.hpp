@@ -62,6 +62,7 @@ public:
     void mark_labels(int level) override;
     void compact(bool apply) override;
     void segment_stats() override;
+    void segment_graph() override;  // cpu_graph.cpp
     void read_back(Result& out, const Outputs& outputs) override;
 
     [[nodiscard]] std::uint32_t fill_rounds() const override { return fill_rounds_; }
@@ -137,6 +138,8 @@ private:
     std::vector<std::uint32_t> candidates_;   // final_fill_rows: three rows of edge candidates a band
     std::vector<std::uint32_t> stats_;        // per-segment statistics words, when asked for
     std::vector<std::uint32_t> merge_words_;  // the merge's label parents and pair table (shaders/pyr_merge_table.h)
+    std::vector<std::uint32_t> graph_words_;  // the segment graph's counter, table and list (shaders/pyr_graph.h)
+    std::size_t graph_list_ = 0;              // where this frame's list starts in it
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::VectorRows* simd_;

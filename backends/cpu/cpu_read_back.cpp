@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "backends/cpu/cpu_executor.hpp"
+#include "core/segment_graph.hpp"
 #include "core/segment_stats.hpp"
 
 namespace pyrseg::cpu {
@@ -54,6 +55,9 @@ void CpuExecutor::read_back(Result& out, const Outputs& outputs) {
     out.segments.clear();
     if (plan_.stats_slots != 0)
         core::decode_segment_stats(stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
+    out.graph.clear();
+    if (plan_.graph_slots != 0)
+        core::decode_segment_graph(graph_words_.data() + graph_list_, graph_words_[0], out.graph);
     out.normals.clear();
     if (outputs.normals && !from_mask_) {
         out.normals.resize(3 * pixels);

@@ -13,6 +13,7 @@
 #include "core/depth_tables.hpp"
 #include "core/gpu/device_fault.hpp"
 #include "core/gpu/host_frame.hpp"
+#include "core/segment_graph.hpp"
 #include "core/segment_stats.hpp"
 #include "pyrseg/error.hpp"
 #include "shaders/pyr_depth.h"
@@ -68,6 +69,7 @@ public:
         const size_t px = plan_.pixel_count();
         staged_.resize(StagedResults::kBytesPerPixel * px);
         host_stats_.resize(plan_.stats_words());
+        host_graph_.resize(size_t(PYR_GRAPH_SLOT_WORDS) * (plan_.graph_slots / 2));
     }
 
     // The device goes first: a frame an error abandoned may still have transfers queued into staged_ and the
@@ -283,6 +285,20 @@ public:
                        plan_.lut_size(), plan_.stats_slots}));
     }
 
+    // The graph's table and list in the fill buffer, which nothing needs after the merge; read_back fetches the
+    // pair count with the labels, then the pairs.
+    void segment_graph() override {
+        if (device_frame_) return;  // a host result
+        device_->zero(Buffer::fill, 0, 4 * plan_.graph_words());
+        const core::Thresholds& t = plan_.thresholds;
+        const uint32_t flags = (from_mask_ ? 0u : 1u) | (plan_.params.compact ? 2u : 0u);
+        dispatch(
+            Kernel::graph_count, width(), height(),
+            args({height(), plan_.full().offset, flags, uint32_t(plan_.params.merge_reach), bits(t.merge_point_scale),
+                  bits(t.merge_tolerance_base), bits(t.merge_tolerance_growth), plan_.graph_slots}));
+        dispatch(Kernel::graph_gather, plan_.graph_slots, 1, args({plan_.graph_slots}));
+    }
+
     void read_back(Result& out, const Outputs& outputs) override {
         device_->mark("download");
         const size_t px = plan_.pixel_count();
@@ -294,6 +310,8 @@ public:
         if (outputs.raw_labels) device_->download(Buffer::labels, 4 * full, staged + S::kRawLabels * px, 4 * px);
         if (outputs.fillable_mask) device_->download(Buffer::mask, texel * full, staged + S::kMask * px, texel * px);
         if (outputs.normals && !from_mask_) device_->download(Buffer::normals, 0, staged + S::kNormals * px, 12 * px);
+        graph_count_ = 0;
+        if (plan_.graph_slots != 0) device_->download(Buffer::fill, 0, &graph_count_, 4);
         device_->mark(nullptr);
         finish();
         frame_done();
@@ -302,14 +320,22 @@ public:
         out.segment_count = segment_count_;
         unstage_results(staged, px, texel == 4, outputs, !from_mask_, out);
         out.segments.clear();
-        if (plan_.stats_slots != 0) {
-            const size_t words = std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
-            if (words != 0) {
-                device_->download(Buffer::lut, 4 * size_t(plan_.lut_size()), host_stats_.data(), 4 * words);
-                finish();
-            }
-            core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
+        out.graph.clear();
+        // The statistics of the K segments and the pairs the graph gathered, now that both counts are known: one
+        // more wait.
+        const size_t stats_words =
+            plan_.stats_slots == 0 ? 0 : std::min(plan_.stats_words(), size_t(segment_count_) * PYR_STATS_WORDS);
+        const uint32_t pairs = std::min(graph_count_, plan_.graph_slots / 2);
+        if (stats_words != 0)
+            device_->download(Buffer::lut, 4 * size_t(plan_.lut_size()), host_stats_.data(), 4 * stats_words);
+        if (pairs != 0) {
+            device_->download(Buffer::fill, 4 * plan_.graph_list_word(), host_graph_.data(),
+                              4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
         }
+        if (stats_words != 0 || plan_.graph_slots != 0) finish();  // the same waits whatever the graph holds
+        if (plan_.stats_slots != 0)
+            core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
+        if (plan_.graph_slots != 0) core::decode_segment_graph(host_graph_.data(), pairs, out.graph);
     }
 
     bool device_timings(std::vector<PassTiming>& timings) override { return device_->pass_times(timings); }
@@ -402,7 +428,9 @@ private:
     std::vector<uint32_t> host_mask_;
     std::vector<unsigned char> staged_;  // the frame's results, laid out as StagedResults
     std::vector<uint32_t> host_stats_;
+    std::vector<uint32_t> host_graph_;  // the graph's pairs as gathered
     uint32_t segment_count_ = 0;
+    uint32_t graph_count_ = 0;
     uint32_t dispatches_ = 0;
     uint32_t host_syncs_ = 0;
     bool from_mask_ = false;
@@ -447,8 +475,10 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
             // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
             // The merge's label parents and pair table (shaders/pyr_merge_table.h) reuse it after the fills.
             const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
+            // So do the segment graph's table and list (shaders/pyr_graph.h), after compaction.
             const size_t merge = size_t(plan.lut_size()) + size_t(PYR_MERGE_SLOT_WORDS) * plan.merge_slots;
-            return 4 * std::max(size_t(2) * fill_level.width * fill_level.height, plan.merge_slots != 0 ? merge : 0);
+            return 4 * std::max({size_t(2) * fill_level.width * fill_level.height, plan.merge_slots != 0 ? merge : 0,
+                                 plan.graph_words()});
         }
         case Buffer::out:
             return 4 * px;

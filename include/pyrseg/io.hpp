@@ -148,6 +148,11 @@ struct SegmentTable {
 PYRSEG_IO_EXPORT void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
                                           const SegmentTable& frame);
 
+// The segment graph (Result::graph): CSV with a header line when the path ends in .csv, else JSON with the frame's
+// size and one object per pair of touching segments (a, b, length and the crossings of each kind).
+PYRSEG_IO_EXPORT void write_segment_graph(const std::filesystem::path& path, const std::vector<SegmentEdge>& graph,
+                                          const SegmentTable& frame);
+
 // The scene summary (pyrseg/scene.hpp): JSON with the frame's size and units, its supports (plane, box) and objects
 // (support, height, box), lengths in the cloud's units; or, when the path ends in .ply, an ASCII PLY mesh of each
 // object's box (12 triangles) and each support's outline (its box's rectangle in its plane, 2 triangles), coloured

@@ -12,6 +12,7 @@ struct Outputs {
     bool fillable_mask = false;  // the metric pass's mask B: 1 fillable, 0 edge/invalid/isolated
     bool normals = false;        // the normals the metric used (given, or estimated), 3 floats per pixel
     bool segment_stats = false;  // per-segment statistics (Result::segments), a pass of every backend
+    bool segment_graph = false;  // which segments touch which, and how (Result::graph), a pass of every backend
 };
 
 // A 128-bit two's-complement integer, high * 2^64 + low: an exact sum too wide for 64 bits.
@@ -60,6 +61,19 @@ struct SegmentStats {
     bool planar = false;  // plane_rms within the frame's planar tolerance (section 10b); false for a mask
 };
 
+// One edge of the segment graph (docs/algorithm.md section 10d): two segments that touch, and the crossings of their
+// shared boundary (pairs of 4-neighbours, one in each) by the kind of boundary each shows. Every backend counts
+// them exactly, so they agree bit for bit.
+struct SegmentEdge {
+    std::uint32_t a = 0, b = 0;  // the two labels, as in Result::labels, a < b
+    std::uint32_t length = 0;    // the crossings: the shared boundary's length in pixel sides
+    // For a cloud (zero for a caller's mask), the crossings where the two sides meet flat (each within the merge's
+    // tolerance of the other's tangent plane), at a convex crease (an object's own edge), at a concave crease (an
+    // object on its support, two walls) and at a depth step (one in front of the other). They add up to length.
+    std::uint32_t flat = 0, convex = 0, concave = 0, step = 0;
+    friend bool operator==(const SegmentEdge&, const SegmentEdge&) = default;
+};
+
 struct Result {
     int width = 0;
     int height = 0;
@@ -71,6 +85,9 @@ struct Result {
     // Filled when Outputs::segment_stats: K entries, segment k at k - 1. It keeps its capacity, so it allocates
     // only when a frame has more segments than every frame before.
     std::vector<SegmentStats> segments;
+    // Filled when Outputs::segment_graph: every pair of touching segments once, by increasing (a, b). It keeps its
+    // capacity, as segments does.
+    std::vector<SegmentEdge> graph;
 };
 
 }  // namespace pyrseg

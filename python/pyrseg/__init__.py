@@ -27,6 +27,7 @@ from ._pyrseg import (  # noqa: F401
     presets,
     scene_object_dtype,
     scene_support_dtype,
+    segment_graph_dtype,
     segment_stats_dtype,
     synthetic,
 )
@@ -55,6 +56,7 @@ __all__ = [
     "presets",
     "scene_object_dtype",
     "scene_support_dtype",
+    "segment_graph_dtype",
     "segment_stats_dtype",
     "synthetic",
 ]

@@ -36,6 +36,7 @@ struct Cached {
     PyObject* result_type = nullptr;   // pyrseg.Result (a named tuple)
     PyObject* backend_type = nullptr;  // pyrseg.BackendInfo (a named tuple)
     PyObject* stats_dtype = nullptr;   // pyrseg.segment_stats_dtype
+    PyObject* graph_dtype = nullptr;   // pyrseg.segment_graph_dtype
     PyObject* uint32 = nullptr;
     PyObject* uint8 = nullptr;
     PyObject* float32 = nullptr;
@@ -154,9 +155,11 @@ Outputs outputs_from(const py::handle& names) {
             o.normals = true;
         } else if (name == "segment_stats") {
             o.segment_stats = true;
+        } else if (name == "segment_graph") {
+            o.segment_graph = true;
         } else {
             throw py::value_error("unknown output '" + name +
-                                  "'; outputs: raw_labels, fillable_mask, normals, segment_stats");
+                                  "'; outputs: raw_labels, fillable_mask, normals, segment_stats, segment_graph");
         }
     }
     return o;
@@ -349,6 +352,7 @@ public:
         if (outputs_.fillable_mask) names.append("fillable_mask");
         if (outputs_.normals) names.append("normals");
         if (outputs_.segment_stats) names.append("segment_stats");
+        if (outputs_.segment_graph) names.append("segment_graph");
         return py::tuple(names);
     }
     [[nodiscard]] bool last_input_copied() const { return last_copied_; }
@@ -444,7 +448,7 @@ private:
         const int w = width(), h = height();
         py::array labels = out.is_none() ? new_array(cached.uint32, h, w) : check_labels_out(out, w, h);
         if (!out.is_none()) input.refuse_alias(labels);
-        py::object raw = py::none(), mask = py::none(), normals = py::none(), segments = py::none();
+        py::object raw = py::none(), mask = py::none(), normals = py::none(), segments = py::none(), graph = py::none();
         void* raw_data = nullptr;
         void* mask_data = nullptr;
         void* normals_data = nullptr;
@@ -499,8 +503,17 @@ private:
                     std::memcpy(a.mutable_data(), result_.segments.data(), std::size_t(k) * sizeof(SegmentStats));
                 segments = std::move(a);
             }
+            if (outputs_.segment_graph) {
+                const py::gil_scoped_acquire gil;
+                const auto k = py::ssize_t(result_.graph.size());
+                auto a =
+                    py::reinterpret_steal<py::array>(PyObject_CallFunction(cached.empty, "nO", k, cached.graph_dtype));
+                if (!a) throw py::error_already_set();
+                if (k > 0) std::memcpy(a.mutable_data(), result_.graph.data(), std::size_t(k) * sizeof(SegmentEdge));
+                graph = std::move(a);
+            }
         }
-        return obj(cached.result_type)(labels, count, segments, normals, mask, raw);
+        return obj(cached.result_type)(labels, count, segments, normals, mask, raw, graph);
     }
 
     Params params_;
@@ -582,6 +595,27 @@ py::object stats_dtype() {
     return np.attr("dtype")(spec);
 }
 
+py::object graph_dtype() {
+    py::list names, formats, offsets;
+    for (const auto& [name, offset] : {std::pair{"a", offsetof(SegmentEdge, a)},
+                                       {"b", offsetof(SegmentEdge, b)},
+                                       {"length", offsetof(SegmentEdge, length)},
+                                       {"flat", offsetof(SegmentEdge, flat)},
+                                       {"convex", offsetof(SegmentEdge, convex)},
+                                       {"concave", offsetof(SegmentEdge, concave)},
+                                       {"step", offsetof(SegmentEdge, step)}}) {
+        names.append(name);
+        formats.append("<u4");
+        offsets.append(offset);
+    }
+    py::dict spec;
+    spec["names"] = names;
+    spec["formats"] = formats;
+    spec["offsets"] = offsets;
+    spec["itemsize"] = sizeof(SegmentEdge);
+    return py::module_::import("numpy").attr("dtype")(spec);
+}
+
 py::list backends() {
     py::list l;
     for (const BackendInfo& b : list_backends()) {
@@ -619,15 +653,20 @@ void bind_segmenter(py::module_& m) {
     cached.float32 = keep(numpy.attr("dtype")("float32"));
     cached.stats_dtype = keep(stats_dtype());
     m.attr("segment_stats_dtype") = obj(cached.stats_dtype);
+    cached.graph_dtype = keep(graph_dtype());
+    m.attr("segment_graph_dtype") = obj(cached.graph_dtype);
     cached.result_type = keep(namedtuple(
-        "Result", py::make_tuple("labels", "segment_count", "segments", "normals", "fillable_mask", "raw_labels"),
+        "Result",
+        py::make_tuple("labels", "segment_count", "segments", "normals", "fillable_mask", "raw_labels", "graph"),
         py::arg("module") = module_name));
     m.attr("Result") = obj(cached.result_type);
     m.attr("Result").attr("__doc__") =
         "One frame's results. labels: H x W uint32 (the out= array when given), 0 for no segment; segment_count: "
         "K; segments: K entries of segment_stats_dtype, segment k at k - 1 (outputs 'segment_stats', else None); "
         "normals: H x W x 3 float32, fillable_mask: H x W uint8, raw_labels: H x W uint32 (each None unless asked "
-        "for in outputs=).";
+        "for in outputs=); graph: the segment graph, one segment_graph_dtype entry per pair of touching segments "
+        "(a < b, their labels; length, the crossings of their boundary; flat, convex, concave, step, the crossings "
+        "of each kind), by increasing (a, b) (outputs 'segment_graph', else None).";
     cached.backend_type = keep(namedtuple(
         "BackendInfo", py::make_tuple("name", "available", "reason", "devices", "emulated", "emulated_device"),
         py::arg("module") = module_name));
@@ -649,7 +688,7 @@ that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, mer
 merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride, color_edge_curvature_share (the
 colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when
 a segment's statistics call it planar) (docs/algorithm.md).
-outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats".
+outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats", "segment_graph".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
 

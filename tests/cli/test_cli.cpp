@@ -755,6 +755,56 @@ TEST(Cli, StatsAreWrittenAsJsonOrCsv) {
     fs::remove_all(dir);
 }
 
+// --graph writes the segment graph as JSON or CSV: its lengths add up to the crossings between the --labels output's
+// segments, and each edge's kinds to its length.
+TEST(Cli, GraphIsWrittenAsJsonOrCsv) {
+    const fs::path dir = temp_dir();
+    const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(160, 120, 1);
+    pyrseg::io::write_pcd(dir / "scene.pcd", cloud, pyrseg::io::PcdEncoding::binary);
+    const std::string frame = "segment " + (dir / "scene.pcd").string() + " --edge-rounds 4";
+    const CliRun r = run(frame + " --labels " + (dir / "l.npy").string() + " --graph " + (dir / "g.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::NpyArray labels = pyrseg::io::read_npy(dir / "l.npy");
+    const auto label = [&](std::size_t x, std::size_t y) {
+        std::uint32_t l = 0;
+        std::memcpy(&l, labels.bytes.data() + 4 * (y * 160 + x), 4);
+        return l;
+    };
+    std::size_t crossings = 0;
+    for (std::size_t y = 0; y < 120; ++y) {
+        for (std::size_t x = 0; x < 160; ++x) {
+            const std::uint32_t a = label(x, y);
+            if (x + 1 < 160 && a != 0 && label(x + 1, y) != 0 && label(x + 1, y) != a) ++crossings;
+            if (y + 1 < 120 && a != 0 && label(x, y + 1) != 0 && label(x, y + 1) != a) ++crossings;
+        }
+    }
+    std::ifstream json_file(dir / "g.json");
+    const nlohmann::json doc = nlohmann::json::parse(json_file);
+    ASSERT_GT(doc["edge_count"].get<std::size_t>(), 0u) << doc.dump();
+    std::size_t counted = 0;
+    for (const nlohmann::json& e : doc["edges"]) {
+        EXPECT_LT(e["a"].get<std::uint32_t>(), e["b"].get<std::uint32_t>());
+        EXPECT_EQ(e["flat"].get<std::uint32_t>() + e["convex"].get<std::uint32_t>() +
+                      e["concave"].get<std::uint32_t>() + e["step"].get<std::uint32_t>(),
+                  e["length"].get<std::uint32_t>());
+        counted += e["length"].get<std::size_t>();
+    }
+    EXPECT_EQ(counted, crossings);
+    ASSERT_EQ(run(frame + " --graph " + (dir / "g.csv").string()).status, 0);
+    std::ifstream csv(dir / "g.csv");
+    std::string line;
+    std::size_t lines = 0;
+    while (std::getline(csv, line)) ++lines;
+    EXPECT_EQ(lines, doc["edge_count"].get<std::size_t>() + 1) << "a header and one line per edge";
+    const CliRun batch = run(frame + " --out-dir " + (dir / "out").string() + " --write graph --progress none");
+    EXPECT_EQ(batch.status, 0) << batch.output;
+    EXPECT_TRUE(fs::exists(dir / "out" / "scene.graph.json"));
+    const CliRun wrong = run(frame + " --graph " + (dir / "g.txt").string());
+    EXPECT_NE(wrong.status, 0);
+    EXPECT_NE(wrong.output.find("--graph"), std::string::npos) << wrong.output;
+    fs::remove_all(dir);
+}
+
 // bench-report turns Google Benchmark JSON into ratio tables: a made-up run with known times gives known ratios,
 // and a file that is not such JSON is an error naming it.
 TEST(Cli, BenchReportWritesRatiosAndPlots) {

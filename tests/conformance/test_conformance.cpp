@@ -81,6 +81,7 @@ void expect_conformance(const std::string& backend, const float* points, const f
     EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, width));
     EXPECT_EQ(result.segment_count, ref.segment_count);
     EXPECT_TRUE(same_segments(result.segments, ref.segments));
+    EXPECT_TRUE(same_graph(result.graph, ref.graph));
 }
 
 class SyntheticScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
@@ -146,6 +147,37 @@ INSTANTIATE_TEST_SUITE_P(Backends, MergeScenes,
                              return std::get<0>(param_info.param) + "_" +
                                     merge_conformance_cases()[std::size_t(std::get<1>(param_info.param))].name;
                          });
+
+// The segment graph asked for alone (no statistics, labels only): a backend must keep what the graph reads (the
+// quantized normals) without the other outputs that need it.
+class GraphAlone : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GraphAlone, MatchesReference) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    std::size_t edges = 0;
+    for (std::size_t index = 0; index < 8; ++index) {
+        const ConformanceCase& c = conformance_cases()[index];
+        SCOPED_TRACE(c.name);
+        Params params = c.params;
+        params.edge_rounds = 4;  // edge bands closed, so that segments touch
+        const synthetic::Scene scene = synthetic::generate(c.scene);
+        const float* normals = c.given_normals ? scene.normals.data() : nullptr;
+        const pyrseg_ref::Output ref =
+            pyrseg_ref::segment(scene.points.data(), normals, scene.width, scene.height, to_reference(params));
+        if (!ref.ok) continue;  // parameters the reference refuses: the other suites check the refusal
+        Outputs graph;
+        graph.segment_graph = true;
+        Segmenter segmenter(scene.width, scene.height, params, GetParam(), graph);
+        const Result result = segmenter.segment(CloudView{scene.points.data(), normals, scene.width, scene.height});
+        EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, scene.width));
+        EXPECT_TRUE(same_graph(result.graph, ref.graph));
+        edges += ref.graph.size();
+    }
+    EXPECT_GT(edges, 8u) << "the cases must have segments that touch";
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, GraphAlone, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
 
 class ColorScenes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
 
@@ -282,6 +314,7 @@ TEST_P(StridedClouds, MatchTheReferenceLikePackedOnes) {
         EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width));
         EXPECT_EQ(result.segment_count, ref.segment_count) << (given_normals ? "given normals" : "estimated normals");
         EXPECT_TRUE(same_segments(result.segments, ref.segments));
+        EXPECT_TRUE(same_graph(result.graph, ref.graph));
     }
 }
 
@@ -332,6 +365,7 @@ TEST_P(StridedClouds, ByteStepsOfAPointCloud2MatchTheReference) {
             EXPECT_TRUE(same_bytes("normals", result.normals, ref.normals, o.width, 3)) << what;
             EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width)) << what;
             EXPECT_TRUE(same_segments(result.segments, ref.segments)) << what;
+            EXPECT_TRUE(same_graph(result.graph, ref.graph)) << what;
         }
     }
 }

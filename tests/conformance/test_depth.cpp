@@ -119,6 +119,7 @@ TEST_P(DepthImages, MatchTheReference) {
         EXPECT_TRUE(same_bytes("raw labels", result.raw_labels, ref.raw_labels, o.width));
         EXPECT_TRUE(same_bytes("labels", result.labels, ref.labels, o.width));
         EXPECT_TRUE(same_segments(result.segments, ref.segments));
+        EXPECT_TRUE(same_graph(result.graph, ref.graph));
         // A second frame on the same Segmenter: nothing of the first may leak into it.
         segmenter.segment(d.view, result);
         EXPECT_TRUE(same_bytes("labels, second frame", result.labels, ref.labels, o.width));

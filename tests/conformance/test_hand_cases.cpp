@@ -71,6 +71,7 @@ protected:
         outputs.raw_labels = true;
         outputs.fillable_mask = true;
         outputs.segment_stats = true;
+        outputs.segment_graph = true;
         Segmenter segmenter(m.width, m.height, params, GetParam(), outputs);
         MaskView view;
         view.fillable = m.fillable.data();
@@ -87,6 +88,7 @@ protected:
         EXPECT_TRUE(same_bytes("labels", r.labels, ref.labels, m.width));
         EXPECT_EQ(r.segment_count, ref.segment_count);
         EXPECT_TRUE(same_segments(r.segments, ref.segments));
+        EXPECT_TRUE(same_graph(r.graph, ref.graph));
         EXPECT_EQ(r.fillable_mask, m.fillable);
         return r;
     }
@@ -315,9 +317,12 @@ TEST_P(HandCases, DispatchesAndHostWaitsDoNotDependOnTheImage) {
     boxes.fill_rect(10, 220, 200, 470);
     std::vector<std::vector<std::uint8_t>> masks = {synthetic::maze_mask(w, h).fillable,
                                                     synthetic::spiral_mask(w, h).fillable, boxes.fillable};
-    for (const bool stats : {false, true}) {
+    for (const int asked : {0, 1, 2, 3}) {
+        const bool stats = (asked & 1) != 0;
+        const bool graph = (asked & 2) != 0;
         Outputs outputs;
         outputs.segment_stats = stats;
+        outputs.segment_graph = graph;
         Segmenter segmenter(w, h, {}, GetParam(), outputs);
         std::set<std::uint32_t> dispatches;
         std::set<std::uint32_t> waits;
@@ -334,7 +339,7 @@ TEST_P(HandCases, DispatchesAndHostWaitsDoNotDependOnTheImage) {
             EXPECT_EQ(*waits.begin(), 0u);
         } else {
             EXPECT_GT(*dispatches.begin(), 10u);
-            EXPECT_EQ(*waits.begin(), stats ? 2u : 1u);
+            EXPECT_EQ(*waits.begin(), stats || graph ? 2u : 1u);
         }
     }
 }

@@ -368,3 +368,25 @@ def test_threads_share_a_segmenter(scene):
     assert len(results) == 30
     for r in results:
         np.testing.assert_array_equal(r, want)
+
+
+def test_segment_graph_matches_the_labels(scene):
+    # Every pair of 4-neighbours with two labels is one crossing of its pair's edge (docs/algorithm.md section 10d).
+    h, w, _ = scene.points.shape
+    seg = pyrseg.Segmenter(w, h, "cpu", edge_rounds=4, outputs=("segment_graph",))
+    r = seg.segment(scene.points)
+    g = r.graph
+    assert g.dtype == pyrseg.segment_graph_dtype and r.segments is None
+    labels = r.labels.astype(np.int64)
+    pairs = {}
+    for a, b in ((labels[:, :-1], labels[:, 1:]), (labels[:-1, :], labels[1:, :])):
+        touch = (a != 0) & (b != 0) & (a != b)
+        lo, hi = np.minimum(a[touch], b[touch]), np.maximum(a[touch], b[touch])
+        for key, n in zip(*np.unique(np.stack([lo, hi], axis=1), axis=0, return_counts=True)):
+            pairs[tuple(key)] = pairs.get(tuple(key), 0) + n
+    assert len(g) == len(pairs) > 0
+    assert [(e["a"], e["b"]) for e in g] == sorted(pairs)
+    np.testing.assert_array_equal(g["length"], [pairs[(e["a"], e["b"])] for e in g])
+    np.testing.assert_array_equal(g["flat"] + g["convex"] + g["concave"] + g["step"], g["length"])
+    with pytest.raises(ValueError, match="segment_graph"):
+        pyrseg.Segmenter(w, h, "cpu", outputs=("graph",))

@@ -847,23 +847,52 @@ Vec3i toward_camera(const std::array<std::int64_t, 3>& qn, const float* p) {
     return n;
 }
 
-// One crossing from pa (on the a side) to pb (on the b side): good or bad.
-bool good_crossing(const float* points, const QuantizedNormals& qn, const MergeConstants& k, std::size_t pa,
-                   std::size_t pb) {
+enum class Boundary { flat, convex, concave, step };
+
+// One crossing from pa (on the a side) to pb (on the b side): its kind (sections 5b and 10d).
+Boundary crossing_kind(const float* points, const QuantizedNormals& qn, const MergeConstants& k, std::size_t pa,
+                       std::size_t pb) {
     const float* a = points + 3 * pa;
     const float* b = points + 3 * pb;
     const float scale = std::ldexp(1.0f, k.e);
     Vec3i d{};
     for (std::size_t c = 0; c < 3; ++c) {
         d[c] = fixed_coordinate(b[c], scale) - fixed_coordinate(a[c], scale);
-        if ((d[c] < 0 ? -d[c] : d[c]) > (std::int64_t{1} << 16)) return false;
+        if ((d[c] < 0 ? -d[c] : d[c]) > (std::int64_t{1} << 16)) return Boundary::step;
     }
     const Vec3i na = toward_camera(qn[pa], a);
     const Vec3i nb = toward_camera(qn[pb], b);
     const std::int64_t ha = na[0] * d[0] + na[1] * d[1] + na[2] * d[2];
     const std::int64_t hb = -(nb[0] * d[0] + nb[1] * d[1] + nb[2] * d[2]);
     const std::int64_t tol = merge_tolerance(k, std::min(a[2], b[2]));
-    return ha <= tol && hb <= tol;
+    const bool one_above = ha > tol || hb > tol;    // a side clearly above the other's tangent plane
+    const bool one_below = ha < -tol || hb < -tol;  // a side clearly below it
+    if (!one_above) return one_below ? Boundary::convex : Boundary::flat;
+    return one_below ? Boundary::step : Boundary::concave;
+}
+
+// Good: flat or convex (section 5b).
+bool good_crossing(const float* points, const QuantizedNormals& qn, const MergeConstants& k, std::size_t pa,
+                   std::size_t pb) {
+    const Boundary kind = crossing_kind(points, qn, k, pa, pb);
+    return kind == Boundary::flat || kind == Boundary::convex;
+}
+
+// The pixel a side of a crossing is measured at: from (sx, sy), up to r - 1 steps of `step` * (dx, dy) through
+// pixels that exist and carry l.
+std::size_t crossing_side(const std::vector<std::uint32_t>& lab, std::int64_t width, std::int64_t height,
+                          std::int64_t r, std::int64_t sx, std::int64_t sy, std::int64_t dx, std::int64_t dy,
+                          std::int64_t step, std::uint32_t l) {
+    std::int64_t kk = 0;
+    while (kk < r - 1) {
+        const std::int64_t nx = sx + step * (kk + 1) * dx;
+        const std::int64_t ny = sy + step * (kk + 1) * dy;
+        if (nx < 0 || ny < 0 || nx >= width || ny >= height || lab[static_cast<std::size_t>(ny * width + nx)] != l) {
+            break;
+        }
+        ++kk;
+    }
+    return static_cast<std::size_t>((sy + step * kk * dy) * width + (sx + step * kk * dx));
 }
 
 // Step 6d on level N's labels: count every pair's good and bad crossings, join the pairs that pass, and give every
@@ -892,19 +921,9 @@ void merge_labels(std::vector<std::uint32_t>& lab, const float* points, const Qu
                 const std::uint32_t b = label_at(qx, qy);
                 if (b == 0 || b == a) continue;
                 // The largest k in 0..r-1 with the k pixels beyond the side's own pixel all existing and carrying
-                // its label; `step` is -1 for the a side (back from p), +1 for the b side (on from q).
-                const auto reach = [&](std::int64_t sx, std::int64_t sy, std::int64_t step, std::uint32_t l) {
-                    std::int64_t kk = 0;
-                    while (kk < r - 1) {
-                        const std::int64_t nx = sx + step * (kk + 1) * dx;
-                        const std::int64_t ny = sy + step * (kk + 1) * dy;
-                        if (nx < 0 || ny < 0 || nx >= width || ny >= height || label_at(nx, ny) != l) break;
-                        ++kk;
-                    }
-                    return static_cast<std::size_t>((sy + step * kk * dy) * width + (sx + step * kk * dx));
-                };
-                const std::size_t pa = reach(x, y, -1, a);
-                const std::size_t pb = reach(qx, qy, +1, b);
+                // its label: back from p on the a side, on from q on the b side.
+                const std::size_t pa = crossing_side(lab, width, height, r, x, y, dx, dy, -1, a);
+                const std::size_t pb = crossing_side(lab, width, height, r, qx, qy, dx, dy, +1, b);
                 Counts& counts = pairs[{std::min(a, b), std::max(a, b)}];
                 if (good_crossing(points, qn, k, pa, pb)) {
                     ++counts.good;
@@ -1012,6 +1031,58 @@ std::vector<Segment> segment_statistics(const Output& out, const float* points, 
     segments.reserve(by_raw.size());
     for (const auto& entry : by_raw) segments.push_back(entry.second);
     return segments;
+}
+
+// Section 10d: every crossing of the final labels between two segments, counted for the pair of their output
+// labels, by kind for a cloud (points and qn null for a mask).
+std::vector<Edge> segment_graph(const Output& out, const float* points, const QuantizedNormals* qn, int width,
+                                int height, const Params& p) {
+    const MergeConstants k = merge_constants(p);
+    const std::vector<std::uint32_t>& raw = out.raw_labels;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, Edge> pairs;
+    const std::int64_t w = width;
+    const std::int64_t h = height;
+    const std::int64_t dirs[2][2] = {{1, 0}, {0, 1}};
+    for (std::int64_t y = 0; y < h; ++y) {
+        for (std::int64_t x = 0; x < w; ++x) {
+            const auto i = static_cast<std::size_t>(y * w + x);
+            if (raw[i] == 0) continue;
+            for (const auto& dir : dirs) {
+                const std::int64_t qx = x + dir[0];
+                const std::int64_t qy = y + dir[1];
+                if (qx >= w || qy >= h) continue;
+                const auto j = static_cast<std::size_t>(qy * w + qx);
+                if (raw[j] == 0 || raw[j] == raw[i]) continue;
+                const std::uint32_t la = std::min(out.labels[i], out.labels[j]);
+                const std::uint32_t lb = std::max(out.labels[i], out.labels[j]);
+                Edge& e = pairs[{la, lb}];
+                e.a = la;
+                e.b = lb;
+                ++e.length;
+                if (points == nullptr) continue;
+                const std::size_t pa = crossing_side(raw, w, h, p.merge_reach, x, y, dir[0], dir[1], -1, raw[i]);
+                const std::size_t pb = crossing_side(raw, w, h, p.merge_reach, qx, qy, dir[0], dir[1], +1, raw[j]);
+                switch (crossing_kind(points, *qn, k, pa, pb)) {
+                    case Boundary::flat:
+                        ++e.flat;
+                        break;
+                    case Boundary::convex:
+                        ++e.convex;
+                        break;
+                    case Boundary::concave:
+                        ++e.concave;
+                        break;
+                    case Boundary::step:
+                        ++e.step;
+                        break;
+                }
+            }
+        }
+    }
+    std::vector<Edge> graph;
+    graph.reserve(pairs.size());
+    for (const auto& entry : pairs) graph.push_back(entry.second);
+    return graph;
 }
 
 Output failure(std::string why) {
@@ -1234,6 +1305,7 @@ Output segment(const float* points, const float* normals, int width, int height,
     if (color != nullptr) clear_color_edges(fillable, color, width, height, params, points, valid, qn, k);
     Output out = label_from_mask(std::move(fillable), valid, width, height, params, plan, points, used.data());
     out.segments = segment_statistics(out, points, used.data(), width, params);
+    out.graph = segment_graph(out, points, &qn, width, height, params);
     out.normals = std::move(used);
     return out;
 }
@@ -1255,6 +1327,7 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
     }
     Output out = label_from_mask(std::move(mask), valid_mask, width, height, params, plan);
     out.segments = segment_statistics(out, nullptr, nullptr, width, params);
+    out.graph = segment_graph(out, nullptr, nullptr, width, height, params);
     return out;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The independent oracle for pyrseg: a plain, slow-but-linear implementation of the algorithm contract
 // (shared/spec/algorithm-contract.md) and of docs/algorithm.md sections 2b and 8b (the robust metric and its normals),
-// 8 (the normals pass), 1b (depth images), 2c (the colour edge term) and 5b (the merge), written from that text only.
+// 8 (the normals pass), 1b (depth images), 2c (the colour edge term), 5b (the merge) and 10d (the segment graph),
+// written from that text only.
 // The conformance suite compares every backend with it bit for bit.
 #include <cstddef>
 #include <cstdint>
@@ -68,6 +69,13 @@ struct Segment {
     std::uint32_t fillable_count = 0;               // the fillable pixels the sums run over; zero for a mask
 };
 
+// One pair of touching segments (docs/algorithm.md section 10d): the crossings of their shared boundary, by kind.
+struct Edge {
+    std::uint32_t a = 0, b = 0;                                 // their labels as in Output::labels, a < b
+    std::uint32_t length = 0;                                   // crossings
+    std::uint32_t flat = 0, convex = 0, concave = 0, step = 0;  // zero for a mask
+};
+
 struct Output {
     bool ok = true;
     std::string error;                      // why, when !ok (bad parameters, sizes, too large for 32-bit labels)
@@ -77,6 +85,7 @@ struct Output {
     std::vector<float> normals;             // 3*W*H: the normals the metric used (given ones copied, or estimated)
     std::uint32_t segment_count = 0;        // distinct non-zero labels
     std::vector<Segment> segments;          // segment_count entries, by increasing raw label
+    std::vector<Edge> graph;                // every pair of touching segments, by increasing (a, b)
 };
 
 // points: packed xyz float32, 3*W*H, row-major. normals: packed, or nullptr to estimate them (docs section 8, or

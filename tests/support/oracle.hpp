@@ -3,6 +3,7 @@
 // comparison that names the first differing pixel.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -24,6 +25,7 @@ inline Outputs everything() {
     o.fillable_mask = true;
     o.normals = true;
     o.segment_stats = true;
+    o.segment_graph = true;
     return o;
 }
 
@@ -128,6 +130,33 @@ inline ::testing::AssertionResult same_segments(const std::vector<SegmentStats>&
         if (a.z_fixed_min != e.z_fixed_min || a.z_fixed_max != e.z_fixed_max) {
             return differ("z range", std::to_string(a.z_fixed_min) + ".." + std::to_string(a.z_fixed_max),
                           std::to_string(e.z_fixed_min) + ".." + std::to_string(e.z_fixed_max));
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// The segment graph edge by edge; on failure, the first differing edge.
+inline ::testing::AssertionResult same_graph(const std::vector<SegmentEdge>& actual,
+                                             const std::vector<pyrseg_ref::Edge>& expected) {
+    const auto text = [](auto e) {
+        std::ostringstream s;
+        s << "{" << e.a << ", " << e.b << "}: length " << e.length << ", flat " << e.flat << ", convex " << e.convex
+          << ", concave " << e.concave << ", step " << e.step;
+        return s.str();
+    };
+    for (std::size_t i = 0; i < std::max(actual.size(), expected.size()); ++i) {
+        if (i == actual.size() || i == expected.size()) {
+            return ::testing::AssertionFailure()
+                   << "segment graph: " << actual.size() << " edges but the reference has " << expected.size()
+                   << "; edge " << i << " is "
+                   << (i == actual.size() ? "reference " + text(expected[i]) : "backend " + text(actual[i]));
+        }
+        const SegmentEdge& a = actual[i];
+        const pyrseg_ref::Edge& e = expected[i];
+        if (a.a != e.a || a.b != e.b || a.length != e.length || a.flat != e.flat || a.convex != e.convex ||
+            a.concave != e.concave || a.step != e.step) {
+            return ::testing::AssertionFailure()
+                   << "segment graph: edge " << i << " is " << text(a) << ", reference " << text(e);
         }
     }
     return ::testing::AssertionSuccess();

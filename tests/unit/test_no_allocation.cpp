@@ -113,7 +113,7 @@ TEST_P(NoAllocation, HostMemoryRunningOutIsOutOfMemory) {
     const synthetic::Scene scene = synthetic::generate(o);
     const CloudView cv{scene.points.data(), nullptr, o.width, o.height};
     Outputs outputs;
-    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = outputs.segment_graph = true;
     int failed_makes = 0;
     int failed_frames = 0;
     for (long n = 1; n <= 120; ++n) {  // every allocation of a small frame's setup, one at a time
@@ -149,7 +149,7 @@ TEST_P(NoAllocation, WarmFramesAllocateNothing) {
     o.seed = 2;
     const synthetic::Scene b = synthetic::generate(o);
     Outputs outputs;
-    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = outputs.segment_graph = true;
     for (const bool given_normals : {false, true}) {
         Segmenter segmenter(320, 240, {}, GetParam(), outputs);
         Result result;
@@ -226,7 +226,7 @@ TEST_P(NoAllocation, WarmRobustAndDepthFramesAllocateNothing) {
     const DepthView dv{depth.data(), DepthFormat::u16, o.width, o.height, 0, 0.001, a.fx, a.fy, a.cx, a.cy};
     const CloudView cv{a.points.data(), nullptr, o.width, o.height};
     Outputs outputs;
-    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = true;
+    outputs.raw_labels = outputs.fillable_mask = outputs.normals = outputs.segment_stats = outputs.segment_graph = true;
     Segmenter segmenter(o.width, o.height, sensor_preset(SensorKind::kinect_v1), GetParam(), outputs);
     Result result;
     segmenter.segment(cv, result);

@@ -1,0 +1,54 @@
+// The segment graph (docs/algorithm.md section 10d) with the GPUs' functions (shaders/pyr_graph.h) over words of its
+// own: every row's crossings counted into the pair table at once, then the pairs gathered. The CPU knows K here, so
+// its table has only the slots K segments can need (and only those are cleared), not the plan's bound.
+#include <algorithm>
+#include <atomic>
+#include <bit>
+
+#include "backends/cpu/cpu_executor.hpp"
+
+#define PYR_UF_LOAD(i) std::atomic_ref<std::uint32_t>(ctx.merge[i]).load(std::memory_order_relaxed)
+#define PYR_UF_STORE(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).store((v), std::memory_order_relaxed)
+#define PYR_UF_MIN(i, v) ::pyrseg::cpu::atomic_min(ctx.merge[i], (v))
+#define PYR_UF_CAS(i, e, v) ::pyrseg::cpu::atomic_cas(ctx.merge[i], (e), (v))
+#define PYR_UF_ADD(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).fetch_add((v), std::memory_order_relaxed)
+
+namespace pyrseg::cpu::pixel {
+using std::min;  // pyr_uf.h's GPU spelling
+#include "shaders/pyr_graph.h"
+}  // namespace pyrseg::cpu::pixel
+
+namespace pyrseg::cpu {
+
+using std::size_t;
+using std::uint32_t;
+
+void CpuExecutor::segment_graph() {
+    const PyrLevel lv = plan_.full();
+    const core::Thresholds& t = plan_.thresholds;
+    // K segments have at most 3 K + 3 pairs (core/plan.cpp); the table has more than twice as many slots.
+    const std::uint64_t pairs = 3 * std::uint64_t(segment_count_) + 3;
+    const auto slots = uint32_t(std::min<std::uint64_t>(std::bit_ceil(2 * pairs + 1), plan_.graph_slots));
+    const size_t list = 1 + size_t(PYR_GRAPH_SLOT_WORDS) * slots;
+    std::fill_n(graph_words_.begin(), list, 0u);
+    PassContext c = context();
+    c.merge = graph_words_.data();
+    const uint32_t with_points = from_mask_ ? 0u : 1u;
+    const uint32_t apply = plan_.params.compact ? 1u : 0u;
+    const auto reach = uint32_t(plan_.params.merge_reach);
+    rows(lv.height, [&](size_t y) {
+        const uint32_t* row = labels_.data() + lv.offset + y * lv.width;
+        const uint32_t* below = y + 1 < lv.height ? row + lv.width : row;  // the last row: no pixel below
+        for (uint32_t x = 0; x < lv.width; ++x) {
+            // Most pixels cross no boundary: only those that may go to the shared function.
+            const uint32_t right = x + 1 < lv.width ? row[x + 1] : row[x];
+            if (row[x] == 0 || (right == row[x] && below[x] == row[x])) continue;
+            pixel::pyr_graph_count(c, lv, x, uint32_t(y), with_points, apply, reach, t.merge_point_scale,
+                                   t.merge_tolerance_base, t.merge_tolerance_growth, 1u, slots - 1);
+        }
+    });
+    for (uint32_t s = 0; s < slots; ++s) pixel::pyr_graph_gather(c, 1u, s, uint32_t(list), 0u);
+    graph_list_ = list;
+}
+
+}  // namespace pyrseg::cpu
