@@ -369,17 +369,6 @@ std::string scene_scores_row(const std::string& first, const SyntheticSceneScore
            " (" + std::to_string(s.planar_faces_flagged) + " of " + std::to_string(s.planar_faces) + ") |\n";
 }
 
-// The picture in gray, darkened: what the scene's boxes are drawn over.
-RgbImage dimmed_gray(const RgbImage& image) {
-    RgbImage out = image;
-    for (std::size_t i = 0; i + 2 < out.rgb.size(); i += 3) {
-        const int gray = (int(image.rgb[i]) + int(image.rgb[i + 1]) + int(image.rgb[i + 2])) / 3;
-        const auto v = std::uint8_t(24 + gray / 2);
-        out.rgb[i] = out.rgb[i + 1] = out.rgb[i + 2] = v;
-    }
-    return out;
-}
-
 // One row of the scenes' table: the scene summary (docs/algorithm.md section 10c) of pyrseg's segments against the
 // truth: its supports, whether the table's segment is one, the objects resting on it, and how much of each truth
 // object its segment's box holds.
@@ -623,7 +612,7 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
        << std::thread::hardware_concurrency() << " hardware threads. Ground truth: the generator's.\n\n## In sum\n\n"
        << printed(kTableHead, "sensor model: method");
     per_frame << "## Per frame\n\n";
-    std::ostringstream scenes;
+    std::ostringstream scenes, matched;
     scenes << "## Scenes\n\nThe scene summary (docs/algorithm.md section 10c) against the generator's scene: the "
               "frames whose largest support is the floor; the 3D IoU of each box object's box with the generator's "
               "box (boxes found whole: one segment holding 80% of the box's pixels and lying 80% on it); the plane "
@@ -657,6 +646,7 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
         std::vector<SyntheticSceneScores> scene_scores(methods.size());
         const std::vector<Totals> totals =
             evaluate_frames(frames, methods, 0.001, out_dir, per_frame, no_planes, no_scenes, &scene_scores);
+        SyntheticSceneScores best_planes;
         if (pcl_peer_missing().empty()) {
             // PCL's OrganizedMultiPlaneSegmentation, its maximum curvature picked from a small grid by the median
             // plane angle over these frames (the smallest wins; the first of equals).
@@ -680,6 +670,7 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
                     best_settings = settings;
                 }
             }
+            best_planes = best;
             if (!best.plane_degrees.empty()) {
                 scenes << "| " << name << ": PCL OMPS (" << best_settings << ") | - | - | - | "
                        << best.plane_degrees.size() << ": "
@@ -692,9 +683,27 @@ int synthetic_tabletops(const Args& args, const std::vector<std::string>& argv) 
             md << row(name + ": `" + methods[m].name + "`", totals[m]);
             if (scene_scores[m].frames > 0)
                 scenes << scene_scores_row(name + ": `" + methods[m].name + "`", scene_scores[m]);
+            if (scene_scores[m].frames > 0 && !best_planes.planes.empty()) {
+                const MatchedPlanes both = match_planes(scene_scores[m], best_planes);
+                matched << "| " << name << ": `" << methods[m].name << "` | " << both.a_degrees.size() << " | "
+                        << printed("%.2f / %.2f", quantile(both.a_degrees, 0.5), quantile(both.a_degrees, 0.95))
+                        << " | "
+                        << printed("%.2f / %.2f", quantile(both.b_degrees, 0.5), quantile(both.b_degrees, 0.95))
+                        << " | " << printed("%.1f / %.1f", quantile(both.a_mm, 0.5), quantile(both.a_mm, 0.95)) << " | "
+                        << printed("%.1f / %.1f", quantile(both.b_mm, 0.5), quantile(both.b_mm, 0.95)) << " |\n";
+            }
         }
     }
-    md << "\n" << scenes.str() << "\n" << per_frame.str();
+    md << "\n" << scenes.str() << "\n";
+    if (!matched.str().empty()) {
+        md << "The planes of the flat parts that both pyrseg (segments flagged planar) and PCL's "
+              "OrganizedMultiPlaneSegmentation found in the same frame, so that both are scored on the same planes:\n\n"
+              "| sensor model: method | flat parts | pyrseg angle median / 95th (degrees) | OMPS angle median / 95th "
+              "(degrees) | pyrseg offset median / 95th (mm) | OMPS offset median / 95th (mm) |\n"
+              "|---|---:|---:|---:|---:|---:|\n"
+           << matched.str() << "\n";
+    }
+    md << per_frame.str();
     const fs::path report = out_dir / "tabletop_synthetic.md";
     write_text_file(report, md.str());
     std::fputs(md.str().substr(0, md.str().find("## Per frame")).c_str(), stdout);

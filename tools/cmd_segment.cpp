@@ -28,6 +28,7 @@
 #include "tools/pcl_peer.hpp"
 #include "tools/printable.hpp"
 #include "tools/progress.hpp"
+#include "tools/scene_picture.hpp"
 
 namespace pyrseg::cli {
 namespace {
@@ -49,7 +50,9 @@ constexpr const char* kSegmentUsage =
     "  --labels OUT.png      or as a 16-bit grayscale PNG, when every label fits in 16 bits\n"
     "  --png OUT.png         the segments in colour\n"
     "  --mask-png OUT.png    the fillable mask (white) the pyramid labels\n"
-    "  --figure OUT.png      mask | plain connected components | pyramid, side by side\n"
+    "  --figure OUT.png      mask | plain connected components | pyramid, side by side; with --scene also the\n"
+    "                        scene's boxes and support outlines over the frame (its colour image, else the\n"
+    "                        segments), projected through the pinhole the cloud was made with\n"
     "  --ply OUT.ply         the cloud coloured by segment (gray: no segment), binary PLY, organized (obj_info\n"
     "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
     "  --pcd OUT.pcd         the cloud with each point's segment in a 'label' field (0: none), binary PCD in PCL's\n"
@@ -362,8 +365,33 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
             write_png(to.string(), mask_picture(result.fillable_mask, result.width, result.height));
         });
     }
+    // The scene, for --scene and the figure's scene panel.
+    Scene scene;
+    if (out.scene) {
+        describe_scene(result.segments, params, SceneParams{}, scene);
+        fit_object_boxes(cloud.points, result.labels, result.fillable_mask, scene);
+    }
+    std::string scene_note;
     if (out.figure) {
-        files.stage(*out.figure, [&](const fs::path& to) { write_png(to.string(), comparison_figure(result)); });
+        RgbImage figure;
+        if (!out.scene) figure = comparison_figure(result);
+        if (out.scene) {
+            // With --scene, a fourth panel: the boxes and support outlines over the segments, projected through the
+            // pinhole the cloud was made with (the depth image's intrinsics, or fitted to an organized cloud).
+            if (const std::optional<PinholeCamera> camera = fit_pinhole(cloud)) {
+                RgbImage base = colorize(result.labels, result.width, result.height);
+                if (!loaded.color.empty()) base.rgb = loaded.color;
+                std::vector<Panel> panels = comparison_panels(result);
+                panels.push_back({"scene: " + std::to_string(scene.objects.size()) + " objects, " +
+                                      std::to_string(scene.supports.size()) + " supports",
+                                  scene_picture(dimmed_gray(base), scene, *camera)});
+                figure = side_by_side(panels);
+            } else {
+                figure = comparison_figure(result);
+                scene_note = "; the figure has no scene panel: the cloud is not a pinhole camera's organized cloud";
+            }
+        }
+        files.stage(*out.figure, [&](const fs::path& to) { write_png(to.string(), figure); });
     }
     if (out.ply) {
         files.stage(*out.ply, [&](const fs::path& to) { io::write_ply(to, cloud, result.labels.data(), true); });
@@ -394,9 +422,6 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         });
     }
     if (out.scene) {
-        Scene scene;
-        describe_scene(result.segments, params, SceneParams{}, scene);
-        fit_object_boxes(cloud.points, result.labels, result.fillable_mask, scene);
         files.stage(*out.scene, [&](const fs::path& to) {
             io::write_scene(to, scene, io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
         });
@@ -408,7 +433,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     std::snprintf(line, sizeof line, "%s, %d x %d, normals %s, %u segments, %.1f ms on %s%s%s%s", unit_note.c_str(),
                   result.width, result.height, cloud.normals.empty() ? "estimated" : "from file", result.segment_count,
                   elapsed.count(), segmenter->backend_name().c_str(), warm_up ? ", including warm-up" : "",
-                  sensor_note.c_str(), pcl_note.c_str());
+                  sensor_note.c_str(), (pcl_note + scene_note).c_str());
     std::string report = printable(input) + ": " + loaded.kind + line;
     if (!out.any()) {
         report += '\n';

@@ -80,12 +80,16 @@ RgbImage side_by_side(const std::vector<Panel>& panels) {
     return out;
 }
 
-RgbImage comparison_figure(const Result& r) {
+std::vector<Panel> comparison_panels(const Result& r) {
     std::uint32_t ccl_count = 0;
     const auto ccl = eval::connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
-    return side_by_side({{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
-                         {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
-                         {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}});
+    return {{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
+            {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
+            {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}};
+}
+
+RgbImage comparison_figure(const Result& r) {
+    return side_by_side(comparison_panels(r));
 }
 
 void write_png(const std::string& path, const RgbImage& image) {

@@ -28,6 +28,7 @@ struct Panel {
 
 // The paper's Figure 3 for one result (needs Outputs::fillable_mask): mask | plain connected components | pyramid.
 [[nodiscard]] RgbImage comparison_figure(const Result& result);
+[[nodiscard]] std::vector<Panel> comparison_panels(const Result& result);  // its panels, to add to
 
 void write_png(const std::string& path, const RgbImage& image);
 

@@ -56,4 +56,59 @@ RgbImage scene_picture(const RgbImage& base, const Scene& scene, const PinholeCa
     return image;
 }
 
+RgbImage dimmed_gray(const RgbImage& image) {
+    RgbImage out = image;
+    for (std::size_t i = 0; i + 2 < out.rgb.size(); i += 3) {
+        const int gray = (int(image.rgb[i]) + int(image.rgb[i + 1]) + int(image.rgb[i + 2])) / 3;
+        const auto v = std::uint8_t(24 + gray / 2);
+        out.rgb[i] = out.rgb[i + 1] = out.rgb[i + 2] = v;
+    }
+    return out;
+}
+
+namespace {
+
+// Least squares of pixel = f * ratio + c over the sums of a line fit; the RMS miss in pixels.
+struct LineFit {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    void add(double x, double y) {
+        n += 1;
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
+    }
+    [[nodiscard]] bool solve(double& f, double& c, double& rms) const {
+        const double det = n * sxx - sx * sx;
+        if (!(det > 0)) return false;
+        f = (n * sxy - sx * sy) / det;
+        c = (sy - f * sx) / n;
+        // sum (y - f x - c)^2, expanded
+        const double sse = syy + f * f * sxx + n * c * c - 2 * f * sxy - 2 * c * sy + 2 * f * c * sx;
+        rms = std::sqrt(std::max(0.0, sse) / n);
+        return true;
+    }
+};
+
+}  // namespace
+
+std::optional<PinholeCamera> fit_pinhole(const io::PointCloud& cloud) {
+    LineFit u, v;
+    for (int y = 0; y < cloud.height; ++y) {
+        for (int x = 0; x < cloud.width; ++x) {
+            const float* p = cloud.points.data() + 3 * (std::size_t(y) * std::size_t(cloud.width) + std::size_t(x));
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !(p[2] > 0) || !std::isfinite(p[2])) continue;
+            u.add(double(p[0]) / p[2], x);
+            v.add(double(p[1]) / p[2], y);
+        }
+    }
+    if (u.n < 100) return std::nullopt;
+    PinholeCamera k;
+    double u_rms = 0, v_rms = 0;
+    if (!u.solve(k.fx, k.cx, u_rms) || !v.solve(k.fy, k.cy, v_rms)) return std::nullopt;
+    if (!(u_rms <= 0.5 && v_rms <= 0.5) || !(k.fx > 0 && k.fy > 0)) return std::nullopt;
+    return k;
+}
+
 }  // namespace pyrseg::cli

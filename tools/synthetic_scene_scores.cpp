@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <set>
+#include <tuple>
 
 #include "tools/eval/tabletop_boxes.hpp"
 
@@ -68,9 +70,11 @@ void add_plane_error(const synthetic::Primitive& p, const Part& part, const Vec3
     Vec3 point{}, truth_normal{};
     if (!flat_part_plane(p, part.part, point, truth_normal)) return;
     const double cosine = std::min(1.0, std::fabs(dot(truth_normal, normal)));
-    out.plane_degrees.push_back(std::acos(cosine) * 180.0 / std::numbers::pi);
+    const double degrees = std::acos(cosine) * 180.0 / std::numbers::pi;
+    out.plane_degrees.push_back(degrees);
     const Vec3 c = {centroid_mm[0] - point[0], centroid_mm[1] - point[1], centroid_mm[2] - point[2]};
     out.plane_mm.push_back(std::fabs(dot(truth_normal, c)));
+    out.planes.push_back({out.frames, part.id, part.part, degrees, out.plane_mm.back()});
 }
 
 }  // namespace
@@ -171,6 +175,23 @@ void score_synthetic_scene(const synthetic::Scene& truth, const std::vector<floa
             {o.label, centre, o.axes, extents},
             {box.id, box.center, box.axes, {2 * box.half_size[0], 2 * box.half_size[1], 2 * box.half_size[2]}}));
     }
+}
+
+MatchedPlanes match_planes(const SyntheticSceneScores& a, const SyntheticSceneScores& b) {
+    std::map<std::tuple<std::size_t, std::uint32_t, int>, const PlaneScore*> first_of_b;
+    for (const PlaneScore& p : b.planes) first_of_b.try_emplace({p.frame, p.object, p.part}, &p);
+    std::set<std::tuple<std::size_t, std::uint32_t, int>> done;
+    MatchedPlanes m;
+    for (const PlaneScore& p : a.planes) {
+        const std::tuple<std::size_t, std::uint32_t, int> key{p.frame, p.object, p.part};
+        const auto other = first_of_b.find(key);
+        if (other == first_of_b.end() || !done.insert(key).second) continue;
+        m.a_degrees.push_back(p.degrees);
+        m.a_mm.push_back(p.mm);
+        m.b_degrees.push_back(other->second->degrees);
+        m.b_mm.push_back(other->second->mm);
+    }
+    return m;
 }
 
 }  // namespace pyrseg::cli

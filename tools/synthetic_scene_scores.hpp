@@ -14,12 +14,21 @@
 
 namespace pyrseg::cli {
 
+// One plane scored against its flat part: which frame (the scores' frame count when it was scored) and part.
+struct PlaneScore {
+    std::size_t frame = 0;
+    std::uint32_t object = 0;  // the generator's object id
+    int part = 0;
+    double degrees = 0, mm = 0;
+};
+
 struct SyntheticSceneScores {
     std::size_t frames = 0;
     std::size_t floor_largest = 0;  // frames whose largest support lies 90% on the floor
     std::vector<double> box_iou;
     std::vector<double> plane_degrees;  // the angle between a flat part's segment's plane and the part's
     std::vector<double> plane_mm;       // the part's plane's distance from the segment's centroid
+    std::vector<PlaneScore> planes;     // the same, each with its frame and part
     std::size_t planar_faces = 0, planar_faces_flagged = 0;  // segments on a box face; of them, flagged planar
     std::size_t cylinder_sides = 0, cylinder_sides_flagged = 0;
 };
@@ -38,5 +47,12 @@ struct PeerPlane {
 };
 void score_peer_planes(const synthetic::Scene& truth, const std::vector<float>& points,
                        const std::vector<PeerPlane>& planes, SyntheticSceneScores& out);
+
+// The flat parts of the same frames that both scored a plane of (the first of each), with a's and b's errors: for
+// comparing two methods on the same planes, not on the ones each happened to find.
+struct MatchedPlanes {
+    std::vector<double> a_degrees, a_mm, b_degrees, b_mm;
+};
+MatchedPlanes match_planes(const SyntheticSceneScores& a, const SyntheticSceneScores& b);
 
 }  // namespace pyrseg::cli

@@ -541,6 +541,39 @@ TEST(Cli, RealSenseSceneHasTheTableAndTheCrackerBoxStandingOnIt) {
     fs::remove_all(dir);
 }
 
+// --figure with --scene adds a fourth panel, the scene's boxes over the segments, projected through the pinhole the
+// cloud file's points were made with (fitted to them); a cloud that is no camera's gets the plain figure and a note.
+TEST(Cli, FigureWithSceneDrawsTheBoxes) {
+    const fs::path dir = temp_dir();
+    const pyrseg::io::PointCloud cloud = pyrseg::cli_test::scene_cloud(160, 120, 1, 4);
+    pyrseg::io::write_pcd(dir / "scene.pcd", cloud, pyrseg::io::PcdEncoding::binary);
+    const std::string frame = "segment " + (dir / "scene.pcd").string();
+    ASSERT_EQ(run(frame + " --figure " + (dir / "plain.png").string()).status, 0);
+    CliRun r = run(frame + " --figure " + (dir / "scene.png").string() + " --scene " + (dir / "s.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("no scene panel"), std::string::npos) << r.output;
+    const pyrseg::io::Image plain = pyrseg::io::read_png(dir / "plain.png");
+    const pyrseg::io::Image with_scene = pyrseg::io::read_png(dir / "scene.png");
+    EXPECT_EQ(with_scene.height, plain.height);
+    EXPECT_GT(with_scene.width, plain.width + 160) << "a fourth panel";
+    // The same points, their columns shuffled: no pinhole maps them to their pixels.
+    pyrseg::io::PointCloud shuffled = cloud;
+    for (int y = 0; y < shuffled.height; ++y) {
+        for (int x = 0; x < shuffled.width / 2; ++x) {
+            float* a = shuffled.points.data() + 3 * (std::size_t(y) * 160 + std::size_t(x));
+            float* b = shuffled.points.data() + 3 * (std::size_t(y) * 160 + std::size_t(159 - x));
+            std::swap_ranges(a, a + 3, b);
+        }
+    }
+    pyrseg::io::write_pcd(dir / "mirrored.pcd", shuffled, pyrseg::io::PcdEncoding::binary);
+    r = run("segment " + (dir / "mirrored.pcd").string() + " --figure " + (dir / "m.png").string() + " --scene " +
+            (dir / "m.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("no scene panel"), std::string::npos) << r.output;
+    EXPECT_EQ(pyrseg::io::read_png(dir / "m.png").width, plain.width);
+    fs::remove_all(dir);
+}
+
 // The cracker box of wood_table_1 with the realsense-d435 preset, with and without the colour image: its front and
 // top faces are one segment (the merge joins them across their convex edge), which stays within the box and apart
 // from the table. With colour, the print on the box cuts nothing: the preset's colour edges need a crease.
