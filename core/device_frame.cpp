@@ -83,11 +83,20 @@ void check_device_color(const DeviceColor& color, int width, int height) {
     check_rows("colour image", color.rgb, pitch, row, std::size_t(height), 1, width, height);
 }
 
-void check_device_labels(const DeviceLabels& labels, int width, int height) {
+void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
+    const int width = plan.width;
+    const int height = plan.height;
     const std::size_t row = 4 * std::size_t(width);
     const std::size_t pitch = labels.row_step_bytes == 0 ? row : labels.row_step_bytes;
     check_rows("labels", labels.labels, pitch, row, std::size_t(height), 4, width, height);
     if (labels.count.handle != 0) check_rows("segment count", labels.count, 4, 4, 1, 4, width, height);
+    if (labels.statistics.handle != 0) {
+        if (plan.stats_slots == 0) {
+            bad("a statistics buffer was given but the Segmenter was made without Outputs::segment_stats");
+        }
+        const std::size_t bytes = 4 * plan.stats_words();
+        check_rows("statistics", labels.statistics, bytes, bytes, 1, 4, width, height);
+    }
 }
 
 }  // namespace
@@ -118,7 +127,7 @@ void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const Devi
     Segmenter::Impl& impl = impl_of(segmenter);
     check_device_cloud(cloud, impl.plan.width, impl.plan.height);
     check_device_color(cloud.color, impl.plan.width, impl.plan.height);
-    check_device_labels(labels, impl.plan.width, impl.plan.height);
+    check_device_labels(labels, impl.plan);
     const InputKind input =
         cloud.normals.handle != 0 ? InputKind::cloud_with_normals : InputKind::cloud_without_normals;
     if (checked) checked();
@@ -138,7 +147,7 @@ void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const Devi
     check_device_depth(depth, impl.plan.width, impl.plan.height);
     if (depth.view.color != nullptr) bad("a device depth frame's colour goes in its color buffer, not view.color");
     check_device_color(depth.color, impl.plan.width, impl.plan.height);
-    check_device_labels(labels, impl.plan.width, impl.plan.height);
+    check_device_labels(labels, impl.plan);
     if (checked) checked();
     run(
         impl, InputKind::depth, [&] { impl.executor->bind_device_depth(depth, impl.depth_tables); }, depth.color,

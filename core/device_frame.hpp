@@ -59,6 +59,8 @@ struct DeviceLabels {
     ExternalBuffer labels;
     std::size_t row_step_bytes = 0;
     ExternalBuffer count;
+    // The statistics' words (Segmenter::device_statistics_bytes), for a Segmenter made with Outputs::segment_stats.
+    ExternalBuffer statistics;
 };
 
 // A Segmenter over an executor a backend made on the caller's context (the interop functions' constructors).

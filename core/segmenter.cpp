@@ -14,6 +14,7 @@
 #include "core/depth_tables.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
+#include "core/segment_stats.hpp"
 #include "core/segmenter_impl.hpp"
 #include "pyrseg/backend.hpp"
 #include "pyrseg/error.hpp"
@@ -266,6 +267,26 @@ std::uint32_t Segmenter::last_dispatches() const {
 }
 std::uint32_t Segmenter::last_host_syncs() const {
     return live(impl_).executor->host_syncs();
+}
+
+std::size_t Segmenter::device_statistics_bytes() const {
+    return 4 * live(impl_).plan.stats_words();
+}
+
+void Segmenter::decode_device_statistics(const std::uint32_t* words, std::uint32_t count,
+                                         std::vector<SegmentStats>& out) const {
+    const core::Plan& plan = live(impl_).plan;
+    if (plan.stats_slots == 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    "decode_device_statistics: the Segmenter was made without Outputs::segment_stats");
+    }
+    if (count > plan.stats_slots) {
+        throw Error(ErrorCode::invalid_argument, "decode_device_statistics: a segment count of " +
+                                                     std::to_string(count) + " is more than the Segmenter's " +
+                                                     std::to_string(plan.stats_slots) + " statistics slots");
+    }
+    if (words == nullptr && count != 0) throw Error(ErrorCode::invalid_argument, "decode_device_statistics: no words");
+    core::decode_segment_stats(words, count, plan, true, out);  // device frames are clouds or depth images
 }
 
 }  // namespace pyrseg

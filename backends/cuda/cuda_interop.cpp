@@ -142,6 +142,7 @@ core::DeviceLabels labels_of(const CudaDevice& device, const LabelPointers& out)
     l.labels = external(device, out.labels, out.labels_bytes, "labels");
     l.row_step_bytes = out.row_step_bytes;
     l.count = external(device, out.count, 4, "segment count");
+    l.statistics = external(device, out.statistics, out.statistics_bytes, "statistics");
     return l;
 }
 

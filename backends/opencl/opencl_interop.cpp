@@ -100,6 +100,7 @@ core::DeviceLabels labels_of(const OpenclDevice& device, const LabelBuffers& out
     l.labels = external(device, out.labels, out.labels_offset, "labels");
     l.row_step_bytes = out.row_step_bytes;
     l.count = external(device, out.count, out.count_offset, "segment count");
+    l.statistics = external(device, out.statistics, out.statistics_offset, "statistics");
     return l;
 }
 

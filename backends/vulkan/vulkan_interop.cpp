@@ -123,6 +123,7 @@ core::DeviceLabels labels_of(const LabelBuffers& out) {
     l.labels = external(out.labels, out.labels_offset, out.labels_bytes);
     l.row_step_bytes = std::size_t(out.row_step_bytes);
     l.count = external(out.count, out.count_offset, out.count_bytes);
+    l.statistics = external(out.statistics, out.statistics_offset, out.statistics_bytes);
     return l;
 }
 

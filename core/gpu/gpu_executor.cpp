@@ -151,6 +151,10 @@ public:
         device_->copy_out(labels.labels, pitch, Buffer::out, 0, row, height());
         if (labels.count.handle != 0)
             device_->copy_out(labels.count, 4, Buffer::sums, 4 * size_t(plan_.scan_chunks()), 4, 1);
+        if (labels.statistics.handle != 0) {
+            const size_t bytes = 4 * plan_.stats_words();
+            device_->copy_out(labels.statistics, bytes, Buffer::lut, 4 * size_t(plan_.lut_size()), bytes, 1);
+        }
         device_->submit();
         frame_done();
     }
@@ -275,9 +279,9 @@ public:
         if (!device_frame_) device_->download(Buffer::sums, 4 * size_t(chunks), &segment_count_, 4);
     }
 
-    // K is known on the device only: every slot is cleared, and read_back fetches the K used.
+    // K is known on the device only: every slot is cleared, and read_back fetches the K used (a device frame's
+    // go to the caller's statistics buffer, write_device_labels).
     void segment_stats() override {
-        if (device_frame_) return;  // a host result
         device_->zero(Buffer::lut, 4 * size_t(plan_.lut_size()), 4 * plan_.stats_words());
         const uint32_t runs = plan_.stats_runs_per_row() * height();
         dispatch(Kernel::stats, runs, 1,

@@ -69,6 +69,16 @@ public:
     [[nodiscard]] std::uint32_t last_dispatches() const;
     [[nodiscard]] std::uint32_t last_host_syncs() const;
 
+    // Device-resident frames (pyrseg/cuda.hpp, vulkan.hpp, opencl.hpp) of a Segmenter made with
+    // Outputs::segment_stats write the statistics' words into the caller's statistics buffer, on the device, with
+    // the labels: this many bytes (0 without Outputs::segment_stats). Once the frame is done and the caller has the
+    // words and K on the host (the first K slots suffice), decode_device_statistics gives Result::segments as a host
+    // frame would (docs/algorithm.md sections 10 and 10b). Throws pyrseg::Error when the Segmenter has no
+    // statistics or `count` is more than its slots.
+    [[nodiscard]] std::size_t device_statistics_bytes() const;
+    void decode_device_statistics(const std::uint32_t* words, std::uint32_t count,
+                                  std::vector<SegmentStats>& out) const;
+
 private:
     friend struct core::SegmenterAccess;
     std::unique_ptr<Impl> impl_;

@@ -101,6 +101,11 @@ struct LabelBuffers {
     VkBuffer count = VK_NULL_HANDLE;  // VK_NULL_HANDLE: K is not written
     VkDeviceSize count_offset = 0;
     VkDeviceSize count_bytes = 0;
+    // A Segmenter made with Outputs::segment_stats: the statistics' words (Segmenter::device_statistics_bytes()),
+    // which Segmenter::decode_device_statistics turns into segments; VK_NULL_HANDLE: not written.
+    VkBuffer statistics = VK_NULL_HANDLE;
+    VkDeviceSize statistics_offset = 0;
+    VkDeviceSize statistics_bytes = 0;
 };
 
 // Records one frame into the application's command buffer, which must be in the recording state, outside a render
@@ -116,8 +121,9 @@ struct LabelBuffers {
 // Frames of one Segmenter share its buffers: they must execute in the order they were recorded or submitted (one
 // after the other in one command buffer, or command buffers submitted in that order to the Segmenter's queue), and
 // a command buffer recorded here must be submitted before the Segmenter's next host frame. Nothing is recorded when
-// a check fails (a pyrseg::Error names the problem). Outputs other than the labels (mask, normals, raw labels,
-// statistics) are host results and are not produced; Segmenter::last_timings() is empty after it.
+// a check fails (a pyrseg::Error names the problem). Outputs other than the labels and the statistics (mask,
+// normals, raw labels, the segment graph) are host results and are not produced; Segmenter::last_timings() is empty
+// after it.
 PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const CloudBuffers& cloud,
                           const LabelBuffers& out);
 PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const DepthBuffer& depth,

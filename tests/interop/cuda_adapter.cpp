@@ -49,8 +49,8 @@ std::string CudaAdapter::open() {
     return "";
 }
 
-Segmenter CudaAdapter::make_segmenter(int width, int height, const Params& params) {
-    return cuda::make_segmenter(width, height, stream_, params);
+Segmenter CudaAdapter::make_segmenter(int width, int height, const Params& params, const Outputs& outputs) {
+    return cuda::make_segmenter(width, height, stream_, params, outputs);
 }
 
 int CudaAdapter::allocate(std::size_t bytes) {
@@ -147,6 +147,10 @@ cuda::LabelPointers CudaAdapter::labels(const LabelFrame& frame) const {
     l.row_step_bytes = frame.row_step_bytes;
     if (frame.count.buffer != Region::kNone) {
         l.count = reinterpret_cast<std::uint32_t*>(pointer(frame.count.buffer) + frame.count.offset);
+    }
+    if (frame.statistics.buffer != Region::kNone) {
+        l.statistics = reinterpret_cast<std::uint32_t*>(pointer(frame.statistics.buffer) + frame.statistics.offset);
+        l.statistics_bytes = size(frame.statistics.buffer) - frame.statistics.offset;
     }
     return l;
 }

@@ -22,7 +22,8 @@ public:
     [[nodiscard]] std::string open() override;
     [[nodiscard]] std::string backend_name() const override { return "cuda"; }
     [[nodiscard]] std::vector<Way> ways() const override { return {{"cuda::segment"}}; }
-    [[nodiscard]] Segmenter make_segmenter(int width, int height, const Params& params) override;
+    [[nodiscard]] Segmenter make_segmenter(int width, int height, const Params& params,
+                                           const Outputs& outputs = {}) override;
     [[nodiscard]] int allocate(std::size_t bytes) override;
     [[nodiscard]] std::size_t size(int buffer) const override;
     void upload(int buffer, std::size_t offset, const void* data, std::size_t bytes) override;

@@ -419,12 +419,97 @@ TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     d.view.width = kW - 1;
     r.expect({d, r.out}, "31 x 24", ErrorCode::size_mismatch);
 
+    // Statistics: a buffer for a Segmenter made without them, or one word too small for a Segmenter made with them.
+    o = r.out;
+    o.statistics = {api().allocate(64), 0};
+    cloud_refused(r.cloud, o, "without Outputs::segment_stats");
+    Outputs stats;
+    stats.segment_stats = true;
+    Segmenter with_stats = api().make_segmenter(Wall::kWidth, Wall::kHeight, {}, stats);
+    o.statistics = {api().allocate(with_stats.device_statistics_bytes() - 4), 0};
+    r.expect(with_stats, {r.cloud, o}, "statistics buffer holds");
+
     // A Segmenter on another API.
     Segmenter cpu(Wall::kWidth, Wall::kHeight, {}, "cpu");
     r.expect(cpu, {r.cloud, r.out}, "does not run on");
     r.expect(cpu, {r.depth, r.out}, "does not run on");
 
     r.expect_still_segments();
+}
+
+// The statistics of device frames (a Segmenter made with Outputs::segment_stats): the words go to the caller's buffer
+// with the labels, and Segmenter::decode_device_statistics gives the host path's segments from them, field for field;
+// a cloud and a depth image, several frames queued before any is read.
+TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
+    synthetic::SceneOptions o;
+    o.width = 96;
+    o.height = 72;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Outputs outputs;
+    outputs.segment_stats = true;
+    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = scene.points[3 * i + 2];
+        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+    }
+    const DepthView view{depth.data(), DepthFormat::u16, o.width,  o.height, 0,
+                         0.001,        scene.fx,         scene.fy, scene.cx, scene.cy};
+    Segmenter cpu(o.width, o.height, params, "cpu", outputs);
+    const Result from_cloud = cpu.segment(CloudView{scene.points.data(), nullptr, o.width, o.height});
+    const Result from_depth = cpu.segment(view);
+    ASSERT_GT(from_cloud.segment_count, 2u);
+    Segmenter segmenter = api().make_segmenter(o.width, o.height, params, outputs);
+    const std::size_t bytes = segmenter.device_statistics_bytes();
+    ASSERT_GT(bytes, 0u);
+    CloudFrame cloud_in;
+    cloud_in.points = put(scene.points.data(), 4 * scene.points.size());
+    DepthFrame depth_in{put(depth.data(), 2 * depth.size()), view};
+    depth_in.view.depth = nullptr;
+    std::vector<Frame> frames;
+    for (int f = 0; f < 4; ++f) {
+        LabelFrame out;
+        out.labels = {api().allocate(4 * depth.size()), 0};
+        out.count = {api().allocate(4), 0};
+        out.statistics = {api().allocate(bytes + 12), 12};
+        frames.push_back(f % 2 == 0 ? Frame{cloud_in, out} : Frame{depth_in, out});
+    }
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        api().run(segmenter, frames, way);
+        for (std::size_t f = 0; f < frames.size(); ++f) {
+            SCOPED_TRACE(ways[way].name + ", frame " + std::to_string(f));
+            const Result& expected = f % 2 == 0 ? from_cloud : from_depth;
+            const std::uint32_t count = words(frames[f].out.count.buffer, 0, 1)[0];
+            ASSERT_EQ(count, expected.segment_count);
+            EXPECT_EQ(words(frames[f].out.statistics.buffer, 8, 1)[0], kUntouched) << "written before the offset";
+            const std::vector<std::uint32_t> stats = words(frames[f].out.statistics.buffer, 12, bytes / 4);
+            std::vector<SegmentStats> segments;
+            segmenter.decode_device_statistics(stats.data(), count, segments);
+            ASSERT_EQ(segments.size(), expected.segments.size());
+            for (std::size_t k = 0; k < segments.size(); ++k) {
+                const SegmentStats& a = segments[k];
+                const SegmentStats& e = expected.segments[k];
+                EXPECT_EQ(a.label, e.label);
+                EXPECT_EQ(a.pixel_count, e.pixel_count);
+                EXPECT_EQ(a.fillable_count, e.fillable_count);
+                EXPECT_EQ(a.point_sum, e.point_sum);
+                EXPECT_EQ(a.normal_sum, e.normal_sum);
+                EXPECT_EQ(a.point_product_sum, e.point_product_sum);
+                EXPECT_EQ(a.plane_normal, e.plane_normal);
+                EXPECT_EQ(a.extents, e.extents);
+                EXPECT_EQ(a.planar, e.planar);
+            }
+            std::vector<unsigned char> blank(bytes, 0xAB);
+            api().upload(frames[f].out.statistics.buffer, 12, blank.data(), blank.size());
+        }
+    }
+    std::vector<SegmentStats> none;
+    EXPECT_THROW(segmenter.decode_device_statistics(nullptr, 1u << 30, none), Error);
+    Segmenter without = api().make_segmenter(o.width, o.height, params);
+    EXPECT_EQ(without.device_statistics_bytes(), 0u);
 }
 
 }  // namespace pyrseg::test

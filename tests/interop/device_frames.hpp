@@ -44,7 +44,8 @@ struct DepthFrame {
 
 struct LabelFrame {
     Region labels;
-    Region count;  // kNone: K is not written
+    Region count;       // kNone: K is not written
+    Region statistics;  // kNone: the statistics are not written (Segmenter::device_statistics_bytes() from it on)
     std::size_t row_step_bytes = 0;
 };
 
@@ -71,7 +72,8 @@ public:
     [[nodiscard]] virtual std::string open() = 0;
     [[nodiscard]] virtual std::string backend_name() const = 0;
     [[nodiscard]] virtual std::vector<Way> ways() const = 0;
-    [[nodiscard]] virtual Segmenter make_segmenter(int width, int height, const Params& params) = 0;
+    [[nodiscard]] virtual Segmenter make_segmenter(int width, int height, const Params& params,
+                                                   const Outputs& outputs = {}) = 0;
 
     // A buffer of `bytes` on the application's context, every byte 0xAB; its index.
     [[nodiscard]] virtual int allocate(std::size_t bytes) = 0;

@@ -42,8 +42,8 @@ std::string OpenclAdapter::open() {
     return "";
 }
 
-Segmenter OpenclAdapter::make_segmenter(int width, int height, const Params& params) {
-    return opencl::make_segmenter(width, height, queue(), params);
+Segmenter OpenclAdapter::make_segmenter(int width, int height, const Params& params, const Outputs& outputs) {
+    return opencl::make_segmenter(width, height, queue(), params, outputs);
 }
 
 int OpenclAdapter::allocate(std::size_t bytes) {
@@ -117,8 +117,8 @@ opencl::DepthBuffer OpenclAdapter::depth(const DepthFrame& frame) const {
 }
 
 opencl::LabelBuffers OpenclAdapter::labels(const LabelFrame& frame) const {
-    return {mem(frame.labels.buffer), frame.labels.offset, frame.row_step_bytes, mem(frame.count.buffer),
-            frame.count.offset};
+    return {mem(frame.labels.buffer), frame.labels.offset,          frame.row_step_bytes,   mem(frame.count.buffer),
+            frame.count.offset,       mem(frame.statistics.buffer), frame.statistics.offset};
 }
 
 cl_context OpenclAdapter::foreign_context() {

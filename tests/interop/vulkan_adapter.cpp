@@ -117,8 +117,8 @@ std::vector<Way> VulkanAdapter::ways() const {
             {"recorded into a command buffer never begun", true}};
 }
 
-Segmenter VulkanAdapter::make_segmenter(int width, int height, const Params& params) {
-    return vulkan::make_segmenter(width, height, device(), params);
+Segmenter VulkanAdapter::make_segmenter(int width, int height, const Params& params, const Outputs& outputs) {
+    return vulkan::make_segmenter(width, height, device(), params, outputs);
 }
 
 int VulkanAdapter::allocate(std::size_t bytes) {
@@ -324,6 +324,11 @@ vulkan::LabelBuffers VulkanAdapter::labels(const LabelFrame& frame) const {
         l.count = buffer(frame.count.buffer).buffer;
         l.count_offset = frame.count.offset;
         l.count_bytes = buffer(frame.count.buffer).bytes;
+    }
+    if (frame.statistics.buffer != Region::kNone) {
+        l.statistics = buffer(frame.statistics.buffer).buffer;
+        l.statistics_offset = frame.statistics.offset;
+        l.statistics_bytes = buffer(frame.statistics.buffer).bytes;
     }
     return l;
 }
