@@ -65,7 +65,8 @@ public:
     [[nodiscard]] std::uint32_t last_fill_rounds() const;
     // What the last frame cost a GPU backend besides its kernels: the dispatches (kernel launches) it queued, and
     // the times the host waited for the device (1 per frame; 2 with Outputs::segment_stats or segment_graph, whose
-    // words are fetched once the segment count and the graph's pair count are known). Neither depends on the image's content. Both 0 on the CPU backend.
+    // words are fetched once the segment count and the graph's pair count are known). Neither depends on the
+    // image's content. Both 0 on the CPU backend.
     [[nodiscard]] std::uint32_t last_dispatches() const;
     [[nodiscard]] std::uint32_t last_host_syncs() const;
 
