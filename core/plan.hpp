@@ -77,12 +77,11 @@ struct Plan {
         return (std::uint32_t(width) + PYR_STATS_RUN - 1) / PYR_STATS_RUN;
     }
     [[nodiscard]] float stats_point_scale() const;
-    // The segment graph's words: the pairs' counter, the table, and the dense list of at most half as many pairs
-    // (shaders/pyr_graph.h); where the list starts.
+    // The segment graph's words at most: the pairs' counter, the table, and the dense list of at most half as many
+    // pairs (shaders/pyr_graph.h); a frame uses those of pyr_graph_slots(K, graph_slots).
     [[nodiscard]] std::size_t graph_words() const {
         return graph_slots == 0 ? 0 : 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * (graph_slots + graph_slots / 2);
     }
-    [[nodiscard]] std::size_t graph_list_word() const { return 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * graph_slots; }
 };
 
 // Validates everything before anything is allocated. Throws pyrseg::Error.

@@ -500,27 +500,40 @@ PYR_KERNEL_1D(stats) {
 }
 #endif
 
-/* The segment graph (shaders/pyr_graph.h), after compact; the host zeroes its words first. graph_count (2D,
- * w x h): h, offset of level N, flags (bit 0: with points, bit 1: the labels compacted), reach, point scale (float),
- * tolerance base and growth (floats), slots (a power of two). The table starts at word 1 (see graph_gather). */
+/* The segment graph (shaders/pyr_graph.h), after compact, in three dispatches over the plan's largest table; each
+ * uses the slots K needs (pyr_graph_slots, K read where the scan left it) and leaves the rest. graph_clear (1D,
+ * 1 + PYR_GRAPH_SLOT_WORDS * max slots): the word of K in the sums buffer, max slots. The counter (word 0) and the
+ * table (from word 1) zeroed. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_GRAPH_CLEAR)
+PYR_KERNEL_1D(graph_clear) {
+    pyr_u32 k = PYR_I;
+    pyr_u32 slots = pyr_graph_slots(PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(1));
+    if (k >= 1u + PYR_GRAPH_SLOT_WORDS * slots) return;
+    PYR_UF_STORE(k, 0u);
+}
+#endif
+
+/* graph_count (2D, w x h): h, offset of level N, flags (bit 0: with points, bit 1: the labels compacted) | reach << 8,
+ * the word of K, point scale (float), tolerance base and growth (floats), max slots. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_GRAPH_COUNT)
 PYR_KERNEL_2D(graph_count) {
     pyr_u32 x = PYR_X;
     pyr_u32 y = PYR_Y;
     if (x >= PYR_W || y >= PYR_ARG(0)) return;
-    pyr_u32 slots = PYR_ARG(7);
+    pyr_u32 slots = pyr_graph_slots(PYR_BUF(sums)[PYR_ARG(3)], PYR_ARG(7));
     pyr_graph_count(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, PYR_ARG(2) & 1u,
-                    (PYR_ARG(2) >> 1u) & 1u, PYR_ARG(3), PYR_ARG_F32(4), PYR_ARG_F32(5), PYR_ARG_F32(6), 1u,
+                    (PYR_ARG(2) >> 1u) & 1u, PYR_ARG(2) >> 8u, PYR_ARG_F32(4), PYR_ARG_F32(5), PYR_ARG_F32(6), 1u,
                     slots - 1u);
 }
 #endif
 
-/* graph_gather (1D, slots): slots. The counter is word 0, the table starts at word 1 and the list after it. */
+/* graph_gather (1D, max slots): the word of K, max slots. The list follows the table K needs. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_GRAPH_GATHER)
 PYR_KERNEL_1D(graph_gather) {
     pyr_u32 s = PYR_I;
-    if (s >= PYR_ARG(0)) return;
-    pyr_graph_gather(PYR_ENTRY_CTX, 1u, s, 1u + PYR_GRAPH_SLOT_WORDS * PYR_ARG(0), 0u);
+    pyr_u32 slots = pyr_graph_slots(PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(1));
+    if (s >= slots) return;
+    pyr_graph_gather(PYR_ENTRY_CTX, 1u, s, 1u + PYR_GRAPH_SLOT_WORDS * slots, 0u);
 }
 #endif
 

@@ -43,6 +43,7 @@
     K(scan_number, SCAN_NUMBER, 1)       \
     K(compact, COMPACT, 1)               \
     K(stats, STATS, 1)                   \
+    K(graph_clear, GRAPH_CLEAR, 1)       \
     K(graph_count, GRAPH_COUNT, 2)       \
     K(graph_gather, GRAPH_GATHER, 1)
 

@@ -146,4 +146,13 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 #define PYR_INIT_INHERIT 1u     /* steps 3 and 5: parent's label, maybe 0 */
 #define PYR_INIT_PIXEL_INDEX 2u /* tiny-image fallback: 1 + the pixel's own index */
 
+/* The segment graph's slots for K segments: the smallest power of two above twice the 3 K + 3 pairs they can have
+ * (core/plan.cpp), at most max_slots (the plan's, for the largest K). Every backend sizes its table with it once K
+ * is known, so a frame's table costs what its segments need. */
+PYR_FN pyr_u32 pyr_graph_slots(pyr_u32 count, pyr_u32 max_slots) {
+    pyr_u32 slots = 1u;
+    while (slots < max_slots && slots <= 6u * count + 6u) slots = slots * 2u;
+    return slots;
+}
+
 #endif /* PYR_TYPES_H */

@@ -1,9 +1,8 @@
 // The segment graph (docs/algorithm.md section 10d) with the GPUs' functions (shaders/pyr_graph.h) over words of its
-// own: every row's crossings counted into the pair table at once, then the pairs gathered. The CPU knows K here, so
-// its table has only the slots K segments can need (and only those are cleared), not the plan's bound.
+// own: every row's crossings counted into the pair table at once, then the pairs gathered, in the slots K segments can
+// need (pyr_graph_slots, as every backend).
 #include <algorithm>
 #include <atomic>
-#include <bit>
 
 #include "backends/cpu/cpu_executor.hpp"
 
@@ -26,9 +25,7 @@ using std::uint32_t;
 void CpuExecutor::segment_graph() {
     const PyrLevel lv = plan_.full();
     const core::Thresholds& t = plan_.thresholds;
-    // K segments have at most 3 K + 3 pairs (core/plan.cpp); the table has more than twice as many slots.
-    const std::uint64_t pairs = 3 * std::uint64_t(segment_count_) + 3;
-    const auto slots = uint32_t(std::min<std::uint64_t>(std::bit_ceil(2 * pairs + 1), plan_.graph_slots));
+    const uint32_t slots = pyr_graph_slots(segment_count_, plan_.graph_slots);
     const size_t list = 1 + size_t(PYR_GRAPH_SLOT_WORDS) * slots;
     std::fill_n(graph_words_.begin(), list, 0u);
     PassContext c = context();

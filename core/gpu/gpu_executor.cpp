@@ -289,18 +289,20 @@ public:
                        plan_.lut_size(), plan_.stats_slots}));
     }
 
-    // The graph's table and list in the fill buffer, which nothing needs after the merge; read_back fetches the
-    // pair count with the labels, then the pairs.
+    // The graph's table and list in the fill buffer, which nothing needs after the merge, sized for K on the device
+    // (pyr_graph_slots); read_back fetches the pair count with the labels, then the pairs.
     void segment_graph() override {
         if (device_frame_) return;  // a host result
-        device_->zero(Buffer::fill, 0, 4 * plan_.graph_words());
         const core::Thresholds& t = plan_.thresholds;
-        const uint32_t flags = (from_mask_ ? 0u : 1u) | (plan_.params.compact ? 2u : 0u);
-        dispatch(
-            Kernel::graph_count, width(), height(),
-            args({height(), plan_.full().offset, flags, uint32_t(plan_.params.merge_reach), bits(t.merge_point_scale),
-                  bits(t.merge_tolerance_base), bits(t.merge_tolerance_growth), plan_.graph_slots}));
-        dispatch(Kernel::graph_gather, plan_.graph_slots, 1, args({plan_.graph_slots}));
+        const uint32_t k_word = plan_.scan_chunks();
+        const uint32_t max_slots = plan_.graph_slots;
+        const uint32_t flags =
+            (from_mask_ ? 0u : 1u) | (plan_.params.compact ? 2u : 0u) | (uint32_t(plan_.params.merge_reach) << 8);
+        dispatch(Kernel::graph_clear, 1 + PYR_GRAPH_SLOT_WORDS * max_slots, 1, args({k_word, max_slots}));
+        dispatch(Kernel::graph_count, width(), height(),
+                 args({height(), plan_.full().offset, flags, k_word, bits(t.merge_point_scale),
+                       bits(t.merge_tolerance_base), bits(t.merge_tolerance_growth), max_slots}));
+        dispatch(Kernel::graph_gather, max_slots, 1, args({k_word, max_slots}));
     }
 
     void read_back(Result& out, const Outputs& outputs) override {
@@ -333,8 +335,8 @@ public:
         if (stats_words != 0)
             device_->download(Buffer::lut, 4 * size_t(plan_.lut_size()), host_stats_.data(), 4 * stats_words);
         if (pairs != 0) {
-            device_->download(Buffer::fill, 4 * plan_.graph_list_word(), host_graph_.data(),
-                              4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
+            const size_t list = 1 + size_t(PYR_GRAPH_SLOT_WORDS) * pyr_graph_slots(segment_count_, plan_.graph_slots);
+            device_->download(Buffer::fill, 4 * list, host_graph_.data(), 4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
         }
         if (stats_words != 0 || plan_.graph_slots != 0) finish();  // the same waits whatever the graph holds
         if (plan_.stats_slots != 0)
