@@ -149,8 +149,7 @@ DepthImage from_tiff(const std::filesystem::path& path) {
 }  // namespace
 
 DepthImage read_depth_image(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = detail::lower_extension(path);
     if (ext == ".png") return detail::guard_reader(path, [&] { return from_png(path); });
     if (ext == ".tif" || ext == ".tiff") return detail::guard_reader(path, [&] { return from_tiff(path); });
     fail(ErrorCode::format, path, "unsupported depth image format '" + ext + "' (16-bit .png, or .tif/.tiff)");

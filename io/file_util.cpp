@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <climits>
 #include <csignal>
@@ -36,6 +37,12 @@ std::string errno_text(int err) {
 
 void fail(ErrorCode code, const std::filesystem::path& path, std::string_view what) {
     throw Error(code, path.string() + ": " + std::string(what));
+}
+
+std::string lower_extension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
 }
 
 std::string printable(std::string_view bytes) {

@@ -25,6 +25,9 @@ namespace pyrseg::io::detail {
 // (File names are the CLI's to print, tools/printable.hpp: they keep UTF-8 and escape control characters.)
 std::string printable(std::string_view bytes);
 
+// The path's extension in lower case (".png", ".csv"), which picks a format whatever its case.
+std::string lower_extension(const std::filesystem::path& path);
+
 // The largest image any reader decodes: 65536 on a side and 2^28 pixels in all (16384 x 16384, 1 GiB of float depth),
 // far beyond any camera. Compressed image data can expand far beyond its size in the file (deflate 1032-fold), so the
 // file's size alone does not bound what a reader allocates.

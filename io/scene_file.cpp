@@ -107,16 +107,10 @@ std::string to_ply(const Scene& scene) {
            std::to_string(face_count) + "\nproperty list uchar int vertex_indices\nend_header\n" + vertices + faces;
 }
 
-bool ends_with_ply(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".ply";
-}
-
 }  // namespace
 
 void write_scene(const std::filesystem::path& path, const Scene& scene, const SegmentTable& frame) {
-    const std::string text = ends_with_ply(path) ? to_ply(scene) : to_json(scene, frame);
+    const std::string text = detail::lower_extension(path) == ".ply" ? to_ply(scene) : to_json(scene, frame);
     detail::write_file(path, text.data(), text.size());
 }
 

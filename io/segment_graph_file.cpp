@@ -1,5 +1,4 @@
 // The segment graph as CSV or JSON (nlohmann/json).
-#include <cctype>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -43,9 +42,7 @@ std::string to_json(const std::vector<SegmentEdge>& graph, const SegmentTable& f
 
 void write_segment_graph(const std::filesystem::path& path, const std::vector<SegmentEdge>& graph,
                          const SegmentTable& frame) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    const std::string text = ext == ".csv" ? to_csv(graph) : to_json(graph, frame);
+    const std::string text = detail::lower_extension(path) == ".csv" ? to_csv(graph) : to_json(graph, frame);
     detail::write_file(path, text.data(), text.size());
 }
 

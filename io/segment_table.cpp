@@ -10,12 +10,6 @@
 namespace pyrseg::io {
 namespace {
 
-bool ends_with_csv(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".csv";
-}
-
 // Shortest text that reads back as the same double; empty for NaN (a mask has no geometry).
 std::string csv_number(double v) {
     if (std::isnan(v)) return {};
@@ -93,7 +87,7 @@ std::string to_json(const std::vector<SegmentStats>& segments, const SegmentTabl
 
 void write_segment_stats(const std::filesystem::path& path, const std::vector<SegmentStats>& segments,
                          const SegmentTable& frame) {
-    const std::string text = ends_with_csv(path) ? to_csv(segments) : to_json(segments, frame);
+    const std::string text = detail::lower_extension(path) == ".csv" ? to_csv(segments) : to_json(segments, frame);
     detail::write_file(path, text.data(), text.size());
 }
 

@@ -6,17 +6,7 @@
 #include <atomic>
 
 #include "backends/cpu/cpu_executor.hpp"
-
-#define PYR_UF_LOAD(i) std::atomic_ref<std::uint32_t>(ctx.merge[i]).load(std::memory_order_relaxed)
-#define PYR_UF_STORE(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).store((v), std::memory_order_relaxed)
-#define PYR_UF_MIN(i, v) ::pyrseg::cpu::atomic_min(ctx.merge[i], (v))
-#define PYR_UF_CAS(i, e, v) ::pyrseg::cpu::atomic_cas(ctx.merge[i], (e), (v))
-#define PYR_UF_ADD(i, v) std::atomic_ref<std::uint32_t>(ctx.merge[i]).fetch_add((v), std::memory_order_relaxed)
-
-namespace pyrseg::cpu::pixel {
-using std::min;  // pyr_uf.h's GPU spelling
-#include "shaders/pyr_merge_table.h"
-}  // namespace pyrseg::cpu::pixel
+#include "backends/cpu/cpu_pair_table.hpp"
 
 namespace pyrseg::cpu {
 
@@ -35,15 +25,10 @@ void CpuExecutor::merge_segments() {
     c.merge = merge_words_.data();
     const auto reach = uint32_t(plan_.params.merge_reach);
     rows(lv.height, [&](size_t y) {
-        const uint32_t* row = labels_.data() + lv.offset + y * lv.width;
-        const uint32_t* below = y + 1 < lv.height ? row + lv.width : row;  // the last row: no pixel below
-        for (uint32_t x = 0; x < lv.width; ++x) {
-            // Most pixels cross no boundary: only those that may go to the shared function.
-            const uint32_t right = x + 1 < lv.width ? row[x + 1] : row[x];
-            if (row[x] == 0 || (right == row[x] && below[x] == row[x])) continue;
+        for_each_boundary_pixel(labels_.data(), lv, y, [&](uint32_t x) {
             pixel::pyr_merge_count(c, lv, x, uint32_t(y), reach, t.merge_point_scale, t.merge_tolerance_base,
                                    t.merge_tolerance_growth, labels, slots - 1);
-        }
+        });
     });
     const auto min_crossings = uint32_t(plan_.params.merge_min_crossings);
     for (uint32_t s = 0; s < slots; ++s) pixel::pyr_merge_link(c, labels, s, min_crossings, t.merge_share);
