@@ -492,26 +492,18 @@ private:
             if (mask_data != nullptr) copy(mask_data, result_.fillable_mask, pixels, "fillable mask");
             if (normals_data != nullptr) copy(normals_data, result_.normals, pixels * 3, "normal");
             count = result_.segment_count;
-            if (outputs_.segment_stats) {
-                // Under the lock, so that another thread's frame cannot overwrite the statistics being read.
+            // Under the lock, so that another thread's frame cannot overwrite the records being read: a structured
+            // array of `dtype` holding a copy of them.
+            const auto records = [](const auto& from, PyObject* dtype) {
                 const py::gil_scoped_acquire gil;
-                const auto k = py::ssize_t(result_.segments.size());
-                auto a =
-                    py::reinterpret_steal<py::array>(PyObject_CallFunction(cached.empty, "nO", k, cached.stats_dtype));
+                const auto k = py::ssize_t(from.size());
+                auto a = py::reinterpret_steal<py::array>(PyObject_CallFunction(cached.empty, "nO", k, dtype));
                 if (!a) throw py::error_already_set();
-                if (k > 0)
-                    std::memcpy(a.mutable_data(), result_.segments.data(), std::size_t(k) * sizeof(SegmentStats));
-                segments = std::move(a);
-            }
-            if (outputs_.segment_graph) {
-                const py::gil_scoped_acquire gil;
-                const auto k = py::ssize_t(result_.graph.size());
-                auto a =
-                    py::reinterpret_steal<py::array>(PyObject_CallFunction(cached.empty, "nO", k, cached.graph_dtype));
-                if (!a) throw py::error_already_set();
-                if (k > 0) std::memcpy(a.mutable_data(), result_.graph.data(), std::size_t(k) * sizeof(SegmentEdge));
-                graph = std::move(a);
-            }
+                if (k > 0) std::memcpy(a.mutable_data(), from.data(), std::size_t(k) * sizeof(from[0]));
+                return py::object(std::move(a));
+            };
+            if (outputs_.segment_stats) segments = records(result_.segments, cached.stats_dtype);
+            if (outputs_.segment_graph) graph = records(result_.graph, cached.graph_dtype);
         }
         return obj(cached.result_type)(labels, count, segments, normals, mask, raw, graph);
     }
