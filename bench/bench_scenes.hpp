@@ -3,6 +3,7 @@
 // the fillable mask pyrseg computes for it (the common input of the labelling peers).
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -68,12 +69,57 @@ inline const SceneMask& scene_mask(int width, int height) {
     return *slot;
 }
 
-// Times `frame(segmenter, result)` (one frame into result) on a Segmenter of `backend`: once to size everything,
-// then once per iteration. Reports per-pass counters (`<pass>_ms`, milliseconds per frame as
-// Segmenter::last_timings() gives them: host times, or the device's timestamps where a backend queues the frame),
-// the fills' sweep rounds, a GPU backend's dispatches and host waits per frame, the segment count, Mpix/s and input
-// bytes/s. A backend that cannot take the frame (a device
-// limit) is reported as skipped with its reason.
+// The scene as a depth camera hands it over: whole millimetres in uint16 (0: no data), with its intrinsics.
+struct DepthFrame {
+    std::vector<std::uint16_t> samples;
+    DepthView view;
+};
+
+inline const DepthFrame& depth_frame(int width, int height) {
+    static std::map<std::pair<int, int>, std::unique_ptr<DepthFrame>> cache;
+    auto& slot = cache[{width, height}];
+    if (!slot) {
+        const synthetic::Scene& s = scene(width, height);
+        slot = std::make_unique<DepthFrame>();
+        slot->samples.resize(std::size_t(width) * std::size_t(height));
+        for (std::size_t i = 0; i < slot->samples.size(); ++i) {
+            const float z = s.points[3 * i + 2];
+            slot->samples[i] = std::isfinite(z) && z > 0 && z < 65535 ? std::uint16_t(std::lround(z)) : 0;
+        }
+        slot->view = DepthView{slot->samples.data(), DepthFormat::u16, width, height, 0, 0.001, s.fx, s.fy, s.cx, s.cy};
+    }
+    return *slot;
+}
+
+// Times `frame(segmenter, result)` (one frame into result) on `segmenter`: once to size everything, then once per
+// iteration. Reports per-pass counters (`<pass>_ms`, milliseconds per frame as Segmenter::last_timings() gives
+// them: host times, or the device's timestamps where a backend queues the frame), the fills' sweep rounds, a GPU
+// backend's dispatches and host waits per frame, the segment count, Mpix/s and input bytes/s.
+template <class Frame>
+void time_frames_on(benchmark::State& state, Segmenter& segmenter, int width, int height, std::size_t input_bytes,
+                    const Frame& frame) {
+    Result result;
+    frame(segmenter, result);
+    std::map<std::string, double> pass_ms;
+    for (auto _ : state) {
+        frame(segmenter, result);
+        for (const PassTiming& t : segmenter.last_timings()) pass_ms[t.pass] += t.milliseconds;
+        benchmark::DoNotOptimize(result.labels.data());
+    }
+    for (const auto& [pass, ms] : pass_ms) {
+        state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
+    }
+    state.counters["fill_rounds"] = segmenter.last_fill_rounds();
+    state.counters["dispatches"] = segmenter.last_dispatches();
+    state.counters["host_syncs"] = segmenter.last_host_syncs();
+    state.counters["segments"] = result.segment_count;
+    state.counters["Mpix/s"] =
+        benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(input_bytes));
+}
+
+// As time_frames_on, on a Segmenter of `backend`; a backend that cannot take the frame (a device limit) is reported
+// as skipped with its reason.
 template <class Frame>
 void time_frames(benchmark::State& state, const std::string& backend, int width, int height, std::size_t input_bytes,
                  const Frame& frame, const Params& params = {}, const Outputs& outputs = {}) {
@@ -84,24 +130,7 @@ void time_frames(benchmark::State& state, const std::string& backend, int width,
         state.SkipWithError(e.what());
         return;
     }
-    Result result;
-    frame(*segmenter, result);
-    std::map<std::string, double> pass_ms;
-    for (auto _ : state) {
-        frame(*segmenter, result);
-        for (const PassTiming& t : segmenter->last_timings()) pass_ms[t.pass] += t.milliseconds;
-        benchmark::DoNotOptimize(result.labels.data());
-    }
-    for (const auto& [pass, ms] : pass_ms) {
-        state.counters[pass + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
-    }
-    state.counters["fill_rounds"] = segmenter->last_fill_rounds();
-    state.counters["dispatches"] = segmenter->last_dispatches();
-    state.counters["host_syncs"] = segmenter->last_host_syncs();
-    state.counters["segments"] = result.segment_count;
-    state.counters["Mpix/s"] =
-        benchmark::Counter(double(width) * height * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-    state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(input_bytes));
+    time_frames_on(state, *segmenter, width, height, input_bytes, frame);
 }
 
 }  // namespace pyrseg::bench

@@ -84,28 +84,6 @@ void color_pipeline(benchmark::State& state, const std::string& backend, int wid
         [&](Segmenter& segmenter, Result& result) { segmenter.segment(view, result); }, params);
 }
 
-// The scene as a depth camera hands it over: whole millimetres in uint16 (0: no data), with its intrinsics.
-struct DepthFrame {
-    std::vector<std::uint16_t> samples;
-    DepthView view;
-};
-
-const DepthFrame& depth_frame(int width, int height) {
-    static std::map<std::pair<int, int>, std::unique_ptr<DepthFrame>> cache;
-    auto& slot = cache[{width, height}];
-    if (!slot) {
-        const synthetic::Scene& s = scene(width, height);
-        slot = std::make_unique<DepthFrame>();
-        slot->samples.resize(std::size_t(width) * std::size_t(height));
-        for (std::size_t i = 0; i < slot->samples.size(); ++i) {
-            const float z = s.points[3 * i + 2];
-            slot->samples[i] = std::isfinite(z) && z > 0 && z < 65535 ? std::uint16_t(std::lround(z)) : 0;
-        }
-        slot->view = DepthView{slot->samples.data(), DepthFormat::u16, width, height, 0, 0.001, s.fx, s.fy, s.cx, s.cy};
-    }
-    return *slot;
-}
-
 // A depth frame: 2 bytes a pixel uploaded, back-projected on the device, then as pipeline/ with estimated normals.
 void depth_pipeline(benchmark::State& state, const std::string& backend, int width, int height) {
     const DepthFrame& frame = depth_frame(width, height);

@@ -11,6 +11,7 @@ packages=(
   libpcl-dev                                    # PLY clouds via PCL's io (the peer benchmarks use PCL too)
   libopencv-dev nlohmann-json3-dev              # peer benchmarks (connectedComponents); statistics as JSON
   libhwy-dev                                    # Google Highway: the CPU backend's vector passes
+  libtbb-dev                                    # oneTBB: the CPU backend's threads
   clang clang-format glslang-tools spirv-tools  # shaders/ compile checks as OpenCL C and GLSL; style
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd  # the OpenCL backend, and PoCL to run it on in CI
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers  # the Vulkan backend, lavapipe, the validation layer

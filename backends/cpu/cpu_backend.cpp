@@ -25,7 +25,7 @@ size_t physical_memory_bytes() {
 }
 
 // Bytes a CpuExecutor allocates (estimated normals counted: they are allocated on the first frame without normals).
-size_t memory_needed(const core::Plan& plan) {
+size_t memory_needed(const core::Plan& plan, unsigned threads) {
     const size_t pixels = plan.pixel_count();
     return pixels * (kQuantWords * sizeof(uint32_t) + 1 + 3 * sizeof(float)) +      // quant, validity, normals
            size_t(plan.total_texels) * (sizeof(std::uint8_t) + sizeof(uint32_t)) +  // masks, labels
@@ -36,13 +36,13 @@ size_t memory_needed(const core::Plan& plan) {
            (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) + pixels / 8 + 8 * size_t(plan.height)
                                         : 0) +                                 // labels, bits
            PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,  // its rows, per thread
-                                       ThreadPool::default_size());
+                                       threads);
 }
 
 }  // namespace
 
-std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
-    const size_t needed = memory_needed(plan);
+std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan, const ThreadSetting& threads) {
+    const size_t needed = memory_needed(plan, ThreadPool(threads).size());  // a bad setting throws here
     const size_t available = physical_memory_bytes();
     const auto mib = [](size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
     const std::string what = "a " + std::to_string(plan.width) + " x " + std::to_string(plan.height) +
@@ -52,10 +52,14 @@ std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
         throw Error(ErrorCode::out_of_memory, what + ", more than this machine's " + mib(available));
     }
     try {
-        return std::make_unique<CpuExecutor>(plan);
+        return std::make_unique<CpuExecutor>(plan, threads);
     } catch (const std::bad_alloc&) {
         throw Error(ErrorCode::out_of_memory, what + ", and allocating it failed");
     }
+}
+
+std::unique_ptr<core::PassExecutor> make_executor(const core::Plan& plan) {
+    return make_executor(plan, ThreadSetting{});
 }
 
 namespace {

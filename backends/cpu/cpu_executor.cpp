@@ -29,8 +29,9 @@ size_t CpuExecutor::fill_scratch_size(const core::Plan& plan) {
     return union_find_scratch_size(lv.width, lv.height);
 }
 
-CpuExecutor::CpuExecutor(const core::Plan& plan)
+CpuExecutor::CpuExecutor(const core::Plan& plan, const ThreadSetting& threads)
     : plan_(plan),
+      pool_(threads),
       quant_(kQuantWords * plan.pixel_count()),
       mask_valid_(plan.pixel_count()),
       mask_(plan.total_texels),

@@ -22,7 +22,7 @@ namespace pyrseg::cpu {
 
 class CpuExecutor final : public core::PassExecutor {
 public:
-    explicit CpuExecutor(const core::Plan& plan);
+    CpuExecutor(const core::Plan& plan, const ThreadSetting& threads);
 
     // Union-find scratch for the largest level a fixed-point fill runs on: N-1, or N itself for the tiny-image
     // fallback.

@@ -98,7 +98,7 @@ void PointsToMask::release(size_t slot) {
 
 void PointsToMask::run(ThreadPool& pool, const simd::VectorRows& vector_rows, const PointsToMaskFrame& frame) {
     const size_t threads = pool.size();
-    if (scratch_.size() != threads) {  // the first frame
+    if (scratch_.size() < threads) {  // the first frame, or a caller's arena with more threads than before
         // Made whole before it is kept: an allocation failing half-way (out_of_memory) must not leave scratch_ sized
         // and busy_ empty for the next frame to index.
         std::vector<Scratch> scratch(threads);

@@ -1,121 +1,121 @@
 #include "backends/cpu/thread_pool.hpp"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+
 #include <algorithm>
 #include <charconv>
-#include <chrono>
 #include <cstdlib>
 #include <string>
 #include <string_view>
+
+#if PYRSEG_LOOPS_WITHOUT_TBB
+#include <atomic>
+#include <thread>
+#include <vector>
+#endif
 
 #include "pyrseg/error.hpp"
 
 namespace pyrseg::cpu {
 namespace {
 
-constexpr unsigned kMaxThreads = 1024;
-
-// PYRSEG_THREADS, or every core when it is unset or empty. A value that is not a count is an error rather than
-// silently every core: PYRSEG_THREADS=2x or =two was meant to limit the pool.
-unsigned default_threads() {
+// $PYRSEG_THREADS as a count, or 0 when it is unset or empty. A value that is not a count is an error rather than
+// silently every core: PYRSEG_THREADS=2x or =two was meant to limit the threads.
+unsigned threads_from_environment() {
     const char* env = std::getenv("PYRSEG_THREADS");
-    if (env == nullptr || *env == '\0') return std::max(1u, std::thread::hardware_concurrency());
+    if (env == nullptr || *env == '\0') return 0;
     const std::string_view text(env);
     unsigned v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || v < 1 || v > kMaxThreads) {
+    if (ec != std::errc() || end != text.data() + text.size() || v < 1 || v > ThreadPool::kMaxThreads) {
         std::string shown(text.substr(0, 40));
         for (char& c : shown) {
             if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
         }
-        throw Error(ErrorCode::invalid_parameter, "PYRSEG_THREADS='" + shown +
-                                                      "' is not a number of threads from 1 to " +
-                                                      std::to_string(kMaxThreads) + " (unset it to use every core)");
+        throw Error(ErrorCode::invalid_parameter,
+                    "PYRSEG_THREADS='" + shown + "' is not a number of threads from 1 to " +
+                        std::to_string(ThreadPool::kMaxThreads) + " (unset it to share the process's oneTBB threads)");
     }
     return v;
 }
 
-// How long a thread spins for the next loop or for the workers to finish before it sleeps.
-constexpr std::chrono::microseconds kSpin{50};
-
-// Spins until done() holds or kSpin has passed; returns done().
-template <class Done>
-bool spin_until(const Done& done) {
-    const auto until = std::chrono::steady_clock::now() + kSpin;
-    for (unsigned n = 0;; ++n) {
-        if (done()) return true;
-        if ((n & 63u) == 63u && std::chrono::steady_clock::now() > until) return done();
-        std::this_thread::yield();
-    }
-}
-
 }  // namespace
 
+ThreadPool::ThreadPool(const ThreadSetting& setting) {
+    if (setting.arena != nullptr && setting.count != 0) {
+        throw Error(ErrorCode::invalid_parameter, "give the CPU backend an arena or a thread count, not both");
+    }
+    if (setting.count > kMaxThreads) {
+        throw Error(ErrorCode::invalid_parameter, "the CPU backend's thread count " + std::to_string(setting.count) +
+                                                      " is over " + std::to_string(kMaxThreads));
+    }
+    const unsigned count = setting.arena != nullptr ? 0
+                           : setting.count != 0     ? setting.count
+                                                    : threads_from_environment();
+#if PYRSEG_LOOPS_WITHOUT_TBB
+    // ThreadSanitizer cannot see the synchronisation inside Debian's (uninstrumented) libtbb, so its builds run the
+    // same chunks on plain threads: the passes' own races stay visible to it.
+    threads_without_tbb_ = setting.arena != nullptr ? unsigned(setting.arena->max_concurrency())
+                           : count != 0             ? count
+                                                    : std::max(1u, std::thread::hardware_concurrency());
+    serial_ = threads_without_tbb_ == 1;
+#else
+    serial_ = count == 1;
+    if (setting.arena != nullptr) {
+        arena_ = setting.arena;
+    } else if (count > 1) {
+        own_ = std::make_unique<tbb::task_arena>(int(count));
+        arena_ = own_.get();
+    }
+#endif
+}
+
+ThreadPool::~ThreadPool() = default;
+
+unsigned ThreadPool::size() const {
+    if (serial_) return 1;
+    if (threads_without_tbb_ != 0) return threads_without_tbb_;
+    const int n = arena_ != nullptr ? arena_->max_concurrency() : tbb::this_task_arena::max_concurrency();
+    return unsigned(std::max(1, n));
+}
+
 unsigned ThreadPool::default_size() {
-    return default_threads();
-}
-
-ThreadPool::ThreadPool(unsigned threads) {
-    const unsigned total = threads == 0 ? default_threads() : threads;
-    workers_.reserve(total - 1);
-    for (unsigned i = 1; i < total; ++i) workers_.emplace_back([this] { worker_loop(); });
-}
-
-ThreadPool::~ThreadPool() {
-    {
-        std::lock_guard lock(mutex_);
-        stopping_ = true;
-    }
-    start_cv_.notify_all();
-    for (std::thread& t : workers_) t.join();
-}
-
-void ThreadPool::work_chunks() {
-    for (;;) {
-        const std::size_t begin = next_.fetch_add(grain_, std::memory_order_relaxed);
-        if (begin >= count_) return;
-        invoke_(ctx_, begin, std::min(count_, begin + grain_));
-    }
+    return ThreadPool().size();
 }
 
 void ThreadPool::run(std::size_t count, std::size_t grain, Invoke invoke, const void* ctx) {
-    {
-        std::lock_guard lock(mutex_);
-        invoke_ = invoke;
-        ctx_ = ctx;
-        count_ = count;
-        grain_ = std::max<std::size_t>(grain, 1);
-        next_.store(0, std::memory_order_relaxed);
-        busy_workers_.store(static_cast<unsigned>(workers_.size()), std::memory_order_relaxed);
-        generation_.fetch_add(1, std::memory_order_release);
-    }
-    start_cv_.notify_all();
-    work_chunks();
-    const auto all_done = [this] { return busy_workers_.load(std::memory_order_acquire) == 0; };
-    if (spin_until(all_done)) return;
-    std::unique_lock lock(mutex_);
-    done_cv_.wait(lock, all_done);
-}
-
-void ThreadPool::worker_loop() {
-    std::size_t seen = 0;
-    for (;;) {
-        // The loop's parameters were written under the mutex before the generation changed: taking the mutex
-        // here (after spinning or sleeping) makes them visible.
-        spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; });
-        {
-            std::unique_lock lock(mutex_);
-            start_cv_.wait(lock, [&] { return stopping_ || generation_.load(std::memory_order_relaxed) != seen; });
-            if (stopping_) return;
-            seen = generation_.load(std::memory_order_relaxed);
+    grain = std::max<std::size_t>(grain, 1);
+#if PYRSEG_LOOPS_WITHOUT_TBB
+    std::atomic<std::size_t> next{0};
+    const auto chunks = [&] {
+        for (;;) {
+            const std::size_t begin = next.fetch_add(grain, std::memory_order_relaxed);
+            if (begin >= count) return;
+            invoke(ctx, begin, std::min(count, begin + grain));
         }
-        work_chunks();
-        if (busy_workers_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
-            // The caller may be asleep: notify under the mutex, so the wake-up cannot fall between its check and
-            // its wait.
-            std::lock_guard lock(mutex_);
-            done_cv_.notify_one();
-        }
+    };
+    std::vector<std::thread> helpers;
+    for (unsigned i = 1; i < threads_without_tbb_; ++i) helpers.emplace_back(chunks);
+    chunks();
+    for (std::thread& t : helpers) t.join();
+#else
+    // The simple partitioner splits down to `grain`: the passes choose their grains for the balance they need.
+    const auto loop = [&] {
+        tbb::this_task_arena::isolate([&] {
+            tbb::parallel_for(
+                tbb::blocked_range<std::size_t>(0, count, grain),
+                [&](const tbb::blocked_range<std::size_t>& r) { invoke(ctx, r.begin(), r.end()); },
+                tbb::simple_partitioner());
+        });
+    };
+    if (arena_ != nullptr) {
+        arena_->execute(loop);
+    } else {
+        loop();
     }
+#endif
 }
 
 }  // namespace pyrseg::cpu

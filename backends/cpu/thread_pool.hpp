@@ -1,34 +1,47 @@
 #pragma once
-// A fixed pool of worker threads for data-parallel loops. The calling thread takes part; a loop allocates
-// nothing (the body is passed by address), so a frame can run many loops without touching the heap.
-#include <atomic>
-#include <condition_variable>
+// The CPU backend's parallel loops, on oneTBB. A loop's chunks are tasks that idle threads take (work stealing): a
+// thread the OS takes away delays only the chunk it holds, and nothing waits for a thread that took none. The
+// threads are oneTBB's: by default those of the arena the caller runs in (the process's, shared with every library
+// that uses oneTBB), or an arena of the Segmenter's own (a thread count), or the application's. A loop allocates
+// nothing of its own (the body is passed by address; oneTBB recycles its task objects).
+#include <oneapi/tbb/task_arena.h>
+
 #include <cstddef>
-#include <mutex>
-#include <thread>
-#include <vector>
+#include <memory>
 
 namespace pyrseg::cpu {
 
+// Where a Segmenter's loops run.
+struct ThreadSetting {
+    // 0: $PYRSEG_THREADS when it is set, else the arena of the thread that calls segment(). 1: the calling thread
+    // alone. n: an arena of n threads of the Segmenter's own (the caller and n - 1 of oneTBB's workers).
+    unsigned count = 0;
+    // The application's arena (count must be 0): every loop runs inside it, beside the application's own work.
+    tbb::task_arena* arena = nullptr;
+};
+
 class ThreadPool {
 public:
-    // threads: total including the caller; 0 means $PYRSEG_THREADS, else the hardware's count.
-    explicit ThreadPool(unsigned threads = 0);
+    // Throws pyrseg::Error for a $PYRSEG_THREADS that is not a count, or a count over kMaxThreads.
+    explicit ThreadPool(const ThreadSetting& setting = {});
     ~ThreadPool();
     ThreadPool(const ThreadPool&) = delete;
     ThreadPool& operator=(const ThreadPool&) = delete;
 
-    [[nodiscard]] unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
-    // The size of a ThreadPool made with threads = 0.
+    static constexpr unsigned kMaxThreads = 1024;
+
+    // The threads a loop started now may use (the arena's concurrency: it can change with the caller's arena).
+    [[nodiscard]] unsigned size() const;
+    // The size of a ThreadPool made with the default setting, from this thread.
     [[nodiscard]] static unsigned default_size();
 
     // Calls body(begin, end) on disjoint chunks of [0, count) of at most `grain` items, in parallel, and returns
-    // when all are done. The body must not throw: workers may still be running chunks of it while an exception
-    // would unwind the caller (the pass bodies neither allocate nor throw).
+    // when all are done. The body must not throw (the pass bodies neither allocate nor throw). The loop is isolated:
+    // a thread waiting in it runs only its chunks, never the application's tasks, so a body is never re-entered.
     template <class Body>
     void parallel_for(std::size_t count, std::size_t grain, const Body& body) {
         if (count == 0) return;
-        if (workers_.empty() || count <= grain) {
+        if (count <= grain || serial_) {
             body(std::size_t{0}, count);
             return;
         }
@@ -40,24 +53,11 @@ public:
 private:
     using Invoke = void (*)(const void*, std::size_t, std::size_t);
     void run(std::size_t count, std::size_t grain, Invoke invoke, const void* ctx);
-    void work_chunks();
-    void worker_loop();
 
-    std::vector<std::thread> workers_;
-    std::mutex mutex_;
-    std::condition_variable start_cv_;
-    std::condition_variable done_cv_;
-    // A frame runs dozens of short loops: waking a sleeping thread costs tens of microseconds on a virtual machine,
-    // so workers and the caller first spin briefly on these before they sleep on the condition variables.
-    std::atomic<std::size_t> generation_{0};
-    std::atomic<unsigned> busy_workers_{0};
-    bool stopping_ = false;
-    // The loop being run.
-    Invoke invoke_ = nullptr;
-    const void* ctx_ = nullptr;
-    std::size_t count_ = 0;
-    std::size_t grain_ = 1;
-    std::atomic<std::size_t> next_{0};
+    std::unique_ptr<tbb::task_arena> own_;  // the arena of a thread count
+    tbb::task_arena* arena_ = nullptr;      // where loops run; null: the caller's arena
+    unsigned threads_without_tbb_ = 0;      // ThreadSanitizer builds: the threads of a loop
+    bool serial_ = false;
 };
 
 }  // namespace pyrseg::cpu

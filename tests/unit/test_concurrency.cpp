@@ -10,60 +10,19 @@
 #include <thread>
 #include <vector>
 
+#include "pyrseg/cpu.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "support/cpu_targets.hpp"
 #include "support/test_frame.hpp"
+#include "support/thread_frames.hpp"
 
 namespace pyrseg::test {
 namespace {
 
-std::vector<TestFrame> frames() {
-    std::vector<TestFrame> out;
-    std::uint64_t seed = 101;
-    for (const int width : {97, 160}) {
-        const int height = width * 3 / 4;
-        for (const bool noisy : {false, true}) {
-            for (const bool robust : {false, true}) {
-                synthetic::SceneOptions o;
-                o.width = width;
-                o.height = height;
-                o.seed = seed++;
-                o.threads = 1;
-                o.noise_mm = noisy ? 1.5 : 0.1;  // a fragmented mask at 1.5 mm
-                o.sensor = robust ? synthetic::Sensor::kinect_v1 : synthetic::Sensor::structured_light;
-                const synthetic::Scene scene = synthetic::generate(o);
-                TestFrame f;
-                f.w = width;
-                f.h = height;
-                f.points = scene.points;
-                if (!robust && !noisy) f.normals = scene.normals;
-                f.params = robust ? sensor_preset(SensorKind::kinect_v1) : Params{};
-                std::ostringstream name;
-                name << width << "x" << height << (noisy ? "_noisy" : "") << (robust ? "_kinect" : "_paper")
-                     << (f.normals.empty() ? "_estimated" : "_given");
-                f.name = name.str();
-                out.push_back(std::move(f));
-            }
-        }
-    }
-    return out;
-}
-
-// What one thread (a pool of one) makes of each frame.
-std::vector<Result> alone(const std::vector<TestFrame>& all) {
-    const ScopedEnv one("PYRSEG_THREADS", "1");
-    std::vector<Result> out;
-    for (const TestFrame& f : all) {
-        Segmenter s(f.w, f.h, f.params, "cpu");
-        out.push_back(segment_frame(s, f));
-    }
-    return out;
-}
-
 TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
-    const std::vector<TestFrame> all = frames();
+    const std::vector<TestFrame> all = thread_test_frames();
     const std::vector<Result> expected = alone(all);
     for (const char* threads : {"2", "3", "4", "7"}) {
         const ScopedEnv env("PYRSEG_THREADS", threads);
@@ -83,8 +42,21 @@ TEST(Concurrency, ThreadPoolsOfEverySizeGiveTheLabelsOfOneThread) {
 }
 
 // Four threads, each with its own Segmenter (pools of 2), over every frame in a different order, at the same time.
+// Segmenters with a thread count of their own (pyrseg/cpu.hpp).
+TEST(Concurrency, ThreadCountsGiveTheLabelsOfOneThread) {
+    const std::vector<TestFrame> all = thread_test_frames();
+    const std::vector<Result> expected = alone(all);
+    for (const unsigned threads : {1u, 2u, 5u}) {
+        for (std::size_t i = 0; i < all.size(); ++i) {
+            SCOPED_TRACE(all[i].name + " threads=" + std::to_string(threads));
+            Segmenter s = cpu::make_segmenter(all[i].w, all[i].h, threads, all[i].params);
+            ASSERT_EQ(segment_frame(s, all[i]).labels, expected[i].labels);
+        }
+    }
+}
+
 TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
-    const std::vector<TestFrame> all = frames();
+    const std::vector<TestFrame> all = thread_test_frames();
     const std::vector<Result> expected = alone(all);
     const ScopedEnv env("PYRSEG_THREADS", "2");
     constexpr int kThreads = 4;
@@ -107,7 +79,7 @@ TEST(Concurrency, SegmentersInSeveralThreadsGiveTheLabelsOfOneThread) {
 
 // One Segmenter handed from thread to thread (one at a time, as a pipeline's stages would): the same labels.
 TEST(Concurrency, ASegmenterMovesBetweenThreads) {
-    const std::vector<TestFrame> all = frames();
+    const std::vector<TestFrame> all = thread_test_frames();
     const std::vector<Result> expected = alone(all);
     const TestFrame& f = all.back();
     Segmenter s(f.w, f.h, f.params, "cpu");

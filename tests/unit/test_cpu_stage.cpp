@@ -506,7 +506,7 @@ TEST(CpuStageFill, UnionFindMatchesAFloodFillOnNoise) {
     std::mt19937 rng(1234);
     std::uint64_t texels = 0;
     for (const unsigned threads : {1u, 2u, 3u}) {
-        ::pyrseg::cpu::ThreadPool pool(threads);
+        ::pyrseg::cpu::ThreadPool pool(::pyrseg::cpu::ThreadSetting{threads, nullptr});
         for (const auto& size : sizes) {
             const std::uint32_t w = size[0];
             const std::uint32_t h = size[1];
