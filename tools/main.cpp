@@ -35,8 +35,9 @@ constexpr const char* kUsage =
     "  --version           print the version\n"
     "\n"
     "Environment: PYRSEG_BACKEND picks the backend when --backend is not given; PYRSEG_THREADS sets the CPU\n"
-    "backend's thread count (unset: every core, as oneTBB threads shared with the process); PYRSEG_OPENCL_DEVICE and PYRSEG_VULKAN_DEVICE pick a device (an index or part of\n"
-    "its name, as `pyrseg backends` lists them); PYRSEG_VULKAN_VALIDATION=1 turns the Vulkan validation layer on.\n";
+    "backend's thread count (unset: every core, as oneTBB threads shared with the process); PYRSEG_OPENCL_DEVICE\n"
+    "and PYRSEG_VULKAN_DEVICE pick a device (an index or part of its name, as `pyrseg backends` lists them);\n"
+    "PYRSEG_VULKAN_VALIDATION=1 turns the Vulkan validation layer on.\n";
 
 // What is printed on stdout is the command's result: when it cannot all be written (a full disk, /dev/full), the
 // run failed, whatever the command returned. Buffered output shows its error only at the flush.
