@@ -70,7 +70,7 @@ public:
 private:
     template <class RowBody>
     void rows(std::size_t count, const RowBody& body) {
-        const std::size_t grain = std::max<std::size_t>(1, count / (std::size_t(pool_.size()) * 8));
+        const std::size_t grain = std::max<std::size_t>(1, count / pool_.pieces());
         pool_.parallel_for(count, grain, [&](std::size_t begin, std::size_t end) {
             for (std::size_t y = begin; y < end; ++y) body(y);
         });

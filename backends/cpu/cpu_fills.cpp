@@ -81,8 +81,8 @@ bool CpuExecutor::sweep(const PyrLevel& lv, bool once, bool init_rows_first) {
             once ? sweep_row_once(c, lv, uint32_t(y)) : pixel::pyr_sweep_row(c, lv, uint32_t(y), onceu) != 0u;
         if (row_changed) changed.store(true, std::memory_order_relaxed);
     });
-    // Columns in a few wide strips, one per task: each row of a strip is a long contiguous run.
-    const size_t strips = size_t(pool_.size()) * 2;
+    // Columns in strips at least kColumnBlock wide, one per task: each row of a strip is a contiguous run.
+    const size_t strips = pool_.pieces();
     const size_t strip = std::max(kColumnBlock, (size_t(lv.width) + strips - 1) / strips);
     const size_t blocks = (size_t(lv.width) + strip - 1) / strip;
     pool_.parallel_for(blocks, 1, [&](size_t b0, size_t b1) {

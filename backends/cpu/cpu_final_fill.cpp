@@ -68,7 +68,7 @@ void CpuExecutor::final_fill_rows(const PyrLevel& lv, const PyrLevel& parent, bo
     if (unlabelled_.size() < h * words) unlabelled_.resize(h * words);  // once per Segmenter
     if (pending_.size() < h) pending_.resize(h);
     // Bands of rows run in parallel; the column sweeps cross their borders afterwards, in order.
-    const size_t bands = std::min(h, size_t(pool_.size()) * 2);
+    const size_t bands = std::min(h, pool_.pieces());
     if (edges && c.mask_valid == nullptr && valid_scratch_.size() < bands * w) valid_scratch_.resize(bands * w);
     const auto band_begin = [&](size_t b) { return h * b / bands; };
     const auto row_of = [&](size_t y) { return c.labels + lv.offset + y * w; };

@@ -32,6 +32,10 @@ public:
 
     // The threads a loop started now may use (the arena's concurrency: it can change with the caller's arena).
     [[nodiscard]] unsigned size() const;
+    // How many pieces to cut a loop into when its pieces cost about the same: several per thread, so that when the
+    // system takes a thread away, the others take over the pieces it has not started.
+    [[nodiscard]] std::size_t pieces() const { return std::size_t(size()) * kPiecesPerThread; }
+    static constexpr unsigned kPiecesPerThread = 8;
     // The size of a ThreadPool made with the default setting, from this thread.
     [[nodiscard]] static unsigned default_size();
 

@@ -215,8 +215,8 @@ void union_find_fill(ThreadPool& pool, const PyrLevel& level, const std::uint8_t
     const auto carve = [&p](size_t n) { return std::exchange(p, p + n); };
     const Work k{w,           h,           words,       carve(plane), carve(plane), carve(runs),
                  carve(runs), carve(runs), carve(runs), carve(h),     carve(h)};
-    const size_t grain = std::max<size_t>(1, h / (size_t(pool.size()) * 8));
-    const size_t stripes = std::min<size_t>(h, size_t(pool.size()) * 4);
+    const size_t grain = std::max<size_t>(1, h / pool.pieces());
+    const size_t stripes = std::min<size_t>(h, pool.pieces());
     const auto stripe_begin = [&](size_t s) { return uint32_t(size_t(h) * s / stripes); };
 
     // 0. The bit planes, in parallel: a row's runs read the anchored bits of the rows above and below it.

@@ -19,6 +19,7 @@
 #include "bindings.hpp"
 #include "device.hpp"
 #include "pyrseg/backend.hpp"
+#include "pyrseg/cpu.hpp"
 #include "pyrseg/depth.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/presets.hpp"
@@ -166,7 +167,8 @@ Outputs outputs_from(const py::handle& names) {
 }
 
 // preset= first (it sets every parameter, in unit_mm), then each parameter given over it.
-Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_stream) {
+// threads: the CPU backend's threads= (0 when not given).
+Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_stream, unsigned& threads) {
     double unit_mm = 1.0;
     if (kwargs.contains("unit_mm")) unit_mm = number(kInit, "unit_mm", kwargs["unit_mm"]);
     Params p;
@@ -180,6 +182,8 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
             outputs = outputs_from(v);
         } else if (key == "cuda_stream") {
             cuda_stream = py::reinterpret_borrow<py::object>(v);
+        } else if (key == "threads") {
+            threads = v.is_none() ? 0u : unsigned(integer(kInit, "threads", v, 1, 1024));
         } else if (!set_param(p, key, v)) {
             throw py::type_error("Segmenter() got an unexpected keyword argument '" + key +
                                  "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
@@ -188,7 +192,7 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
                                  "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
                                  "planar_tolerance_mm, planar_tolerance_per_m2; and preset, "
-                                 "outputs, cuda_stream");
+                                 "outputs, cuda_stream, threads");
         }
     }
     return p;
@@ -240,7 +244,7 @@ public:
         } else if (kwargs.contains("preset") && !kwargs["preset"].is_none()) {
             preset_name_ = text(kInit, "preset", kwargs["preset"]);
         }
-        params_ = params_from(given, outputs_, cuda_stream);
+        params_ = params_from(given, outputs_, cuda_stream, threads_);
         const std::string requested = backend.is_none() ? std::string() : text(kInit, "backend", backend);
         // The device-array path needs the Segmenter pyrseg/cuda.hpp makes on a stream; it segments host frames
         // too, so every CUDA Segmenter is made that way.
@@ -249,6 +253,9 @@ public:
             device_.emplace(cuda_stream);
         } else if (!cuda_stream.is_none()) {
             throw py::value_error("cuda_stream= is for the cuda backend; this Segmenter runs " + name);
+        }
+        if (threads_ != 0 && name != "cpu") {
+            throw py::value_error("threads= is for the cpu backend; this Segmenter runs " + name);
         }
         width_ = w;
         height_ = h;
@@ -381,6 +388,8 @@ private:
         if (release_gil) nogil.emplace();
         if (device_) {
             segmenter_.emplace(device_->make_segmenter(width_, height_, params_, outputs_));
+        } else if (threads_ != 0) {
+            segmenter_.emplace(cpu::make_segmenter(width_, height_, threads_, params_, outputs_));
         } else {
             segmenter_.emplace(width_, height_, params_, backend_, outputs_);
         }
@@ -392,9 +401,10 @@ private:
         if (segmenter_) return;
         Outputs outputs;
         py::object cuda_stream = py::none();
+        unsigned threads = 0;
         py::dict with_preset(*auto_overrides_);
         with_preset["preset"] = sensor_kind_name(noise.suggested);
-        params_ = params_from(with_preset, outputs, cuda_stream);
+        params_ = params_from(with_preset, outputs, cuda_stream, threads);
         preset_name_ = sensor_kind_name(noise.suggested);
         preset_reason_ = noise.reason;
         make_segmenter(false);
@@ -513,6 +523,7 @@ private:
     int width_ = 0;
     int height_ = 0;
     std::string backend_;                       // resolved at construction
+    unsigned threads_ = 0;                      // threads=: the CPU backend's arena of its own (0: the default)
     std::optional<py::dict> auto_overrides_;    // preset="auto": the other keyword arguments, for the first frame
     std::optional<std::string> preset_name_;    // named, or chosen by "auto"
     std::optional<std::string> preset_reason_;  // why "auto" chose it
@@ -668,7 +679,7 @@ void bind_segmenter(py::module_& m) {
     // module.
     static std::string segmenter_doc = R"(A segmenter for one backend and one frame size.
 
-Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, **params)
+Segmenter(width, height, backend=None, *, preset=None, outputs=(), cuda_stream=None, threads=None, **params)
 
 backend: @BACKENDS@"auto", or None for $PYRSEG_BACKEND (else "auto").
 preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it. "auto" chooses one from
@@ -683,6 +694,8 @@ a segment's statistics call it planar) (docs/algorithm.md).
 outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats", "segment_graph".
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
+threads: the CPU backend's threads, 1 to 1024, an arena of its own (backend "cpu" only); None shares the oneTBB
+threads of the process ($PYRSEG_THREADS, when set, gives every Segmenter that many). The labels do not depend on it.
 
 Every argument of the wrong type is a TypeError naming it; a Segmenter made by Segmenter.__new__ alone raises
 TypeError from every member, and a second __init__ on a Segmenter raises TypeError (make a new one).)";

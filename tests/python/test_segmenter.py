@@ -190,6 +190,23 @@ def test_params_presets_and_errors(scene):
         seg.segment(np.concatenate([scene.points, scene.normals], 2), normals=scene.normals)
 
 
+def test_threads_of_its_own_give_the_same_labels(scene):
+    """threads= gives a cpu Segmenter an arena of its own; the labels do not depend on it."""
+    h, w, _ = scene.points.shape
+    expected = reference(scene)
+    for n in (1, 2, 3):
+        assert np.array_equal(pyrseg.Segmenter(w, h, "cpu", threads=n).segment(scene.points).labels, expected)
+    assert np.array_equal(pyrseg.Segmenter(w, h, "cpu", threads=None).segment(scene.points).labels, expected)
+    with pytest.raises(ValueError, match="threads must be in 1..1024, got 0"):
+        pyrseg.Segmenter(w, h, "cpu", threads=0)
+    with pytest.raises(TypeError, match="threads"):
+        pyrseg.Segmenter(w, h, "cpu", threads=2.0)
+    others = [b.name for b in pyrseg.backends() if b.available and b.name != "cpu"]
+    for name in others:
+        with pytest.raises(ValueError, match="threads= is for the cpu backend"):
+            pyrseg.Segmenter(w, h, name, threads=2)
+
+
 def test_backends_and_choice():
     infos = pyrseg.backends()
     assert infos[-1].name == "cpu" and infos[-1].available
