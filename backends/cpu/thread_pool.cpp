@@ -81,10 +81,6 @@ unsigned ThreadPool::size() const {
     return unsigned(std::max(1, n));
 }
 
-unsigned ThreadPool::default_size() {
-    return ThreadPool().size();
-}
-
 void ThreadPool::run(std::size_t count, std::size_t grain, Invoke invoke, const void* ctx) {
     grain = std::max<std::size_t>(grain, 1);
 #if PYRSEG_LOOPS_WITHOUT_TBB

@@ -36,8 +36,6 @@ public:
     // system takes a thread away, the others take over the pieces it has not started.
     [[nodiscard]] std::size_t pieces() const { return std::size_t(size()) * kPiecesPerThread; }
     static constexpr unsigned kPiecesPerThread = 8;
-    // The size of a ThreadPool made with the default setting, from this thread.
-    [[nodiscard]] static unsigned default_size();
 
     // Calls body(begin, end) on disjoint chunks of [0, count) of at most `grain` items, in parallel, and returns
     // when all are done. The body must not throw (the pass bodies neither allocate nor throw). The loop is isolated:
