@@ -44,7 +44,7 @@ packages=(
   cmake ninja-build nlohmann-json3-dev                  # the build (nlohmann/json is header-only, for any arch)
   g++-aarch64-linux-gnu libc6-dev-arm64-cross            # the cross compiler and its C library
   libgtest-dev:arm64 libhwy-dev:arm64                    # GoogleTest; Google Highway (the CPU backend's vectors)
-  libtbb-dev:arm64                                       # oneTBB (the CPU backend's threads)
+  libtbb-dev:arm64 libgomp1:arm64                        # oneTBB (the CPU backend's threads); OpenMP (a test's)
   liblzf-dev:arm64 libpng-dev:arm64 libtiff-dev:arm64    # pyrseg_io, which the conformance suite reads scans with
   libtinyxml2-dev:arm64 libyaml-dev:arm64                # pyrseg_io's calibration files (XML, YAML)
 )
