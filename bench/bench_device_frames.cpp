@@ -283,34 +283,22 @@ int register_all() {
         const int h = size[1];
         const std::string px = size_name(w, h);
 #ifdef PYRSEG_BENCH_OPENCL
-        benchmark::RegisterBenchmark(("pipeline_device/opencl/" + px + "/estimated_normals").c_str(),
-                                     [=](benchmark::State& st) { opencl_frames(st, w, h, false); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
-        benchmark::RegisterBenchmark(("pipeline_depth_device/opencl/" + px + "/u16").c_str(),
-                                     [=](benchmark::State& st) { opencl_frames(st, w, h, true); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        register_timed(("pipeline_device/opencl/" + px + "/estimated_normals").c_str(),
+                       [=](benchmark::State& st) { opencl_frames(st, w, h, false); });
+        register_timed(("pipeline_depth_device/opencl/" + px + "/u16").c_str(),
+                       [=](benchmark::State& st) { opencl_frames(st, w, h, true); });
 #endif
 #ifdef PYRSEG_BENCH_VULKAN
-        benchmark::RegisterBenchmark(("pipeline_device/vulkan/" + px + "/estimated_normals").c_str(),
-                                     [=](benchmark::State& st) { vulkan_frames(st, w, h, false); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
-        benchmark::RegisterBenchmark(("pipeline_depth_device/vulkan/" + px + "/u16").c_str(),
-                                     [=](benchmark::State& st) { vulkan_frames(st, w, h, true); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        register_timed(("pipeline_device/vulkan/" + px + "/estimated_normals").c_str(),
+                       [=](benchmark::State& st) { vulkan_frames(st, w, h, false); });
+        register_timed(("pipeline_depth_device/vulkan/" + px + "/u16").c_str(),
+                       [=](benchmark::State& st) { vulkan_frames(st, w, h, true); });
 #endif
 #ifdef PYRSEG_BENCH_CUDA
-        benchmark::RegisterBenchmark(("pipeline_device/cuda/" + px + "/estimated_normals").c_str(),
-                                     [=](benchmark::State& st) { cuda_frames(st, w, h, false); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
-        benchmark::RegisterBenchmark(("pipeline_depth_device/cuda/" + px + "/u16").c_str(),
-                                     [=](benchmark::State& st) { cuda_frames(st, w, h, true); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        register_timed(("pipeline_device/cuda/" + px + "/estimated_normals").c_str(),
+                       [=](benchmark::State& st) { cuda_frames(st, w, h, false); });
+        register_timed(("pipeline_depth_device/cuda/" + px + "/u16").c_str(),
+                       [=](benchmark::State& st) { cuda_frames(st, w, h, true); });
 #endif
     }
     return 0;

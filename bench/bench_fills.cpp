@@ -38,11 +38,9 @@ int register_all() {
             for (const BackendInfo& b : list_backends()) {
                 if (!b.available) continue;
                 const std::string name = "fills/" + kind + "/" + b.name + "/" + size_name(size.first, size.second);
-                benchmark::RegisterBenchmark(
-                    name.c_str(),
-                    [=](benchmark::State& st) { fill_worst_case(st, b.name, kind, size.first, size.second); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(name.c_str(), [=](benchmark::State& st) {
+                    fill_worst_case(st, b.name, kind, size.first, size.second);
+                });
             }
         }
     }

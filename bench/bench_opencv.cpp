@@ -40,10 +40,8 @@ int register_all() {
                 const std::string name =
                     std::string("opencv/") + a.name + "_" + std::to_string(connectivity) + "/" + size_name(w, h);
                 const int algorithm = a.algorithm;
-                benchmark::RegisterBenchmark(
-                    name.c_str(), [=](benchmark::State& st) { opencv_labelling(st, w, h, connectivity, algorithm); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(name.c_str(),
+                               [=](benchmark::State& st) { opencv_labelling(st, w, h, connectivity, algorithm); });
             }
         }
     }

@@ -34,9 +34,7 @@ int register_all() {
         for (const bool given : {false, true}) {
             const std::string name =
                 "pcl/organized_edge_aware/" + size_name(w, h) + (given ? "/given_normals" : "/estimated_normals");
-            benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) { pcl_segmentation(st, w, h, given); })
-                ->Unit(benchmark::kMillisecond)
-                ->UseRealTime();
+            register_timed(name.c_str(), [=](benchmark::State& st) { pcl_segmentation(st, w, h, given); });
         }
     }
     benchmark::AddCustomContext("pcl", peers::pcl_version());

@@ -20,6 +20,12 @@
 
 namespace pyrseg::bench {
 
+// Registers a row that reports wall time per iteration in milliseconds, as every row of pyrseg_bench does.
+template <class Fn>
+benchmark::internal::Benchmark* register_timed(const char* name, Fn&& fn) {
+    return benchmark::RegisterBenchmark(name, std::forward<Fn>(fn))->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
 // VGA (Kinect, RealSense), SXGA-, a full PhoXi XL frame, and four times that.
 inline constexpr int kSizes[][2] = {{640, 480}, {1280, 960}, {2064, 1544}, {4128, 3088}};
 

@@ -119,16 +119,11 @@ int register_all() {
         for (const bool given : {false, true}) {
             const std::string suffix = px + (given ? "/given_normals" : "/estimated_normals");
             const std::size_t bytes = pixels * 12 * (given ? 2 : 1);
-            benchmark::RegisterBenchmark(("memcpy/" + suffix).c_str(),
-                                         [=](benchmark::State& st) { copy_bytes(st, bytes); })
-                ->Unit(benchmark::kMillisecond)
-                ->UseRealTime();
+            register_timed(("memcpy/" + suffix).c_str(), [=](benchmark::State& st) { copy_bytes(st, bytes); });
             for (const BackendInfo& b : list_backends()) {
                 if (!b.available) continue;
-                benchmark::RegisterBenchmark(("pipeline/" + b.name + "/" + suffix).c_str(),
-                                             [=](benchmark::State& st) { pipeline(st, b.name, w, h, given); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given); });
                 // The same surface neighbourhood as the default radius on the PhoXi frame: at 4128x3088 (half the
                 // pixel spacing, the same 0.1 mm noise) radius 2 sees noise that fragments the mask
                 // (docs/performance-history.md, "Time per pixel"), so the frame size alone is compared on this row.
@@ -136,89 +131,60 @@ int register_all() {
                     !given && same_footprint > kDefaultNormalRadius) {
                     Params wider;
                     wider.normal_radius = same_footprint;
-                    benchmark::RegisterBenchmark(
+                    register_timed(
                         ("pipeline/" + b.name + "/" + suffix + "_radius" + std::to_string(same_footprint)).c_str(),
-                        [=](benchmark::State& st) { pipeline(st, b.name, w, h, false, wider); })
-                        ->Unit(benchmark::kMillisecond)
-                        ->UseRealTime();
+                        [=](benchmark::State& st) { pipeline(st, b.name, w, h, false, wider); });
                 }
                 // The robust metric alone (the preset without its merge), then the preset as it is.
                 Params robust = sensor_preset(SensorKind::kinect_v1);
                 robust.merge = false;
-                benchmark::RegisterBenchmark(("pipeline_robust/" + b.name + "/" + suffix).c_str(),
-                                             [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, robust); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, robust); });
                 // The same robust frames with the merge (step 6d): the difference to pipeline_robust is its cost.
                 const Params merged = sensor_preset(SensorKind::kinect_v1);
-                benchmark::RegisterBenchmark(("pipeline_robust_merge/" + b.name + "/" + suffix).c_str(),
-                                             [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged); });
                 // And with the segment statistics (section 10: moments, plane and box fits): the difference to
                 // pipeline_robust_merge is what they cost.
                 Outputs stats;
                 stats.segment_stats = true;
-                benchmark::RegisterBenchmark(
-                    ("pipeline_robust_merge_stats/" + b.name + "/" + suffix).c_str(),
-                    [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, stats); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge_stats/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, stats); });
                 // And with the segment graph (section 10d): the difference to pipeline_robust_merge is its cost.
                 Outputs graph;
                 graph.segment_graph = true;
-                benchmark::RegisterBenchmark(
-                    ("pipeline_robust_merge_graph/" + b.name + "/" + suffix).c_str(),
-                    [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, graph); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge_graph/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, graph); });
                 // And the scene (section 10c) on the host from those statistics, its boxes fitted to the fillable
                 // points: the difference to pipeline_robust_merge is what statistics and scene cost together.
-                benchmark::RegisterBenchmark(("pipeline_robust_merge_scene/" + b.name + "/" + suffix).c_str(),
-                                             [=](benchmark::State& st) { scene_pipeline(st, b.name, w, h, given); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge_scene/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { scene_pipeline(st, b.name, w, h, given); });
                 // And with a colour image and the colour edge term (step 0c): the difference to
                 // pipeline_robust_merge is the colour's cost, its upload included.
                 Params colored = merged;
                 colored.color_edge_threshold = 120;
-                benchmark::RegisterBenchmark(
-                    ("pipeline_robust_merge_color/" + b.name + "/" + suffix).c_str(),
-                    [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, colored); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge_color/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, colored); });
                 // And with the colour edges gated by curvature (as the realsense-d435 preset does): the difference to
                 // pipeline_robust_merge_color is the gate's cost and the segmentation it changes.
                 Params gated = colored;
                 gated.color_edge_curvature_share = 0.3;
-                benchmark::RegisterBenchmark(
-                    ("pipeline_robust_merge_color_gated/" + b.name + "/" + suffix).c_str(),
-                    [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, gated); })
-                    ->Unit(benchmark::kMillisecond)
-                    ->UseRealTime();
+                register_timed(("pipeline_robust_merge_color_gated/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { color_pipeline(st, b.name, w, h, given, gated); });
             }
         }
-        benchmark::RegisterBenchmark(("memcpy/" + px + "/depth_u16").c_str(),
-                                     [=](benchmark::State& st) { copy_bytes(st, 2 * pixels); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        register_timed(("memcpy/" + px + "/depth_u16").c_str(),
+                       [=](benchmark::State& st) { copy_bytes(st, 2 * pixels); });
         for (const BackendInfo& b : list_backends()) {
             if (!b.available) continue;
-            benchmark::RegisterBenchmark(("pipeline_depth/" + b.name + "/" + px + "/u16").c_str(),
-                                         [=](benchmark::State& st) { depth_pipeline(st, b.name, w, h); })
-                ->Unit(benchmark::kMillisecond)
-                ->UseRealTime();
+            register_timed(("pipeline_depth/" + b.name + "/" + px + "/u16").c_str(),
+                           [=](benchmark::State& st) { depth_pipeline(st, b.name, w, h); });
         }
-        benchmark::RegisterBenchmark(("memcpy/" + px + "/mask").c_str(),
-                                     [=](benchmark::State& st) { copy_bytes(st, pixels); })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+        register_timed(("memcpy/" + px + "/mask").c_str(), [=](benchmark::State& st) { copy_bytes(st, pixels); });
         for (const BackendInfo& b : list_backends()) {
             if (!b.available) continue;
-            benchmark::RegisterBenchmark(("stage/" + b.name + "/" + px).c_str(),
-                                         [=](benchmark::State& st) { stage(st, b.name, w, h); })
-                ->Unit(benchmark::kMillisecond)
-                ->UseRealTime();
+            register_timed(("stage/" + b.name + "/" + px).c_str(),
+                           [=](benchmark::State& st) { stage(st, b.name, w, h); });
         }
     }
     for (const BackendInfo& b : list_backends()) {

@@ -29,14 +29,14 @@ unsigned threads_from_environment() {
     const std::string_view text(env);
     unsigned v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || v < 1 || v > ThreadPool::kMaxThreads) {
+    if (ec != std::errc() || end != text.data() + text.size() || v < 1 || v > kMaxThreads) {
         std::string shown(text.substr(0, 40));
         for (char& c : shown) {
             if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
         }
         throw Error(ErrorCode::invalid_parameter,
                     "PYRSEG_THREADS='" + shown + "' is not a number of threads from 1 to " +
-                        std::to_string(ThreadPool::kMaxThreads) + " (unset it to share the process's oneTBB threads)");
+                        std::to_string(kMaxThreads) + " (unset it to share the process's oneTBB threads)");
     }
     return v;
 }

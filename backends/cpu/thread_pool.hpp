@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <memory>
 
+#include "pyrseg/cpu.hpp"
+
 namespace pyrseg::cpu {
 
 // Where a Segmenter's loops run.
@@ -22,13 +24,11 @@ struct ThreadSetting {
 
 class ThreadPool {
 public:
-    // Throws pyrseg::Error for a $PYRSEG_THREADS that is not a count, or a count over kMaxThreads.
+    // Throws pyrseg::Error for a $PYRSEG_THREADS that is not a count, or a count over kMaxThreads (pyrseg/cpu.hpp).
     explicit ThreadPool(const ThreadSetting& setting = {});
     ~ThreadPool();
     ThreadPool(const ThreadPool&) = delete;
     ThreadPool& operator=(const ThreadPool&) = delete;
-
-    static constexpr unsigned kMaxThreads = 1024;
 
     // The threads a loop started now may use (the arena's concurrency: it can change with the caller's arena).
     [[nodiscard]] unsigned size() const;

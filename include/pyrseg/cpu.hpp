@@ -16,8 +16,11 @@
 
 namespace pyrseg::cpu {
 
+// The most threads a CPU Segmenter takes (make_segmenter below, $PYRSEG_THREADS, Python's threads=).
+inline constexpr unsigned kMaxThreads = 1024;
+
 // An arena of `threads` threads of the Segmenter's own (the calling thread and threads - 1 of oneTBB's workers);
-// 1 runs every pass on the calling thread alone. Throws pyrseg::Error for 0 or more than 1024 threads.
+// 1 runs every pass on the calling thread alone. Throws pyrseg::Error for 0 or more than kMaxThreads threads.
 [[nodiscard]] PYRSEG_EXPORT Segmenter make_segmenter(int width, int height, unsigned threads, const Params& params = {},
                                                      const Outputs& outputs = {});
 

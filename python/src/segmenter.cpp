@@ -183,7 +183,7 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
         } else if (key == "cuda_stream") {
             cuda_stream = py::reinterpret_borrow<py::object>(v);
         } else if (key == "threads") {
-            threads = v.is_none() ? 0u : unsigned(integer(kInit, "threads", v, 1, 1024));
+            threads = v.is_none() ? 0u : unsigned(integer(kInit, "threads", v, 1, cpu::kMaxThreads));
         } else if (!set_param(p, key, v)) {
             throw py::type_error("Segmenter() got an unexpected keyword argument '" + key +
                                  "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
