@@ -114,6 +114,7 @@ Segmenter make_segmenter(int width, int height, const Params& params, const Outp
     impl->backend = backend;
     impl->outputs = outputs;
     impl->executor = make_executor(impl->plan);
+    check_executor_outputs(*impl);
     impl->timings.reserve(16);
     return Segmenter(std::move(impl));
 }
@@ -165,6 +166,9 @@ void PassExecutor::bind_device_color(const DeviceColor& /*color*/) {
 }
 void PassExecutor::write_device_labels(const DeviceLabels& /*labels*/) {
     throw Error(ErrorCode::invalid_argument, "this Segmenter's backend takes no device buffers");
+}
+void PassExecutor::track_overlaps() {
+    throw Error(ErrorCode::backend_unavailable, "this Segmenter's backend has no tracks");
 }
 
 }  // namespace pyrseg::core

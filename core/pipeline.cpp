@@ -91,6 +91,7 @@ void run_pipeline(const Plan& plan, InputKind input, bool with_color, PassExecut
     clock.run("compact", [&] { ex.compact(plan.params.compact); });  // step 7
     if (plan.stats_slots != 0) clock.run("stats", [&] { ex.segment_stats(); });
     if (plan.graph_slots != 0) clock.run("graph", [&] { ex.segment_graph(); });
+    if (plan.track_slots != 0) clock.run("tracks", [&] { ex.track_overlaps(); });
 }
 
 }  // namespace pyrseg::core

@@ -100,6 +100,17 @@ void check_planar_parameters(const Params& p) {
     }
 }
 
+void check_track_parameters(const Params& p) {
+    if (!std::isfinite(p.track_max_distance_mm) || p.track_max_distance_mm < 0.0) {
+        bad_parameter("track_max_distance_mm must be a finite number of millimetres >= 0, got " +
+                      std::to_string(p.track_max_distance_mm));
+    }
+    if (p.track_hold_frames < 0 || p.track_hold_frames > kMaxTrackHoldFrames) {
+        bad_parameter("track_hold_frames must be in 0.." + std::to_string(kMaxTrackHoldFrames) + " frames, got " +
+                      std::to_string(p.track_hold_frames));
+    }
+}
+
 void check_merge_parameters(const Params& p, Thresholds& t) {
     if (p.merge_reach < 1 || p.merge_reach > kMaxMergeReach) {
         bad_parameter("merge_reach must be in 1.." + std::to_string(kMaxMergeReach) + " pixels, got " +
@@ -178,6 +189,7 @@ Thresholds compute_thresholds(const Params& params) {
     check_merge_parameters(params, t);
     check_color_parameters(params, t);
     check_planar_parameters(params);
+    check_track_parameters(params);
     return t;
 }
 
@@ -276,7 +288,20 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         }
         plan.graph_slots = std::uint32_t(slots);
     }
-    if (outputs.segment_stats) {
+    if (outputs.segment_tracks || outputs.track_ids) {
+        if (!params.compact) {
+            bad_parameter("tracks follow the compacted labels: segment_tracks and track_ids need compact on");
+        }
+        // Each pair of (previous label, label) holds at least one pixel; the table gets more than twice as many
+        // slots as a frame can have pairs.
+        const std::uint64_t slots = std::uint64_t(1) << ceil_log2(2 * pixels + 1);
+        if (std::uint64_t(PYR_TRACK_SLOT_WORDS) * slots > kMax32) {
+            throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
+                                                        " is too large for the tracks' 32-bit pair table");
+        }
+        plan.track_slots = std::uint32_t(slots);
+    }
+    if (outputs.segment_stats || plan.track_slots != 0) {
         // Steps 3 to 6 only copy labels, so every final label lies on a fillable texel of level M and
         // K <= w_M * h_M; the fallback's labels are pixels.
         const PyrLevel& lm = plan.small_image ? plan.full() : plan.level(m);

@@ -59,6 +59,9 @@ struct Plan {
     // The segment graph's pair table (Outputs::segment_graph; shaders/pyr_graph.h): a power of two above twice the
     // pairs a frame can have; 0 when not asked for.
     std::uint32_t graph_slots = 0;
+    // The tracks' pair table at most (Outputs::segment_tracks; shaders/pyr_track.h): a power of two above twice
+    // the pairs of (previous label, label) a frame can have; 0 without tracks (which also run the statistics).
+    std::uint32_t track_slots = 0;
     // Outputs::normals: the frame returns the normals the metric used, so a backend must keep them per pixel.
     bool keep_normals = false;
 

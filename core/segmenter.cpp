@@ -1,5 +1,6 @@
 #include "pyrseg/segmenter.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,36 @@
 #include "pyrseg/error.hpp"
 
 namespace pyrseg {
+
+namespace core {
+
+void check_executor_outputs(const Segmenter::Impl& impl) {
+    if (impl.plan.track_slots != 0 && !impl.executor->has_tracks()) {
+        throw Error(ErrorCode::backend_unavailable,
+                    "tracks (Outputs::segment_tracks, track_ids) run on the cpu backend only so far; the " +
+                        impl.backend + " backend has none");
+    }
+}
+
+namespace {
+
+// Tracks (docs/algorithm.md section 11) from the frame's overlap pairs and statistics, then the id image.
+void follow_tracks(Segmenter::Impl& impl, Result& out) {
+    std::uint32_t pair_count = 0;
+    const std::uint32_t* pairs = impl.executor->track_pairs(pair_count);
+    impl.tracks.next(pairs, pair_count, out.segments, impl.plan.params, out.tracks);
+    if (!impl.outputs.track_ids) {
+        out.track_ids.clear();
+        return;
+    }
+    out.track_ids.resize(out.labels.size());
+    std::transform(out.labels.begin(), out.labels.end(), out.track_ids.begin(),
+                   [&](std::uint32_t k) { return k == 0 ? 0u : out.tracks[k - 1].id; });
+}
+
+}  // namespace
+
+}  // namespace core
 
 namespace {
 
@@ -162,6 +193,12 @@ void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, R
         core::run_pipeline(impl.plan, input, color != nullptr, *impl.executor, impl.timings);
         const auto download_start = std::chrono::steady_clock::now();
         impl.executor->read_back(out, impl.outputs);
+        if (impl.plan.track_slots != 0) {
+            core::follow_tracks(impl, out);
+        } else {
+            out.tracks.clear();
+            out.track_ids.clear();
+        }
         impl.timings.push_back(PassTiming{"upload", upload_ms});
         impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
         impl.executor->device_timings(impl.timings);
@@ -177,6 +214,7 @@ Segmenter::Segmenter(int width, int height, const Params& params, std::string_vi
     impl_->backend = resolve_backend_name(backend);
     impl_->outputs = outputs;
     impl_->executor = core::make_executor(impl_->backend, impl_->plan);
+    core::check_executor_outputs(*impl_);
     impl_->timings.reserve(16);
 } catch (const std::bad_alloc&) {
     throw Error(ErrorCode::out_of_memory, "making a " + std::to_string(width) + " x " + std::to_string(height) +
@@ -242,6 +280,12 @@ void Segmenter::segment_mask(const MaskView& mask, Result& out) {
     check_layout("the mask's", mask.row_stride, 1, mask.width, mask.height);
     run_frame(
         impl, core::InputKind::mask, [&] { impl.executor->bind_mask(mask); }, out);
+}
+
+void Segmenter::reset_tracks() {
+    Impl& impl = live(impl_);
+    impl.tracks.reset();
+    impl.executor->forget_previous_labels();
 }
 
 int Segmenter::width() const {

@@ -8,6 +8,7 @@
 #include "core/depth_tables.hpp"
 #include "core/executor.hpp"
 #include "core/plan.hpp"
+#include "core/segment_tracks.hpp"
 #include "pyrseg/segmenter.hpp"
 
 namespace pyrseg {
@@ -20,9 +21,13 @@ struct Segmenter::Impl {
     std::vector<PassTiming> timings;
     core::DepthTables depth_tables;           // a depth frame's constants, reused
     core::CheckedDepthCamera checked_camera;  // the camera whose frame check_depth_camera last passed
+    core::TrackState tracks;                  // Outputs::segment_tracks: the stream's tracks
 };
 
 namespace core {
+// Throws pyrseg::Error when the Segmenter's executor cannot give what its outputs ask for.
+void check_executor_outputs(const Segmenter::Impl& impl);
+
 struct SegmenterAccess {
     // Throws pyrseg::Error for a moved-from Segmenter.
     static Segmenter::Impl& impl(Segmenter& segmenter);

@@ -136,6 +136,9 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 #define PYR_GRAPH_SLOT_WORDS 7u
 #define PYR_GRAPH_LENGTH 2u
 #define PYR_GRAPH_KINDS 3u
+/* The tracks' pair table (shaders/pyr_track.h, docs/algorithm.md section 11): words per slot: the previous
+ * frame's label and the frame's (0: a free slot), and the pixels they share. */
+#define PYR_TRACK_SLOT_WORDS 3u
 /* The statistics pass walks rows in runs of this many pixels, one invocation per run. */
 #define PYR_STATS_RUN 32u
 /* Points are clamped to +-(2^31 - 128), the largest float magnitude below 2^31, before rounding to int32. */
@@ -152,6 +155,18 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 PYR_FN pyr_u32 pyr_graph_slots(pyr_u32 count, pyr_u32 max_slots) {
     pyr_u32 slots = 1u;
     while (slots < max_slots && slots <= 6u * count + 6u) slots = slots * 2u;
+    return slots;
+}
+
+/* The tracks' slots for a frame of K segments after one of K' (docs/algorithm.md section 11): the smallest power of
+ * two above twice the K' K pairs they can have, at most max_slots (the plan's, above twice the pixels, which bound
+ * the pairs too). */
+PYR_FN pyr_u32 pyr_track_slots(pyr_u32 previous_count, pyr_u32 count, pyr_u32 max_slots) {
+    pyr_u32 limit = max_slots / 2u;
+    pyr_u32 pairs = limit;
+    if (previous_count == 0u || count <= limit / previous_count) pairs = previous_count * count;
+    pyr_u32 slots = 1u;
+    while (slots < max_slots && slots <= 2u * pairs) slots = slots * 2u;
     return slots;
 }
 

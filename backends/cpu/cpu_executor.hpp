@@ -62,7 +62,11 @@ public:
     void mark_labels(int level) override;
     void compact(bool apply) override;
     void segment_stats() override;
-    void segment_graph() override;  // cpu_graph.cpp
+    void segment_graph() override;   // cpu_graph.cpp
+    void track_overlaps() override;  // cpu_tracks.cpp
+    void forget_previous_labels() override { previous_count_ = 0; }
+    [[nodiscard]] const std::uint32_t* track_pairs(std::uint32_t& count) const override;
+    [[nodiscard]] bool has_tracks() const override { return true; }
     void read_back(Result& out, const Outputs& outputs) override;
 
     [[nodiscard]] std::uint32_t fill_rounds() const override { return fill_rounds_; }
@@ -140,6 +144,12 @@ private:
     std::vector<std::uint32_t> merge_words_;  // the merge's label parents and pair table (shaders/pyr_merge_table.h)
     std::vector<std::uint32_t> graph_words_;  // the segment graph's counter, table and list (shaders/pyr_graph.h)
     std::size_t graph_list_ = 0;              // where this frame's list starts in it
+    // Tracks: the previous frame's compacted labels, its segment count (0: no previous frame), and the overlap pairs'
+    // counter, table and list (shaders/pyr_track.h), grown to the largest frame so far.
+    std::vector<std::uint32_t> previous_labels_;
+    std::uint32_t previous_count_ = 0;
+    std::vector<std::uint32_t> track_words_;
+    std::size_t track_list_ = 0;
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::VectorRows* simd_;

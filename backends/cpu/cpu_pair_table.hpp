@@ -1,7 +1,8 @@
 #pragma once
-// The GPUs' pair-table functions (shaders/pyr_merge_table.h for the merge, shaders/pyr_graph.h for the segment graph)
-// over the words in PassContext::merge, with the accessors they need as relaxed atomics; and the walk over the rows
-// both run, which hands them only the pixels that may cross a boundary.
+// The GPUs' pair-table functions (shaders/pyr_merge_table.h for the merge, shaders/pyr_graph.h for the segment graph,
+// shaders/pyr_track.h for the tracks' overlaps) over the words in PassContext::merge, with the accessors they need as
+// relaxed atomics; and the walk over the rows the merge and the graph run, which hands them only the pixels that may
+// cross a boundary.
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
@@ -18,6 +19,7 @@
 namespace pyrseg::cpu::pixel {
 using std::min;                 // pyr_uf.h's GPU spelling
 #include "shaders/pyr_graph.h"  // and, through it, shaders/pyr_merge_table.h
+#include "shaders/pyr_track.h"
 }  // namespace pyrseg::cpu::pixel
 
 namespace pyrseg::cpu {

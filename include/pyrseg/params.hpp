@@ -16,6 +16,7 @@ inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
 inline constexpr int kMaxEdgeRounds = 63;
 inline constexpr int kMaxMergeReach = 16;
+inline constexpr int kMaxTrackHoldFrames = 1000;
 inline constexpr int kMaxColorEdgeStride = 16;
 inline constexpr int kMaxColorEdgeThreshold = 765;
 
@@ -62,6 +63,11 @@ struct Params {
     // centroid's depth in metres). Only the `planar` flag reads them.
     double planar_tolerance_mm = 2.0;
     double planar_tolerance_per_m2 = 0.0;
+    // Tracks (Outputs::segment_tracks; docs/algorithm.md section 11): a segment that no previous segment overlaps
+    // enough takes the id of a track whose predicted centroid is at most track_max_distance_mm from its own; a track
+    // not seen for more than track_hold_frames frames (0..1000) is dropped.
+    double track_max_distance_mm = 50.0;
+    int track_hold_frames = 10;
     bool compact = true;                       // step 7: renumber labels 1..K
     int normal_radius = kDefaultNormalRadius;  // used only when normals are estimated
     Metric metric = Metric::paper;

@@ -13,6 +13,10 @@ struct Outputs {
     bool normals = false;        // the normals the metric used (given, or estimated), 3 floats per pixel
     bool segment_stats = false;  // per-segment statistics (Result::segments), a pass of every backend
     bool segment_graph = false;  // which segments touch which, and how (Result::graph), a pass of every backend
+    // Track ids that carry over from frame to frame (Result::tracks; docs/algorithm.md section 11): the Segmenter's
+    // frames are one stream until Segmenter::reset_tracks(). Needs Params::compact; runs the statistics pass.
+    bool segment_tracks = false;
+    bool track_ids = false;  // an image of the track ids beside the labels (Result::track_ids); implies segment_tracks
 };
 
 // A 128-bit two's-complement integer, high * 2^64 + low: an exact sum too wide for 64 bits.
@@ -74,6 +78,24 @@ struct SegmentEdge {
     friend bool operator==(const SegmentEdge&, const SegmentEdge&) = default;
 };
 
+// How a segment got its track id (docs/algorithm.md section 11).
+enum class TrackMatch : std::uint8_t {
+    new_track,  // a new id: it matched no track
+    overlap,    // the previous frame's segment it overlaps most, and that overlaps it most
+    position,   // a track not matched by overlap (hidden, or not overlapping) found where the camera's motion put it
+};
+
+// One segment's track (docs/algorithm.md section 11).
+struct SegmentTrack {
+    std::uint32_t label = 0;          // its label in Result::labels
+    std::uint32_t id = 0;             // its track id: from 1, never reused within a stream
+    std::uint32_t first_frame = 0;    // the stream's frame (0 = its first) the id was first seen in
+    std::uint32_t age = 0;            // the frames the id was seen in, this one included
+    std::uint32_t hidden_frames = 0;  // the frames just before this one in which the id was not seen
+    TrackMatch how = TrackMatch::new_track;
+    friend bool operator==(const SegmentTrack&, const SegmentTrack&) = default;
+};
+
 struct Result {
     int width = 0;
     int height = 0;
@@ -88,6 +110,10 @@ struct Result {
     // Filled when Outputs::segment_graph: every pair of touching segments once, by increasing (a, b). It keeps its
     // capacity, as segments does.
     std::vector<SegmentEdge> graph;
+    // Filled when Outputs::segment_tracks: K entries, segment k at k - 1. It keeps its capacity, as segments does.
+    std::vector<SegmentTrack> tracks;
+    // Filled when Outputs::track_ids: width*height, each labelled pixel's track id (0 where unlabelled).
+    std::vector<std::uint32_t> track_ids;
 };
 
 }  // namespace pyrseg

@@ -52,6 +52,9 @@ public:
     // Labels a caller-made fillable mask (the pyramid without the normals and metric passes).
     void segment_mask(const MaskView& mask, Result& out);
 
+    // With Outputs::segment_tracks, the next frame starts a new stream: no track carries over into it.
+    void reset_tracks();
+
     // Every member of a moved-from Segmenter throws pyrseg::Error (ErrorCode::invalid_argument); only destroying it
     // or assigning another to it are allowed.
     [[nodiscard]] int width() const;

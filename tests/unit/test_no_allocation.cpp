@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <functional>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
@@ -170,6 +171,37 @@ TEST_P(NoAllocation, WarmFramesAllocateNothing) {
                   }),
                   0);
     }
+}
+
+// Tracks (docs/algorithm.md section 11) over a stream that alternates between two scenes: every frame makes new
+// tracks and hides others, and once the hidden ones are dropped as fast as new ones come, the stream's tracks, the
+// overlap pairs and the id image live in what the first frames sized.
+TEST_P(NoAllocation, WarmTrackedFramesAllocateNothing) {
+    synthetic::SceneOptions o;
+    o.width = 320;
+    o.height = 240;
+    const synthetic::Scene a = synthetic::generate(o);
+    o.seed = 2;
+    const synthetic::Scene b = synthetic::generate(o);
+    Outputs outputs;
+    outputs.segment_tracks = outputs.track_ids = true;
+    Params params;
+    params.track_hold_frames = 2;
+    std::unique_ptr<Segmenter> segmenter;
+    try {
+        segmenter = std::make_unique<Segmenter>(320, 240, params, GetParam(), outputs);
+    } catch (const Error& e) {
+        GTEST_SKIP() << GetParam() << ": " << e.what();
+    }
+    Result result;
+    const CloudView va{a.points.data(), nullptr, 320, 240};
+    const CloudView vb{b.points.data(), nullptr, 320, 240};
+    for (int frame = 0; frame < 8; ++frame) segmenter->segment(frame % 2 ? va : vb, result);
+    EXPECT_EQ(allocations_during([&] {
+                  for (int frame = 0; frame < 4; ++frame) segmenter->segment(frame % 2 ? va : vb, result);
+              }),
+              0);
+    EXPECT_GT(result.tracks.size(), 1u);
 }
 
 // The scene of a warm frame (describe_scene and fit_object_boxes into a Scene that has seen as many segments)

@@ -1,0 +1,56 @@
+#pragma once
+// Tracks (docs/algorithm.md section 11): the host's side, once for every backend. From a frame's overlap pairs
+// (counted on the device, shaders/pyr_track.h) and its statistics, each segment gets the id of the track it
+// continues, or a new one.
+#include <cstdint>
+#include <vector>
+
+#include "pyrseg/params.hpp"
+#include "pyrseg/result.hpp"
+
+namespace pyrseg::core {
+
+class TrackState {
+public:
+    // The next frame starts a new stream.
+    void reset();
+    // One frame: `pairs` words (previous label, label, pixels) PYR_TRACK_SLOT_WORDS each, `pair_count` of them in
+    // any order (none on the stream's first frame); `segments` the frame's K statistics (label k at k - 1).
+    // Fills `out` with K tracks. Allocates only when the frame has more segments or pairs than any before.
+    void next(const std::uint32_t* pairs, std::uint32_t pair_count, const std::vector<SegmentStats>& segments,
+              const Params& params, std::vector<SegmentTrack>& out);
+
+    struct Pair {
+        std::uint32_t previous = 0, label = 0, pixels = 0;
+    };
+    struct Track {
+        std::uint32_t id = 0;
+        std::uint32_t first_frame = 0;
+        std::uint32_t age = 0;
+        std::uint32_t last_seen = 0;
+        std::uint32_t pixels = 0;  // its last pixel count
+        std::uint32_t label = 0;   // its label in the previous frame; 0 when it was not seen there
+        bool has_centroid = false;
+        double centroid[3] = {0, 0, 0};
+    };
+
+private:
+    std::uint32_t frame_ = 0;  // the next frame's number in the stream
+    std::uint32_t next_id_ = 1;
+    std::vector<Track> tracks_;                 // live and hidden tracks
+    std::vector<std::uint32_t> by_previous_;    // previous label j -> index in tracks_ + 1
+    std::vector<std::uint32_t> previous_size_;  // previous label j -> its pixel count
+    // Per frame, sized to the largest frame so far.
+    std::vector<Pair> pairs_;
+    std::vector<std::uint32_t> best_previous_;  // label k -> j*(k) (0: none)
+    std::vector<std::uint32_t> best_count_k_;
+    std::vector<std::uint32_t> best_label_;  // previous label j -> k*(j)
+    std::vector<std::uint32_t> best_count_j_;
+    std::vector<std::uint32_t> matched_;  // label k -> index in tracks_ + 1 (0: not matched yet)
+    std::vector<std::uint8_t> track_taken_;
+    std::vector<std::uint32_t> nearest_track_;  // step 3: label k -> index in tracks_ + 1
+    std::vector<std::uint32_t> nearest_label_;  // step 3: index in tracks_ -> label k
+    std::vector<double> nearest_d2_;
+};
+
+}  // namespace pyrseg::core
