@@ -4,7 +4,8 @@
 // pipeline_robust_merge with the preset's merge, as pipeline_robust_merge_stats with the segment statistics, and as
 // pipeline_robust_merge_color with a colour image and the colour edge term as well, pipeline_robust_merge_color_gated
 // with its curvature gate, pipeline_robust_merge_graph with the segment graph of section 10d,
-// pipeline_robust_merge_scene with the statistics and the scene summary of section 10c)
+// pipeline_robust_merge_scene with the statistics and the scene summary of section 10c, pipeline_robust_merge_tracks
+// with the tracks of section 11)
 // (points, with estimated or given
 // normals, to compacted labels) and the segmentation stage alone (a fillable mask to compacted labels), at every frame
 // size, next to a memcpy of the same input bytes measured in the same process, so that ratios, not absolute numbers,
@@ -155,6 +156,13 @@ int register_all() {
                 graph.segment_graph = true;
                 register_timed(("pipeline_robust_merge_graph/" + b.name + "/" + suffix).c_str(),
                                [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, graph); });
+                // And with tracks (section 11), which run the statistics too: the difference to
+                // pipeline_robust_merge_stats is what following the ids costs (the same frame again and again: every
+                // segment overlaps itself).
+                Outputs tracks;
+                tracks.segment_tracks = true;
+                register_timed(("pipeline_robust_merge_tracks/" + b.name + "/" + suffix).c_str(),
+                               [=](benchmark::State& st) { pipeline(st, b.name, w, h, given, merged, tracks); });
                 // And the scene (section 10c) on the host from those statistics, its boxes fitted to the fillable
                 // points: the difference to pipeline_robust_merge is what statistics and scene cost together.
                 register_timed(("pipeline_robust_merge_scene/" + b.name + "/" + suffix).c_str(),

@@ -81,7 +81,7 @@ public:
     // Tracks (Outputs::segment_tracks; docs/algorithm.md section 11), after compact and the statistics: the pixels
     // each pair of (previous frame's label, this frame's label) shares, counted when the executor holds a previous
     // frame's labels (shaders/pyr_track.h), then this frame's labels kept as the previous ones. track_pairs gives
-    // the pairs after read_back. A backend without tracks throws pyrseg::Error (checked when the Segmenter is made).
+    // the pairs after read_back.
     virtual void track_overlaps();
     virtual void forget_previous_labels() {}
     // After read_back: the last frame's pairs, PYR_TRACK_SLOT_WORDS words each (previous label, label, pixels),
@@ -90,7 +90,6 @@ public:
         count = 0;
         return nullptr;
     }
-    [[nodiscard]] virtual bool has_tracks() const { return false; }
     // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
     // Device-resident frames (core/device_frame.hpp), on a GPU backend made on the caller's context: the input

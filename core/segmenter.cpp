@@ -24,14 +24,6 @@ namespace pyrseg {
 
 namespace core {
 
-void check_executor_outputs(const Segmenter::Impl& impl) {
-    if (impl.plan.track_slots != 0 && !impl.executor->has_tracks()) {
-        throw Error(ErrorCode::backend_unavailable,
-                    "tracks (Outputs::segment_tracks, track_ids) run on the cpu backend only so far; the " +
-                        impl.backend + " backend has none");
-    }
-}
-
 namespace {
 
 // Tracks (docs/algorithm.md section 11) from the frame's overlap pairs and statistics, then the id image.
@@ -214,7 +206,6 @@ Segmenter::Segmenter(int width, int height, const Params& params, std::string_vi
     impl_->backend = resolve_backend_name(backend);
     impl_->outputs = outputs;
     impl_->executor = core::make_executor(impl_->backend, impl_->plan);
-    core::check_executor_outputs(*impl_);
     impl_->timings.reserve(16);
 } catch (const std::bad_alloc&) {
     throw Error(ErrorCode::out_of_memory, "making a " + std::to_string(width) + " x " + std::to_string(height) +

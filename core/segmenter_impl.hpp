@@ -25,9 +25,6 @@ struct Segmenter::Impl {
 };
 
 namespace core {
-// Throws pyrseg::Error when the Segmenter's executor cannot give what its outputs ask for.
-void check_executor_outputs(const Segmenter::Impl& impl);
-
 struct SegmenterAccess {
     // Throws pyrseg::Error for a moved-from Segmenter.
     static Segmenter::Impl& impl(Segmenter& segmenter);

@@ -21,6 +21,7 @@
 #include "pyr_graph.h"
 #include "pyr_kernels.h"
 #include "pyr_merge_table.h"
+#include "pyr_track.h"
 #include "pyr_uf.h"
 
 #define PYR_SCAN_NONE 0xffffffffu /* no event yet (a barrier is an event of value 0) */
@@ -534,6 +535,54 @@ PYR_KERNEL_1D(graph_gather) {
     pyr_u32 slots = pyr_graph_slots(PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(1));
     if (s >= slots) return;
     pyr_graph_gather(PYR_ENTRY_CTX, 1u, s, 1u + PYR_GRAPH_SLOT_WORDS * slots, 0u);
+}
+#endif
+
+/* Tracks' overlaps (shaders/pyr_track.h), after compact, in two dispatches over at most the plan's largest table;
+ * each uses the slots K' and K need (pyr_track_slots: K read where the scan left it, K' the previous frame's, which
+ * the host knows). The table starts at a word of the fill buffer after the segment graph's; the host reads the slots
+ * K' and K need (no list: empty slots have a zero first word). track_clear (1D, PYR_TRACK_SLOT_WORDS * the slots
+ * the host allows): the word of K, K', max slots, the table's first word. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_CLEAR)
+PYR_KERNEL_1D(track_clear) {
+    pyr_u32 i = PYR_I;
+    pyr_u32 slots = pyr_track_slots(PYR_ARG(1), PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(2));
+    if (i >= PYR_TRACK_SLOT_WORDS * slots) return;
+    PYR_UF_STORE(PYR_ARG(3) + i, 0u);
+}
+#endif
+
+/* track_count (1D, runs of PYR_STATS_RUN pixels of each row): h, runs, the word of K, K' (0: no previous frame, nothing
+ * is counted), max slots, the table's first word. Each run's stretches of one (previous label, label) pair counted
+ * at once, and the frame's labels kept as the previous ones. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_COUNT)
+PYR_KERNEL_1D(track_count) {
+    pyr_u32 run = PYR_I;
+    if (run >= PYR_ARG(1)) return;
+    pyr_u32 per_row = (PYR_W + PYR_STATS_RUN - 1u) / PYR_STATS_RUN;
+    pyr_u32 y = run / per_row;
+    pyr_u32 x0 = (run - y * per_row) * PYR_STATS_RUN;
+    pyr_u32 x1 = min(x0 + PYR_STATS_RUN, PYR_W);
+    pyr_u32 previous_count = PYR_ARG(3);
+    pyr_u32 slot_mask = pyr_track_slots(previous_count, PYR_BUF(sums)[PYR_ARG(2)], PYR_ARG(4)) - 1u;
+    pyr_u32 run_previous = 0u;
+    pyr_u32 run_label = 0u;
+    pyr_u32 count = 0u;
+    for (pyr_u32 x = x0; x < x1; ++x) {
+        pyr_u32 i = y * PYR_W + x;
+        pyr_u32 k = PYR_BUF(out)[i];
+        pyr_u32 j = previous_count != 0u ? PYR_BUF(previous)[i] : 0u; /* a first frame's buffer is unwritten */
+        PYR_BUF(previous)[i] = k;
+        if (j == run_previous && k == run_label) {
+            count += 1u;
+            continue;
+        }
+        if (previous_count != 0u) pyr_track_count(PYR_ENTRY_CTX, run_previous, run_label, count, PYR_ARG(5), slot_mask);
+        run_previous = j;
+        run_label = k;
+        count = 1u;
+    }
+    if (previous_count != 0u) pyr_track_count(PYR_ENTRY_CTX, run_previous, run_label, count, PYR_ARG(5), slot_mask);
 }
 #endif
 

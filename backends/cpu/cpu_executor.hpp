@@ -66,7 +66,6 @@ public:
     void track_overlaps() override;  // cpu_tracks.cpp
     void forget_previous_labels() override { previous_count_ = 0; }
     [[nodiscard]] const std::uint32_t* track_pairs(std::uint32_t& count) const override;
-    [[nodiscard]] bool has_tracks() const override { return true; }
     void read_back(Result& out, const Outputs& outputs) override;
 
     [[nodiscard]] std::uint32_t fill_rounds() const override { return fill_rounds_; }

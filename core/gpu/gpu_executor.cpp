@@ -305,6 +305,26 @@ public:
         dispatch(Kernel::graph_gather, max_slots, 1, args({k_word, max_slots}));
     }
 
+    // Tracks' overlaps (shaders/pyr_track.h) in the fill buffer after the graph's words, in the slots the previous
+    // frame's K and this frame's need (at most those of the largest K the statistics allow); read_back fetches them
+    // with the statistics.
+    void track_overlaps() override {
+        const uint32_t k_word = plan_.scan_chunks();
+        const uint32_t max_slots = plan_.track_slots;
+        const uint32_t table = track_table_word();
+        const uint32_t allowed = pyr_track_slots(previous_count_, plan_.stats_slots, max_slots);
+        dispatch(Kernel::track_clear, PYR_TRACK_SLOT_WORDS * allowed, 1,
+                 args({k_word, previous_count_, max_slots, table}));
+        const uint32_t runs = plan_.stats_runs_per_row() * height();
+        dispatch(Kernel::track_count, runs, 1, args({height(), runs, k_word, previous_count_, max_slots, table}));
+        counted_previous_ = previous_count_;
+    }
+    void forget_previous_labels() override { previous_count_ = 0; }
+    [[nodiscard]] const uint32_t* track_pairs(uint32_t& count) const override {
+        count = track_pair_slots_;
+        return host_tracks_.data();
+    }
+
     void read_back(Result& out, const Outputs& outputs) override {
         device_->mark("download");
         const size_t px = plan_.pixel_count();
@@ -338,7 +358,20 @@ public:
             const size_t list = 1 + size_t(PYR_GRAPH_SLOT_WORDS) * pyr_graph_slots(segment_count_, plan_.graph_slots);
             device_->download(Buffer::fill, 4 * list, host_graph_.data(), 4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
         }
-        if (stats_words != 0 || plan_.graph_slots != 0) finish();  // the same waits whatever the graph holds
+        // The tracks' table, every slot the two counts need (a free slot's first word is 0); the executor's labels
+        // are the previous frame's from now on.
+        track_pair_slots_ = 0;
+        if (plan_.track_slots != 0) {
+            if (counted_previous_ != 0 && segment_count_ != 0) {
+                track_pair_slots_ = pyr_track_slots(counted_previous_, segment_count_, plan_.track_slots);
+                const size_t words = size_t(PYR_TRACK_SLOT_WORDS) * track_pair_slots_;
+                if (host_tracks_.size() < words) host_tracks_.resize(words);  // grows with the largest frame
+                device_->download(Buffer::fill, 4 * size_t(track_table_word()), host_tracks_.data(), 4 * words);
+            }
+            previous_count_ = segment_count_;
+        }
+        // The same waits whatever the graph and the tracks hold.
+        if (stats_words != 0 || plan_.graph_slots != 0 || plan_.track_slots != 0) finish();
         if (plan_.stats_slots != 0)
             core::decode_segment_stats(host_stats_.data(), segment_count_, plan_, !from_mask_, out.segments);
         if (plan_.graph_slots != 0) core::decode_segment_graph(host_graph_.data(), pairs, out.graph);
@@ -390,6 +423,9 @@ private:
         from_mask_ = false;
     }
 
+    // Where the tracks' table starts in the fill buffer: after the segment graph's words.
+    [[nodiscard]] uint32_t track_table_word() const { return uint32_t(plan_.graph_words()); }
+
     // Where the ray slopes start in the sums buffer: after the scan's chunk sums and K.
     [[nodiscard]] uint32_t rays_word() const { return plan_.scan_chunks() + 1; }
 
@@ -437,6 +473,10 @@ private:
     std::vector<uint32_t> host_graph_;  // the graph's pairs as gathered
     uint32_t segment_count_ = 0;
     uint32_t graph_count_ = 0;
+    std::vector<uint32_t> host_tracks_;  // the tracks' table slots, as the device left them
+    uint32_t track_pair_slots_ = 0;      // how many of them the last frame used (0: none counted)
+    uint32_t previous_count_ = 0;        // the K of the labels the previous buffer holds (0: none)
+    uint32_t counted_previous_ = 0;      // the K' the frame being read back counted against
     uint32_t dispatches_ = 0;
     uint32_t host_syncs_ = 0;
     bool from_mask_ = false;
@@ -481,10 +521,12 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
             // The fills' parents and minima, for the largest level a fill runs on (N - 1, or N in the fallback).
             // The merge's label parents and pair table (shaders/pyr_merge_table.h) reuse it after the fills.
             const PyrLevel& fill_level = plan.small_image ? plan.full() : plan.level(plan.level_count - 1);
-            // So do the segment graph's table and list (shaders/pyr_graph.h), after compaction.
+            // So do the segment graph's table and list (shaders/pyr_graph.h), after compaction, and the tracks'
+            // table after them (shaders/pyr_track.h).
             const size_t merge = size_t(plan.lut_size()) + size_t(PYR_MERGE_SLOT_WORDS) * plan.merge_slots;
+            const size_t tracks = size_t(PYR_TRACK_SLOT_WORDS) * plan.track_slots;
             return 4 * std::max({size_t(2) * fill_level.width * fill_level.height, plan.merge_slots != 0 ? merge : 0,
-                                 plan.graph_words()});
+                                 plan.graph_words() + tracks});
         }
         case Buffer::out:
             return 4 * px;
@@ -493,6 +535,8 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
             return plan.params.metric == Metric::robust ? 4 * size_t(PYR_TEXEL_WORDS) * px : 0;
         case Buffer::color:
             return (3 * px + 3) / 4 * 4;  // R, G, B per pixel, whole words
+        case Buffer::previous:
+            return plan.track_slots != 0 ? 4 * px : 0;
         case Buffer::count:
             break;
     }

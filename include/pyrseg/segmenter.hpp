@@ -21,7 +21,8 @@ struct SegmenterAccess;  // the library's own access to a Segmenter's insides (c
 struct PassTiming {
     // "depth" (a DepthView's back-projection), "normals", "quantize", "metric" (or "points_to_mask": the three as one
     // pass, on a backend that fuses them), "color", "mip", "labels", "fill", "final_fill", "edges", "merge",
-    // "compact", "stats", "graph", then "upload" (the frame to the backend) and "download" (the results back).
+    // "compact", "stats", "graph", "tracks", then "upload" (the frame to the backend) and "download" (the results
+    // back).
     const char* pass;
     double milliseconds;
 };
@@ -67,9 +68,9 @@ public:
     // backend uses (only the CPU's PYRSEG_CPU_FILL=sweeps, kept as a cross-check, sweeps).
     [[nodiscard]] std::uint32_t last_fill_rounds() const;
     // What the last frame cost a GPU backend besides its kernels: the dispatches (kernel launches) it queued, and
-    // the times the host waited for the device (1 per frame; 2 with Outputs::segment_stats or segment_graph, whose
-    // words are fetched once the segment count and the graph's pair count are known). Neither depends on the
-    // image's content. Both 0 on the CPU backend.
+    // the times the host waited for the device (1 per frame; 2 with Outputs::segment_stats, segment_graph or
+    // segment_tracks, whose words are fetched once the segment count and the graph's pair count are known). Neither
+    // depends on the image's content. Both 0 on the CPU backend.
     [[nodiscard]] std::uint32_t last_dispatches() const;
     [[nodiscard]] std::uint32_t last_host_syncs() const;
 

@@ -429,6 +429,13 @@ TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     o.statistics = {api().allocate(with_stats.device_statistics_bytes() - 4), 0};
     r.expect(with_stats, {r.cloud, o}, "statistics buffer holds");
 
+    // Tracks follow host frames only so far.
+    Outputs tracks;
+    tracks.segment_tracks = true;
+    Segmenter with_tracks = api().make_segmenter(Wall::kWidth, Wall::kHeight, {}, tracks);
+    r.expect(with_tracks, {r.cloud, r.out}, "tracks");
+    r.expect(with_tracks, {r.depth, r.out}, "tracks");
+
     // A Segmenter on another API.
     Segmenter cpu(Wall::kWidth, Wall::kHeight, {}, "cpu");
     r.expect(cpu, {r.cloud, r.out}, "does not run on");

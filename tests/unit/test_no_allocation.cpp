@@ -187,12 +187,11 @@ TEST_P(NoAllocation, WarmTrackedFramesAllocateNothing) {
     outputs.segment_tracks = outputs.track_ids = true;
     Params params;
     params.track_hold_frames = 2;
-    std::unique_ptr<Segmenter> segmenter;
-    try {
-        segmenter = std::make_unique<Segmenter>(320, 240, params, GetParam(), outputs);
-    } catch (const Error& e) {
-        GTEST_SKIP() << GetParam() << ": " << e.what();
+    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
+        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
+                        "no_allocation_without_validation_layer runs this test without it";
     }
+    auto segmenter = std::make_unique<Segmenter>(320, 240, params, GetParam(), outputs);
     Result result;
     const CloudView va{a.points.data(), nullptr, 320, 240};
     const CloudView vb{b.points.data(), nullptr, 320, 240};
