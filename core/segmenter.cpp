@@ -185,14 +185,17 @@ void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, R
         core::run_pipeline(impl.plan, input, color != nullptr, *impl.executor, impl.timings);
         const auto download_start = std::chrono::steady_clock::now();
         impl.executor->read_back(out, impl.outputs);
+        const double download_ms = milliseconds_since(download_start);
+        impl.timings.push_back(PassTiming{"upload", upload_ms});
+        impl.timings.push_back(PassTiming{"download", download_ms});
         if (impl.plan.track_slots != 0) {
+            const auto match_start = std::chrono::steady_clock::now();
             core::follow_tracks(impl, out);
+            impl.timings.push_back(PassTiming{"track_matching", milliseconds_since(match_start)});
         } else {
             out.tracks.clear();
             out.track_ids.clear();
         }
-        impl.timings.push_back(PassTiming{"upload", upload_ms});
-        impl.timings.push_back(PassTiming{"download", milliseconds_since(download_start)});
         impl.executor->device_timings(impl.timings);
     });
 }

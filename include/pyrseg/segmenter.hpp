@@ -21,8 +21,8 @@ struct SegmenterAccess;  // the library's own access to a Segmenter's insides (c
 struct PassTiming {
     // "depth" (a DepthView's back-projection), "normals", "quantize", "metric" (or "points_to_mask": the three as one
     // pass, on a backend that fuses them), "color", "mip", "labels", "fill", "final_fill", "edges", "merge",
-    // "compact", "stats", "graph", "tracks", then "upload" (the frame to the backend) and "download" (the results
-    // back).
+    // "compact", "stats", "graph", "tracks", then "upload" (the frame to the backend), "download" (the results
+    // back) and, with tracks, "track_matching" (on the host, docs/algorithm.md section 11).
     const char* pass;
     double milliseconds;
 };
