@@ -37,45 +37,44 @@ void TrackState::reset() {
 }
 
 void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, const std::vector<SegmentStats>& segments,
-                      const Params& params, std::vector<SegmentTrack>& out) {
+                      int width, int height, const Params& params, std::vector<SegmentTrack>& out) {
     const auto count = std::uint32_t(segments.size());
     const std::uint32_t f = frame_;
     const std::uint32_t previous_count = by_previous_.empty() ? 0 : std::uint32_t(by_previous_.size() - 1);
     out.resize(count);
+    const auto on_border = [&](const SegmentStats& s) {
+        return s.x_min <= 0 || s.y_min <= 0 || s.x_max >= width - 1 || s.y_max >= height - 1;
+    };
 
-    // Step 1: by overlap. Each side's best partner (the larger count, then the smaller label).
-    best_previous_.assign(count + 1, 0);
-    best_count_k_.assign(count + 1, 0);
-    best_label_.assign(previous_count + 1, 0);
-    best_count_j_.assign(previous_count + 1, 0);
+    // Step 1: by overlap, greedily: the pairs sharing at least an eighth of the smaller, the largest first.
+    pairs_.clear();
     for (std::uint32_t i = 0; i < pair_count; ++i) {
         const std::uint32_t* w = pairs + std::size_t(PYR_TRACK_SLOT_WORDS) * i;
-        const std::uint32_t j = w[0];
-        const std::uint32_t k = w[1];
-        const std::uint32_t m = w[2];
-        if (j == 0 || j > previous_count || k == 0 || k > count || m == 0) continue;  // cannot happen: labels are 1..K
-        if (m > best_count_k_[k] || (m == best_count_k_[k] && j < best_previous_[k])) {
-            best_count_k_[k] = m;
-            best_previous_[k] = j;
-        }
-        if (m > best_count_j_[j] || (m == best_count_j_[j] && k < best_label_[j])) {
-            best_count_j_[j] = m;
-            best_label_[j] = k;
-        }
+        const Pair pair{w[0], w[1], w[2]};
+        // Free slots (a first word of 0) come from a GPU's table; labels are 1..K.
+        if (pair.previous == 0 || pair.previous > previous_count || pair.label == 0 || pair.label > count) continue;
+        if (by_previous_[pair.previous] == 0) continue;
+        const std::uint32_t smaller = std::min(segments[pair.label - 1].pixel_count, previous_size_[pair.previous]);
+        if (8 * std::uint64_t(pair.pixels) >= smaller) pairs_.push_back(pair);
     }
+    std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) {
+        if (a.pixels != b.pixels) return a.pixels > b.pixels;
+        return a.previous != b.previous ? a.previous < b.previous : a.label < b.label;
+    });
     matched_.assign(count + 1, 0);
+    overlap_.assign(count + 1, 0);
     track_taken_.assign(tracks_.size(), 0);
-    for (std::uint32_t k = 1; k <= count; ++k) {
-        const std::uint32_t j = best_previous_[k];
-        if (j == 0 || best_label_[j] != k || by_previous_[j] == 0) continue;
-        const std::uint32_t smaller = std::min(segments[k - 1].pixel_count, previous_size_[j]);
-        if (8 * std::uint64_t(best_count_k_[k]) < smaller) continue;
-        matched_[k] = by_previous_[j];
-        track_taken_[by_previous_[j] - 1] = 1;
-        out[k - 1].how = TrackMatch::overlap;
+    for (const Pair& pair : pairs_) {
+        const std::uint32_t track = by_previous_[pair.previous] - 1;
+        if (matched_[pair.label] != 0 || track_taken_[track] != 0) continue;
+        matched_[pair.label] = track + 1;
+        overlap_[pair.label] = pair.pixels;
+        track_taken_[track] = 1;
+        out[pair.label - 1].how = TrackMatch::overlap;
     }
 
-    // Step 2: the camera's motion, the overlap-weighted mean shift of the segments matched by overlap.
+    // Step 2: the camera's motion, the overlap-weighted mean shift of the segments matched by overlap that the
+    // image's border cuts in neither frame.
     double t[3] = {0, 0, 0};
     {
         double numerator[3] = {0, 0, 0};
@@ -84,8 +83,8 @@ void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, cons
             if (matched_[k] == 0) continue;
             const Track& track = tracks_[matched_[k] - 1];
             const SegmentStats& s = segments[k - 1];
-            if (!track.has_centroid || !has_centroid(s)) continue;
-            const double m = double(best_count_k_[k]);
+            if (!track.has_centroid || !has_centroid(s) || track.on_border || on_border(s)) continue;
+            const double m = double(overlap_[k]);
             for (int c = 0; c < 3; ++c) numerator[c] += m * (s.centroid[std::size_t(c)] - track.centroid[c]);
             denominator += m;
         }
@@ -94,40 +93,31 @@ void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, cons
         }
     }
 
-    // Step 3: by position, each the other's nearest within the distance and with sizes within a factor of 4.
+    // Step 3: by position, greedily: the pairs within the distance and with sizes within a factor of 4, the nearest
+    // first.
     const double reach = params.track_max_distance_mm / params.unit_mm;
     const double reach2 = reach * reach;
     const auto track_count = std::uint32_t(tracks_.size());
-    nearest_track_.assign(count + 1, 0);
-    nearest_label_.assign(track_count, 0);
-    nearest_d2_.assign(track_count, 0.0);
+    candidates_.clear();
     for (std::uint32_t k = 1; k <= count; ++k) {
         const SegmentStats& s = segments[k - 1];
         if (matched_[k] != 0 || !has_centroid(s)) continue;
-        double best = 0;
         for (std::uint32_t i = 0; i < track_count; ++i) {
             const Track& track = tracks_[i];
             if (track_taken_[i] != 0 || !track.has_centroid || !sizes_agree(s.pixel_count, track.pixels)) continue;
             const double d2 = distance2(s.centroid.data(), track.centroid, t);
-            if (!(d2 <= reach2)) continue;
-            const std::uint32_t current = nearest_track_[k];
-            if (current == 0 || d2 < best || (d2 == best && track.id < tracks_[current - 1].id)) {
-                nearest_track_[k] = i + 1;
-                best = d2;
-            }
-            // Segments come in increasing k: a later one replaces the nearest only when strictly nearer.
-            if (nearest_label_[i] == 0 || d2 < nearest_d2_[i]) {
-                nearest_label_[i] = k;
-                nearest_d2_[i] = d2;
-            }
+            if (d2 <= reach2) candidates_.push_back(Candidate{d2, track.id, k, i});
         }
     }
-    for (std::uint32_t k = 1; k <= count; ++k) {
-        const std::uint32_t i = nearest_track_[k];
-        if (i == 0 || nearest_label_[i - 1] != k) continue;
-        matched_[k] = i;
-        track_taken_[i - 1] = 1;
-        out[k - 1].how = TrackMatch::position;
+    std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& a, const Candidate& b) {
+        if (a.distance2 != b.distance2) return a.distance2 < b.distance2;
+        return a.id != b.id ? a.id < b.id : a.label < b.label;
+    });
+    for (const Candidate& c : candidates_) {
+        if (matched_[c.label] != 0 || track_taken_[c.track] != 0) continue;
+        matched_[c.label] = c.track + 1;
+        track_taken_[c.track] = 1;
+        out[c.label - 1].how = TrackMatch::position;
     }
 
     // Steps 4 and 5: new tracks, then every track brought up to this frame.
@@ -154,6 +144,7 @@ void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, cons
         track.pixels = s.pixel_count;
         track.label = k;
         track.has_centroid = has_centroid(s);
+        track.on_border = on_border(s);
         for (int c = 0; c < 3; ++c) track.centroid[c] = track.has_centroid ? s.centroid[std::size_t(c)] : 0.0;
         o.id = track.id;
         o.first_frame = track.first_frame;

@@ -18,7 +18,7 @@ public:
     // any order (none on the stream's first frame); `segments` the frame's K statistics (label k at k - 1).
     // Fills `out` with K tracks. Allocates only when the frame has more segments or pairs than any before.
     void next(const std::uint32_t* pairs, std::uint32_t pair_count, const std::vector<SegmentStats>& segments,
-              const Params& params, std::vector<SegmentTrack>& out);
+              int width, int height, const Params& params, std::vector<SegmentTrack>& out);
 
     struct Pair {
         std::uint32_t previous = 0, label = 0, pixels = 0;
@@ -31,7 +31,12 @@ public:
         std::uint32_t pixels = 0;  // its last pixel count
         std::uint32_t label = 0;   // its label in the previous frame; 0 when it was not seen there
         bool has_centroid = false;
+        bool on_border = false;  // its last segment touched the image's border
         double centroid[3] = {0, 0, 0};
+    };
+    struct Candidate {  // step 3's pairs
+        double distance2 = 0;
+        std::uint32_t id = 0, label = 0, track = 0;
     };
 
 private:
@@ -41,16 +46,11 @@ private:
     std::vector<std::uint32_t> by_previous_;    // previous label j -> index in tracks_ + 1
     std::vector<std::uint32_t> previous_size_;  // previous label j -> its pixel count
     // Per frame, sized to the largest frame so far.
-    std::vector<Pair> pairs_;
-    std::vector<std::uint32_t> best_previous_;  // label k -> j*(k) (0: none)
-    std::vector<std::uint32_t> best_count_k_;
-    std::vector<std::uint32_t> best_label_;  // previous label j -> k*(j)
-    std::vector<std::uint32_t> best_count_j_;
+    std::vector<Pair> pairs_;             // step 1's pairs, in the order it takes them
     std::vector<std::uint32_t> matched_;  // label k -> index in tracks_ + 1 (0: not matched yet)
+    std::vector<std::uint32_t> overlap_;  // label k -> the pixels it shares with the track it matched in step 1
     std::vector<std::uint8_t> track_taken_;
-    std::vector<std::uint32_t> nearest_track_;  // step 3: label k -> index in tracks_ + 1
-    std::vector<std::uint32_t> nearest_label_;  // step 3: index in tracks_ -> label k
-    std::vector<double> nearest_d2_;
+    std::vector<Candidate> candidates_;
 };
 
 }  // namespace pyrseg::core

@@ -30,7 +30,7 @@ namespace {
 void follow_tracks(Segmenter::Impl& impl, Result& out) {
     std::uint32_t pair_count = 0;
     const std::uint32_t* pairs = impl.executor->track_pairs(pair_count);
-    impl.tracks.next(pairs, pair_count, out.segments, impl.plan.params, out.tracks);
+    impl.tracks.next(pairs, pair_count, out.segments, impl.plan.width, impl.plan.height, impl.plan.params, out.tracks);
     if (!impl.outputs.track_ids) {
         out.track_ids.clear();
         return;

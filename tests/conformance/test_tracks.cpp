@@ -118,7 +118,7 @@ TEST_P(TrackStreams, MatchesReference) {
         const std::vector<float> points = view_of(wide, frames[f].x0, width, frames[f].hidden);
         const pyrseg_ref::Output ref = pyrseg_ref::segment(points.data(), nullptr, width, height, to_reference(params));
         ASSERT_TRUE(ref.ok) << ref.error;
-        const std::vector<pyrseg_ref::Track> expected = tracker.next(ref);
+        const std::vector<pyrseg_ref::Track> expected = tracker.next(ref, width, height);
         segmenter->segment(CloudView{points.data(), nullptr, width, height}, result);
         ASSERT_TRUE(same_bytes("labels", result.labels, ref.labels, width));
         ASSERT_EQ(result.tracks.size(), expected.size());

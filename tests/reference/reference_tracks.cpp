@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -42,6 +43,11 @@ bool sizes_close(std::uint32_t a, std::uint32_t b) {
     return hi <= 4 * lo;
 }
 
+// Step 2: the segment's bounding box (inclusive, section 10) reaches column 0 or W - 1, or row 0 or H - 1.
+bool touches_border(const Segment& s, int width, int height) {
+    return s.x_min <= 0 || s.y_min <= 0 || s.x_max >= width - 1 || s.y_max >= height - 1;
+}
+
 }  // namespace
 
 Tracker::Tracker(const TrackParams& params) : params_(params) {
@@ -59,19 +65,26 @@ void Tracker::reset() {
     frame_ = 0;
     next_id_ = 1;
     has_previous_ = false;
+    previous_width_ = 0;
+    previous_height_ = 0;
     previous_.clear();
     tracks_.clear();
 }
 
-std::vector<Track> Tracker::next(const Output& out) {
+std::vector<Track> Tracker::next(const Output& out, int width, int height) {
     if (!out.ok) throw std::invalid_argument("Tracker::next: the Output is not ok");
-    return next(out.labels, out.segments);
+    return next(out.labels, width, height, out.segments);
 }
 
-std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const std::vector<Segment>& segments) {
+std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, int width, int height,
+                                 const std::vector<Segment>& segments) {
     const std::size_t K = segments.size();
-    if (has_previous_ && labels.size() != previous_.size()) {
-        throw std::invalid_argument("Tracker::next: the labels' size differs from the previous frame's");
+    if (width < 0 || height < 0) throw std::invalid_argument("Tracker::next: negative width or height");
+    if (labels.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
+        throw std::invalid_argument("Tracker::next: the labels' size is not width * height");
+    }
+    if (has_previous_ && (width != previous_width_ || height != previous_height_)) {
+        throw std::invalid_argument("Tracker::next: the frame's size differs from the previous frame's");
     }
     for (std::uint32_t label : labels) {
         if (label > K) throw std::invalid_argument("Tracker::next: a label exceeds the segment count");
@@ -81,9 +94,11 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
     // This frame's n_k and c_k, indexed by k (index 0 unused).
     std::vector<std::uint32_t> n(K + 1, 0);
     std::vector<Centroid> c(K + 1);
+    std::vector<bool> border(K + 1, false);
     for (std::size_t k = 1; k <= K; ++k) {
         n[k] = segments[k - 1].pixel_count;
         c[k] = centroid_of(segments[k - 1]);
+        border[k] = touches_border(segments[k - 1], width, height);
     }
 
     // The tracks seen in the previous frame, by their label j there.
@@ -102,47 +117,43 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
         }
     }
 
-    // Step 1, by overlap. Ambiguity: "the j with the largest m(j, k)" is read over the pairs that have a count
-    // (m > 0); a segment that overlaps nothing has no best previous label.
-    std::map<std::uint32_t, std::pair<std::uint32_t, std::uint64_t>> best_j;  // k -> (j*(k), m)
-    std::map<std::uint32_t, std::pair<std::uint32_t, std::uint64_t>> best_k;  // j -> (k*(j), m)
+    // Step 1, by overlap: a greedy assignment. The pairs with 8 m(j, k) >= min(n_k, n'_j) (n'_j the pixel count of
+    // the track seen as j), in decreasing m, then increasing j, then increasing k; a pair whose j and k are both
+    // still unmatched matches. Only the pairs with a count are listed (a pair with m = 0 shares nothing).
+    std::vector<std::tuple<std::uint64_t, std::uint32_t, std::uint32_t>> overlap_pairs;  // (m, j, k)
     for (const auto& [jk, count] : m) {
         const auto [j, k] = jk;
-        auto bj = best_j.find(k);
-        if (bj == best_j.end() || count > bj->second.second || (count == bj->second.second && j < bj->second.first)) {
-            best_j[k] = {j, count};
-        }
-        auto bk = best_k.find(j);
-        if (bk == best_k.end() || count > bk->second.second || (count == bk->second.second && k < bk->second.first)) {
-            best_k[j] = {k, count};
-        }
+        const std::uint32_t id = id_of_label.at(j);
+        const std::uint64_t smaller = std::min<std::uint64_t>(n[k], tracks_.at(id).pixel_count);
+        if (8 * count >= smaller) overlap_pairs.emplace_back(count, j, k);
     }
+    std::sort(overlap_pairs.begin(), overlap_pairs.end(), [](const auto& a, const auto& b) {
+        if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) > std::get<0>(b);
+        if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
+        return std::get<2>(a) < std::get<2>(b);
+    });
     std::vector<std::uint32_t> id_of(K + 1, 0);  // k -> its track's id, 0 while unmatched
     std::vector<TrackMatch> how(K + 1, TrackMatch::new_track);
     std::vector<std::uint64_t> overlap_of(K + 1, 0);  // m(j, k) of k's step-1 pair
     std::set<std::uint32_t> matched_ids;
-    for (std::uint32_t k = 1; k <= K; ++k) {
-        const auto bj = best_j.find(k);
-        if (bj == best_j.end()) continue;
-        const std::uint32_t j = bj->second.first;
-        const std::uint64_t mjk = bj->second.second;
-        if (best_k.at(j).first != k) continue;
+    for (const auto& [count, j, k] : overlap_pairs) {
         const std::uint32_t id = id_of_label.at(j);
-        const std::uint64_t smaller = std::min<std::uint64_t>(n[k], tracks_.at(id).pixel_count);  // min(n_k, n'_j)
-        if (8 * mjk < smaller) continue;
+        if (how[k] != TrackMatch::new_track || matched_ids.count(id) != 0) continue;
         id_of[k] = id;
         how[k] = TrackMatch::overlap;
-        overlap_of[k] = mjk;
+        overlap_of[k] = count;
         matched_ids.insert(id);
     }
 
-    // Step 2, the camera's motion t, summed in increasing k over the step-1 pairs where both centroids exist.
+    // Step 2, the camera's motion t, summed in increasing k over the step-1 pairs where both centroids exist and
+    // neither segment touches the border (the previous one as its track remembers, from the previous frame).
     double num[3] = {0, 0, 0};
     double den = 0.0;
     for (std::uint32_t k = 1; k <= K; ++k) {
         if (how[k] != TrackMatch::overlap) continue;
         const State& s = tracks_.at(id_of[k]);
         if (!c[k].has || !s.has_centroid) continue;
+        if (border[k] || s.border) continue;
         const double w = static_cast<double>(overlap_of[k]);
         for (int a = 0; a < 3; ++a) {
             const double diff = c[k].c[a] - s.centroid[a];
@@ -156,9 +167,8 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
         for (int a = 0; a < 3; ++a) t[a] = num[a] / den;
     }
 
-    // Step 3, by position: mutual nearest among the eligible pairs. Ambiguities: "such track" is read as a track
-    // meeting both the distance and the size condition; and the mutual-nearest test is one round over all
-    // candidates (no second round among the pairs left over).
+    // Step 3, by position: a greedy assignment over the pairs meeting the distance and the size conditions, in
+    // increasing d^2, then increasing id, then increasing k; a pair whose k and s are both still unmatched matches.
     const double D = params_.max_distance_mm / params_.unit_mm;
     const double D2 = D * D;
     auto d2_of = [&](std::uint32_t k, const State& s) {
@@ -173,9 +183,6 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
         const double xy = xx + yy;
         return xy + zz;
     };
-    auto eligible = [&](std::uint32_t k, const State& s, double d2) {
-        return d2 <= D2 && sizes_close(n[k], s.pixel_count);
-    };
     std::vector<std::uint32_t> position_segments;  // unmatched segments with a centroid, increasing k
     for (std::uint32_t k = 1; k <= K; ++k) {
         if (how[k] == TrackMatch::new_track && c[k].has) position_segments.push_back(k);
@@ -184,25 +191,21 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
     for (const auto& [id, s] : tracks_) {
         if (matched_ids.count(id) == 0 && s.has_centroid) position_tracks.push_back(id);
     }
-    std::map<std::uint32_t, std::pair<std::uint32_t, double>> nearest_track;    // k -> (s, d2)
-    std::map<std::uint32_t, std::pair<std::uint32_t, double>> nearest_segment;  // s -> (k, d2)
+    std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> position_pairs;  // (d^2, id, k)
     for (std::uint32_t k : position_segments) {
         for (std::uint32_t id : position_tracks) {
             const State& s = tracks_.at(id);
             const double d2 = d2_of(k, s);
-            if (!eligible(k, s, d2)) continue;
-            // Visited in increasing k and increasing id, so a strict < keeps the smaller one among equals.
-            auto nt = nearest_track.find(k);
-            if (nt == nearest_track.end() || d2 < nt->second.second) nearest_track[k] = {id, d2};
-            auto ns = nearest_segment.find(id);
-            if (ns == nearest_segment.end() || d2 < ns->second.second) nearest_segment[id] = {k, d2};
+            if (d2 <= D2 && sizes_close(n[k], s.pixel_count)) position_pairs.emplace_back(d2, id, k);
         }
     }
-    for (std::uint32_t k : position_segments) {
-        const auto nt = nearest_track.find(k);
-        if (nt == nearest_track.end()) continue;
-        const std::uint32_t id = nt->second.first;
-        if (nearest_segment.at(id).first != k) continue;
+    std::sort(position_pairs.begin(), position_pairs.end(), [](const auto& a, const auto& b) {
+        if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) < std::get<0>(b);
+        if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
+        return std::get<2>(a) < std::get<2>(b);
+    });
+    for (const auto& [d2, id, k] : position_pairs) {
+        if (how[k] != TrackMatch::new_track || matched_ids.count(id) != 0) continue;
         id_of[k] = id;
         how[k] = TrackMatch::position;
         matched_ids.insert(id);
@@ -231,6 +234,7 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
         s.has_centroid = c[k].has;
         for (int a = 0; a < 3; ++a) s.centroid[a] = c[k].has ? c[k].c[a] : 0.0;
         s.pixel_count = n[k];
+        s.border = border[k];
         s.label = k;
         r.age = s.age;
     }
@@ -254,6 +258,8 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, const
     }
 
     previous_ = labels;
+    previous_width_ = width;
+    previous_height_ = height;
     has_previous_ = true;
     ++frame_;
     return result;

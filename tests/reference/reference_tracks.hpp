@@ -33,12 +33,15 @@ public:
     // Throws std::invalid_argument for parameters out of their ranges above.
     explicit Tracker(const TrackParams& params);
 
-    // The next frame of the stream: its compacted labels (width*height, 0 = unlabelled, 1..K) and K segments'
-    // statistics (segments[k-1] is label k). Returns K tracks, in k's order. Throws std::invalid_argument (and
-    // changes nothing) when a label exceeds K or the labels' size differs from the previous frame's.
-    std::vector<Track> next(const std::vector<std::uint32_t>& labels, const std::vector<Segment>& segments);
-    // Convenience: next(out.labels, out.segments). Throws std::invalid_argument when !out.ok.
-    std::vector<Track> next(const Output& out);
+    // The next frame of the stream: its compacted labels (width*height, row-major, 0 = unlabelled, 1..K) and K
+    // segments' statistics (segments[k-1] is label k; step 2 reads their bounding boxes against W = width and
+    // H = height). Returns K tracks, in k's order. Throws std::invalid_argument (and changes nothing) when width or
+    // height is negative, the labels' size is not width*height, a label exceeds K, or width or height differs from
+    // the previous frame's.
+    std::vector<Track> next(const std::vector<std::uint32_t>& labels, int width, int height,
+                            const std::vector<Segment>& segments);
+    // Convenience: next(out.labels, width, height, out.segments). Throws std::invalid_argument when !out.ok.
+    std::vector<Track> next(const Output& out, int width, int height);
     // A new stream: frame 0 next, no previous labels, no tracks, ids from 1 again.
     void reset();
 
@@ -50,6 +53,7 @@ private:
         bool has_centroid = false;
         double centroid[3] = {0, 0, 0};
         std::uint32_t pixel_count = 0;
+        bool border = false;      // whether its last segment touched the image's border (step 2)
         std::uint32_t label = 0;  // its label in the previous frame; meaningful only when last_seen + 1 == frame_
     };
 
@@ -57,6 +61,8 @@ private:
     std::uint32_t frame_ = 0;  // f of the next frame
     std::uint32_t next_id_ = 1;
     bool has_previous_ = false;
+    int previous_width_ = 0;
+    int previous_height_ = 0;
     std::vector<std::uint32_t> previous_;    // P
     std::map<std::uint32_t, State> tracks_;  // by id: the tracks still held (seen in the previous frame, or hidden)
 };
