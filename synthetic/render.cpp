@@ -178,7 +178,8 @@ public:
                       tiles[static_cast<std::size_t>(t)]);
         }
         for (int v = v_begin; v < v_end; ++v) {
-            Rng rng(options_.seed, static_cast<std::uint64_t>(Stream::noise_rows) + static_cast<std::uint64_t>(v));
+            Rng rng(noise_seed_of(options_),
+                    static_cast<std::uint64_t>(Stream::noise_rows) + static_cast<std::uint64_t>(v));
             for (int u = 0; u < w; ++u) {
                 const std::vector<Entry>& list = tiles[static_cast<std::size_t>(u / kTileWidth)];
                 if (fields_ != nullptr) {

@@ -13,10 +13,19 @@ inline std::uint64_t splitmix64(std::uint64_t& state) {
     return z ^ (z >> 31);
 }
 
-// Independent streams of one seed (layout, holes, the noise of each row), so that changing one part of the
-// options or the image size leaves the others as they were. Sensor models draw row j of their field k from
-// sensor_rows + (k << 16) + j, clear of noise_rows + v for every v below the largest image side.
-enum class Stream : std::uint64_t { layout = 1, holes = 2, noise_rows = 0x100, sensor_rows = 0x100000 };
+// Independent streams of one seed (layout, holes, the noise of each row; a sequence's camera walk, object motion
+// and per-frame noise seeds), so that changing one part of the options or the image size leaves the others as they
+// were. Sensor models draw row j of their field k from sensor_rows + (k << 16) + j, clear of noise_rows + v for
+// every v below the largest image side.
+enum class Stream : std::uint64_t {
+    layout = 1,
+    holes = 2,
+    camera_walk = 3,
+    object_motion = 4,
+    frame_noise = 5,
+    noise_rows = 0x100,
+    sensor_rows = 0x100000
+};
 
 class Rng {
 public:

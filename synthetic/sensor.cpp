@@ -197,11 +197,11 @@ SensorFields make_sensor_fields(const SensorModel& model, const SceneOptions& op
     SensorFields fields;
     const int r = static_cast<int>(model.correlation_radius_px);
     const int threads = thread_count(options);
-    fields.depth = correlated_field(options.seed, depth_field, width, height, r, threads);
+    fields.depth = correlated_field(noise_seed_of(options), depth_field, width, height, r, threads);
     if (model.lateral_sigma_px > 0) {
         const double sigma = model.lateral_sigma_px, limit = kMaxJitterSigmas;
         for (const Field field : {jitter_u_field, jitter_v_field}) {
-            std::vector<float> jitter = correlated_field(options.seed, field, width, height, r, threads);
+            std::vector<float> jitter = correlated_field(noise_seed_of(options), field, width, height, r, threads);
             for (float& x : jitter) x = static_cast<float>(sigma * std::clamp(static_cast<double>(x), -limit, limit));
             (field == jitter_u_field ? fields.jitter_u : fields.jitter_v) = std::move(jitter);
         }
@@ -220,7 +220,7 @@ void apply_sensor(const SensorModel& model, const SensorFields& fields, const Sc
     const bool dropouts = options.shadows && options.hole_fraction > 0;
 
     for_rows(height, thread_count(options), [&](int v) {
-        Rng rng = row_rng(options.seed, decision_field, v);
+        Rng rng = row_rng(noise_seed_of(options), decision_field, v);
         for (int u = 0; u < width; ++u) {
             // Every pixel draws the same numbers, so that one pixel's fate never shifts another's.
             const double drop = rng.uniform(), fly = rng.uniform(), mix = rng.uniform();

@@ -15,6 +15,11 @@ struct SensorFields {
     double max_jitter = 0;  // no |jitter| exceeds this, so that tiles padded by it hold every solid a ray can hit
 };
 
+// The seed of a frame's depth noise and sensor fields: noise_seed, or seed when it is 0.
+inline std::uint64_t noise_seed_of(const SceneOptions& options) {
+    return options.noise_seed != 0 ? options.noise_seed : options.seed;
+}
+
 // The thread count for options.threads (0: one per hardware thread).
 int thread_count(const SceneOptions& options);
 

@@ -10,9 +10,17 @@ namespace fs = std::filesystem;
 
 const std::map<std::string, std::string>& batch_output_suffixes() {
     static const std::map<std::string, std::string> suffixes = {
-        {"labels", ".labels.npy"}, {"png", ".png"},          {"mask", ".mask.png"},
-        {"figure", ".figure.png"}, {"ply", ".ply"},          {"pcd", ".labels.pcd"},
-        {"stats", ".stats.json"},  {"graph", ".graph.json"}, {"scene", ".scene.json"},
+        {"labels", ".labels.npy"},
+        {"png", ".png"},
+        {"mask", ".mask.png"},
+        {"figure", ".figure.png"},
+        {"ply", ".ply"},
+        {"pcd", ".labels.pcd"},
+        {"stats", ".stats.json"},
+        {"graph", ".graph.json"},
+        {"scene", ".scene.json"},
+        {"track_ids", ".track_ids.npy"},
+        {"tracks", ".tracks.json"},
     };
     return suffixes;
 }

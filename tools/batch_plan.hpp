@@ -19,9 +19,10 @@ struct PlannedFrame {
 // The kinds --write accepts, and the name each writes for a frame named NAME.
 [[nodiscard]] const std::map<std::string, std::string>& batch_output_suffixes();
 
-// DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png, NAME.ply, NAME.labels.pcd, NAME.stats.json for
-// the `kinds` asked, NAME being the input's stem, or NAME_2, NAME_3, ... when one of those names is already another
-// frame's. An output that would be one of the inputs is a UsageError naming both (nothing is read or written then).
+// DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png, NAME.ply, NAME.labels.pcd, NAME.stats.json,
+// NAME.graph.json, NAME.scene.json, NAME.track_ids.npy, NAME.tracks.json for the `kinds` asked, NAME being the input's
+// stem, or NAME_2, NAME_3, ... when one of those names is already another frame's. An output that would be one of the
+// inputs is a UsageError naming both (nothing is read or written then).
 [[nodiscard]] std::vector<PlannedFrame> plan_batch(const std::vector<std::filesystem::path>& inputs,
                                                    const std::filesystem::path& out_dir,
                                                    const std::set<std::string>& kinds);

@@ -44,6 +44,8 @@ constexpr const char* kEvalUsage =
     "       pyrseg eval --tabletop DIR [--presets NAME,...] [--out-dir DIR]   (real RGB-D frames: --tabletop --help)\n"
     "       pyrseg eval --tabletop-synthetic [--sensors NAME,...] [--seeds N] [--out-dir DIR]  (the same on synthetic\n"
     "                   tabletops through the sensor models)\n"
+    "       pyrseg eval --tracks [--sensors NAME,...] [--frames N] [--seeds N] [--out-dir DIR]  (track ids over\n"
+    "                   synthetic sequences from a moving camera: --tracks --help)\n"
     "\n"
     "Measures segmentation quality against ground truth on seeded synthetic bin-picking scenes (boxes, cylinders\n"
     "and spheres touching each other in a bin; seeds 1..N), comparing three labellings:\n"
@@ -889,6 +891,7 @@ int cmd_eval(const std::vector<std::string>& argv) {
         if (a == "--tabletop" || a.starts_with("--tabletop=") || a == "--tabletop-synthetic") {
             return cmd_eval_tabletop(argv);
         }
+        if (a == "--tracks") return cmd_eval_tracks(argv);
     }
     std::set<std::string> values = {"sizes",   "seeds",     "noise",  "bridges",   "out-dir",
                                     "sensors", "distances", "params", "tune-seeds"};

@@ -29,6 +29,7 @@
 #include "tools/printable.hpp"
 #include "tools/progress.hpp"
 #include "tools/scene_picture.hpp"
+#include "tools/track_table.hpp"
 
 namespace pyrseg::cli {
 namespace {
@@ -37,8 +38,9 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
     "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [input options] [parameters]\n"
-    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,graph,scene]\n"
-    "                      [--progress auto|bar|lines|none] [--backend NAME] [input options] [parameters]\n"
+    "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,graph,scene,\n"
+    "                      track_ids,tracks] [--track] [--progress auto|bar|lines|none] [--backend NAME]\n"
+    "                      [input options] [parameters]\n"
     "\n"
     "Segments one organized point cloud or depth image (see Inputs below) and prints a line with the segment count\n"
     "and the time (the first frame's includes the warm-up: kernel builds, first-touch allocation).\n"
@@ -66,6 +68,11 @@ constexpr const char* kSegmentUsage =
     "  --graph OUT.json      which segments touch which: per pair, its boundary's length in pixel sides and how many\n"
     "  --graph OUT.csv       of them are flat, a convex crease, a concave crease or a depth step (docs/algorithm.md\n"
     "                        10d), counted exactly by the backend; JSON or CSV, as the extension says\n"
+    "  --track-ids OUT.npy   with --track (below): each pixel's track id, as --labels writes labels (0 = no\n"
+    "  --track-ids OUT.png   segment; a 16-bit PNG when every id fits in 16 bits)\n"
+    "  --tracks OUT.json     with --track: per segment, its label, its track id, the frame of the stream it was first\n"
+    "  --tracks OUT.csv      seen in, its age (the frames it was seen in), the frames it was hidden just before this\n"
+    "                        one and how it was matched (new_track, overlap, position); JSON or CSV\n"
     "  --scene OUT.json      the scene: the support surfaces (large flat segments: floor, table, wall; plane and\n"
     "                        outline) and the objects resting on them, each with its support, its height above it\n"
     "                        and a box standing on it that holds the object's points (docs/algorithm.md 10c)\n"
@@ -79,6 +86,8 @@ constexpr const char* kSegmentUsage =
     "                        unless --progress is given); stdout still has the results: the frame's line, a batch's\n"
     "                        summary (redirect it to drop them)\n"
     "  --verbose, -v         the full reason for the backend auto chose (by default one short line)\n"
+    "  --track               follow the segments from frame to frame (docs/algorithm.md section 11): each segment\n"
+    "                        gets a track id that carries over from the previous frame (see Tracks below)\n"
     "\n"
     "Units: cloud files do not say theirs. Without --unit-mm, a cloud whose median depth is under 20 units is read\n"
     "as metres (pyrseg says so), any other as millimetres; --unit-mm always wins. Depth images and depth maps take\n"
@@ -86,21 +95,30 @@ constexpr const char* kSegmentUsage =
     "\n"
     "Batches: several INPUTs, folders (their .pcd/.ply/.npy/.png/.tif/.tiff files, by name) or quoted glob\n"
     "patterns, with --out-dir. Each frame writes DIR/NAME.labels.npy, NAME.png, NAME.mask.png, NAME.figure.png,\n"
-    "NAME.ply, NAME.labels.pcd, NAME.stats.json, NAME.graph.json, NAME.scene.json as --write asks (default "
-    "labels,png); NAME_2, NAME_3 "
-    "... when\n"
-    "another frame's output has that name already. An output that would be one of the batch's inputs is refused\n"
+    "NAME.ply, NAME.labels.pcd, NAME.stats.json, NAME.graph.json, NAME.scene.json, NAME.track_ids.npy,\n"
+    "NAME.tracks.json as --write asks (default labels,png; with --track labels,png,track_ids); NAME_2, NAME_3 ...\n"
+    "when another frame's output has that name already. An output that would be one of the batch's inputs is refused\n"
     "before anything is read. A frame that fails (also one an input option does not apply to: --intrinsics on a\n"
     "cloud, --unit-mm on a depth image) is reported and skipped (none of its outputs is left); the exit status is 1\n"
     "if any failed.\n"
     "Progress is a bar on a terminal and a line per frame otherwise (--progress); a summary ends the batch, with the\n"
     "first frame's time (its warm-up) apart from the others'.\n"
+    "\n"
+    "Tracks: with --track the batch's frames are one stream, in the order the batch takes them: the INPUTs in the\n"
+    "order given, a folder's files and a pattern's matches by name (number the frames with leading zeros:\n"
+    "frame_0009 before frame_0010). One Segmenter segments them all, and each segment keeps its track id while the\n"
+    "camera moves (an object hidden for up to --track-hold frames gets its id back); a frame that fails is left out\n"
+    "of the stream, and one of another size (or other parameters: --sensor auto) restarts it, with a warning. The\n"
+    "labels outputs stay the frame's labels 1..K; the pictures (--png, --figure, --ply, --scene OUT.ply) are\n"
+    "coloured by track id, so that a segment keeps its colour and a video of them does not flicker. A backend\n"
+    "without tracks refuses --track with the library's error.\n"
     "\n";
 
 struct OutputPaths {
-    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, graph, scene, pcl_png;
+    std::optional<fs::path> labels, png, mask, figure, ply, pcd, stats, graph, scene, pcl_png, track_ids, tracks;
     [[nodiscard]] bool any() const {
-        return labels || png || mask || figure || ply || pcd || stats || graph || scene || pcl_png;
+        return labels || png || mask || figure || ply || pcd || stats || graph || scene || pcl_png || track_ids ||
+               tracks;
     }
 };
 
@@ -127,6 +145,8 @@ const std::vector<OutputOption>& output_options() {
         {"graph", &OutputPaths::graph, {".json", ".csv"}, "the segment graph, as JSON or CSV"},
         {"scene", &OutputPaths::scene, {".json", ".ply"}, "the scene, as JSON or a PLY mesh of its boxes"},
         {"pcl-png", &OutputPaths::pcl_png, {".png"}, "PCL's segmentation in colour, as PNG"},
+        {"track-ids", &OutputPaths::track_ids, {".npy", ".png"}, "track ids as a NumPy uint32 array or a 16-bit PNG"},
+        {"tracks", &OutputPaths::tracks, {".json", ".csv"}, "the tracks, as JSON or CSV"},
     };
     return options;
 }
@@ -181,23 +201,39 @@ struct RunNotes {
     // --sensor auto chooses once, on the first frame with enough depth to judge, and keeps it for the batch (one
     // camera's frames do not change sensor; a batch that switched presets frame by frame would not compare).
     std::optional<SensorKind> auto_sensor;
-    bool hinted = false;  // the hint to name a preset is given once per run
+    bool hinted = false;             // the hint to name a preset is given once per run
+    bool track = false;              // --track: the frames are one stream, their segments' ids carry over
+    std::uint32_t stream_frame = 0;  // with --track, the next frame's number in the stream (0 after a restart)
 };
 
-// .npy (uint32) or, when every label fits, a 16-bit PNG that image viewers and OpenCV read directly.
-void write_labels(const fs::path& path, const Result& result) {
+// Labels or track ids (`what`: "label", "track id"): .npy (uint32) or, when every value fits, a 16-bit PNG that
+// image viewers and OpenCV read directly.
+void write_id_image(const fs::path& path, const std::vector<std::uint32_t>& values, int width, int height,
+                    const char* what) {
     if (lower_extension(path) != ".png") {
-        io::write_npy(path, result.labels.data(), result.height, result.width);
+        io::write_npy(path, values.data(), height, width);
         return;
     }
-    const std::uint32_t largest =
-        result.labels.empty() ? 0u : *std::max_element(result.labels.begin(), result.labels.end());
+    const std::uint32_t largest = values.empty() ? 0u : *std::max_element(values.begin(), values.end());
     if (largest > 65535u) {
-        throw Error(ErrorCode::invalid_argument, path.string() + ": label " + std::to_string(largest) +
+        throw Error(ErrorCode::invalid_argument, path.string() + ": " + what + " " + std::to_string(largest) +
                                                      " does not fit a 16-bit PNG; write .npy instead");
     }
-    std::vector<std::uint16_t> gray(result.labels.begin(), result.labels.end());
-    io::write_png_gray16(path, gray.data(), result.width, result.height);
+    std::vector<std::uint16_t> gray(values.begin(), values.end());
+    io::write_png_gray16(path, gray.data(), width, height);
+}
+
+// The scene as its pictures show it (--scene OUT.ply, the figure's scene panel): with tracks, each support and
+// object under its segment's track id, so that its colour is the one --png gives the segment.
+Scene coloured_as_segments(const Scene& scene, const Result& result) {
+    if (result.tracks.empty()) return scene;
+    Scene coloured = scene;
+    const auto id = [&](std::uint32_t label) {
+        return label >= 1 && label <= result.tracks.size() ? result.tracks[label - 1].id : label;
+    };
+    for (SceneSupport& s : coloured.supports) s.label = id(s.label);
+    for (SceneObject& o : coloured.objects) o.label = id(o.label);
+    return coloured;
 }
 
 // One frame: read, segment (reusing the Segmenter while the size stays the same), write what was asked.
@@ -340,8 +376,19 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         outputs.fillable_mask = out.mask.has_value() || out.figure.has_value() || out.scene.has_value();
         outputs.segment_stats = out.stats.has_value() || out.scene.has_value();
         outputs.segment_graph = out.graph.has_value();
+        // With --track the id image is always made: the pictures are coloured by it.
+        outputs.segment_tracks = notes.track;
+        outputs.track_ids = notes.track;
+        if (notes.track && segmenter) {
+            std::fprintf(stderr,
+                         "pyrseg: warning: %s: the tracks restart at this frame (ids from 1 again): its size or "
+                         "parameters differ from the previous frame's\n",
+                         printable(input).c_str());
+        }
+        segmenter.reset();  // the old one's memory goes before the new one's is taken
         segmenter =
             std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
+        notes.stream_frame = 0;
     }
     const auto start = std::chrono::steady_clock::now();
     DepthView depth_view;
@@ -351,15 +398,22 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
     }
     const Result result = loaded.depth ? segmenter->segment(depth_view) : segmenter->segment(view);
     const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
+    const std::uint32_t stream_frame = notes.stream_frame++;
+    const io::SegmentTable table{result.width, result.height, params.unit_mm, input.string()};
 
     // All of the frame's outputs or none (tools/output_files.hpp).
     OutputFiles files;
-    if (out.labels) files.stage(*out.labels, [&](const fs::path& to) { write_labels(to, result); });
-    if (out.png) {
-        files.stage(*out.png, [&](const fs::path& to) {
-            write_png(to.string(), colorize(result.labels, result.width, result.height));
+    if (out.labels) {
+        files.stage(*out.labels, [&](const fs::path& to) {
+            write_id_image(to, result.labels, result.width, result.height, "label");
         });
     }
+    if (out.track_ids) {
+        files.stage(*out.track_ids, [&](const fs::path& to) {
+            write_id_image(to, result.track_ids, result.width, result.height, "track id");
+        });
+    }
+    if (out.png) files.stage(*out.png, [&](const fs::path& to) { write_png(to.string(), colorize_segments(result)); });
     if (out.mask) {
         files.stage(*out.mask, [&](const fs::path& to) {
             write_png(to.string(), mask_picture(result.fillable_mask, result.width, result.height));
@@ -379,12 +433,12 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
             // With --scene, a fourth panel: the boxes and support outlines over the segments, projected through the
             // pinhole the cloud was made with (the depth image's intrinsics, or fitted to an organized cloud).
             if (const std::optional<PinholeCamera> camera = fit_pinhole(cloud)) {
-                RgbImage base = colorize(result.labels, result.width, result.height);
+                RgbImage base = colorize_segments(result);
                 if (!loaded.color.empty()) base.rgb = loaded.color;
                 std::vector<Panel> panels = comparison_panels(result);
                 panels.push_back({"scene: " + std::to_string(scene.objects.size()) + " objects, " +
                                       std::to_string(scene.supports.size()) + " supports",
-                                  scene_picture(dimmed_gray(base), scene, *camera)});
+                                  scene_picture(dimmed_gray(base), coloured_as_segments(scene, result), *camera)});
                 figure = side_by_side(panels);
             } else {
                 figure = comparison_figure(result);
@@ -394,7 +448,7 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         files.stage(*out.figure, [&](const fs::path& to) { write_png(to.string(), figure); });
     }
     if (out.ply) {
-        files.stage(*out.ply, [&](const fs::path& to) { io::write_ply(to, cloud, result.labels.data(), true); });
+        files.stage(*out.ply, [&](const fs::path& to) { io::write_ply(to, cloud, colour_keys(result).data(), true); });
     }
     if (out.pcd) {
         files.stage(*out.pcd, [&](const fs::path& to) {
@@ -410,20 +464,20 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         pcl_note = "; " + std::to_string(pcl.regions) + " PCL regions (" + pcl.settings + ")";
     }
     if (out.stats) {
-        files.stage(*out.stats, [&](const fs::path& to) {
-            io::write_segment_stats(to, result.segments,
-                                    io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
-        });
+        files.stage(*out.stats, [&](const fs::path& to) { io::write_segment_stats(to, result.segments, table); });
     }
     if (out.graph) {
-        files.stage(*out.graph, [&](const fs::path& to) {
-            io::write_segment_graph(to, result.graph,
-                                    io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+        files.stage(*out.graph, [&](const fs::path& to) { io::write_segment_graph(to, result.graph, table); });
+    }
+    if (out.tracks) {
+        files.stage(*out.tracks, [&](const fs::path& to) {
+            write_text_file(to, segment_tracks_text(result.tracks, table, stream_frame, lower_extension(to) == ".csv"));
         });
     }
     if (out.scene) {
         files.stage(*out.scene, [&](const fs::path& to) {
-            io::write_scene(to, scene, io::SegmentTable{result.width, result.height, params.unit_mm, input.string()});
+            // The mesh in the pictures' colours; the JSON names the segments by label, as --stats does.
+            io::write_scene(to, lower_extension(to) == ".ply" ? coloured_as_segments(scene, result) : scene, table);
         });
     }
     files.commit();
@@ -476,22 +530,21 @@ std::vector<fs::path> expand_inputs(const std::vector<std::string>& names, bool 
     return inputs;
 }
 
-std::set<std::string> parse_write_list(const std::string& text) {
+std::set<std::string> parse_write_list(const std::string& text, bool track) {
+    constexpr const char* kKinds = "labels, png, mask, figure, ply, pcd, stats, graph, scene, track_ids, tracks";
     std::set<std::string> kinds;
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        if (item != "labels" && item != "png" && item != "mask" && item != "figure" && item != "ply" && item != "pcd" &&
-            item != "stats" && item != "graph" && item != "scene") {
-            throw UsageError{
-                "--write expects a list of labels, png, mask, figure, ply, pcd, stats, graph, scene; got '" + item +
-                "'"};
+        if (batch_output_suffixes().count(item) == 0) {
+            throw UsageError{std::string("--write expects a list of ") + kKinds + "; got '" + item + "'"};
+        }
+        if ((item == "track_ids" || item == "tracks") && !track) {
+            throw UsageError{"--write " + item + " needs --track (the frames as one stream whose segments keep ids)"};
         }
         kinds.insert(item);
     }
-    if (kinds.empty()) {
-        throw UsageError{"--write needs at least one of labels, png, mask, figure, ply, pcd, stats, graph, scene"};
-    }
+    if (kinds.empty()) throw UsageError{std::string("--write needs at least one of ") + kKinds};
     return kinds;
 }
 
@@ -533,7 +586,8 @@ struct BatchTimes {
 int run_batch(const Args& args, const Params& params, RunNotes& notes) {
     const std::string out_dir_name = *args.value("out-dir");
     const fs::path out_dir = out_dir_name;
-    const std::set<std::string> kinds = parse_write_list(args.value("write").value_or("labels,png"));
+    const std::set<std::string> kinds = parse_write_list(
+        args.value("write").value_or(notes.track ? "labels,png,track_ids" : "labels,png"), notes.track);
     const std::vector<fs::path> inputs = expand_inputs(args.positional(), args.value("color").has_value());
     if (inputs.empty()) throw Error(ErrorCode::io, "the batch has no input file");
     make_output_folder(out_dir_name);
@@ -565,6 +619,8 @@ int run_batch(const Args& args, const Params& params, RunNotes& notes) {
         out.stats = planned("stats");
         out.graph = planned("graph");
         out.scene = planned("scene");
+        out.track_ids = planned("track_ids");
+        out.tracks = planned("tracks");
         std::string failure;
         try {
             const FrameReport r = segment_frame(frame.input, args, params, out, segmenter, notes);
@@ -617,15 +673,16 @@ void say_backend_choice(const Args& args, const RunNotes& notes) {
 int cmd_segment(const std::vector<std::string>& argv) {
     std::set<std::string> values = kParameterValueOptions;
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
+    values.insert(kTrackValueOptions.begin(), kTrackValueOptions.end());
     for (const OutputOption& o : output_options()) values.insert(o.name);
     values.insert({"backend", "out-dir", "write", "progress", "color"});
     std::set<std::string> flags = kParameterFlagOptions;
-    flags.insert({"help", "quiet", "verbose"});
+    flags.insert({"help", "quiet", "verbose", "track"});
     const Args args(argv, values, flags, {{"-q", "quiet"}, {"-v", "verbose"}});
     if (args.flag("help")) {
         std::string usage = kSegmentUsage;
         usage.replace(usage.find("@BACKENDS@"), 10, backend_names_text());
-        std::printf("%s%s%s", usage.c_str(), kInputHelp, kParameterHelp);
+        std::printf("%s%s%s%s", usage.c_str(), kInputHelp, kParameterHelp, kTrackParameterHelp);
         return 0;
     }
     // Every option is checked before the first input is read: a mistake costs a message, not a partial run.
@@ -633,6 +690,18 @@ int cmd_segment(const std::vector<std::string>& argv) {
     if (args.flag("quiet") && args.flag("verbose")) throw UsageError{"give --quiet or --verbose, not both"};
     RunNotes notes;
     notes.quiet = args.flag("quiet");
+    notes.track = args.flag("track");
+    if (!notes.track) {
+        for (const char* option : {"track-ids", "tracks", "track-max-distance", "track-hold"}) {
+            if (args.value(option)) {
+                throw UsageError{"--" + std::string(option) +
+                                 " needs --track (the frames as one stream whose segments keep ids)"};
+            }
+        }
+    }
+    if (notes.track && args.flag("raw")) {
+        throw UsageError{"--track follows the compacted labels 1..K: leave out --raw"};
+    }
     check_input_options(args);
     const Params params = parse_params(args);
     if (args.value("out-dir")) {

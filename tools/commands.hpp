@@ -21,6 +21,8 @@ int cmd_demo(const std::vector<std::string>& args);
 int cmd_eval(const std::vector<std::string>& args);
 // `pyrseg eval --tabletop DIR` (cmd_eval_tabletop.cpp), which cmd_eval hands over to.
 int cmd_eval_tabletop(const std::vector<std::string>& args);
+// `pyrseg eval --tracks` (cmd_eval_tracks.cpp): track ids over synthetic sequences, which cmd_eval hands over to.
+int cmd_eval_tracks(const std::vector<std::string>& args);
 int cmd_bench_report(const std::vector<std::string>& args);
 
 // Parameters shared by the commands that segment: --ct --dt --unit-mm --bridge-levels --unjoinable-gap
@@ -28,6 +30,9 @@ int cmd_bench_report(const std::vector<std::string>& args);
 extern const char* const kParameterHelp;
 extern const std::set<std::string> kParameterValueOptions;
 extern const std::set<std::string> kParameterFlagOptions;
+// The tracks' parameters, --track-max-distance and --track-hold: segment's alone (parse_params reads them when given).
+extern const char* const kTrackParameterHelp;
+extern const std::set<std::string> kTrackValueOptions;
 // --sensor: a preset, or auto (chosen per frame by measure_frame_noise).
 struct SensorChoice {
     bool automatic = false;

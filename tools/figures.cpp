@@ -50,6 +50,15 @@ RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int heigh
     return RgbImage{width, height, io::colorize_labels(labels.data(), width, height)};
 }
 
+const std::vector<std::uint32_t>& colour_keys(const Result& result) {
+    return result.track_ids.size() == result.labels.size() && !result.track_ids.empty() ? result.track_ids
+                                                                                        : result.labels;
+}
+
+RgbImage colorize_segments(const Result& result) {
+    return colorize(colour_keys(result), result.width, result.height);
+}
+
 RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height) {
     RgbImage img{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 3)};
     for (std::size_t i = 0; i < fillable.size(); ++i)
@@ -85,7 +94,8 @@ std::vector<Panel> comparison_panels(const Result& r) {
     const auto ccl = eval::connected_components(r.fillable_mask, r.width, r.height, &ccl_count);
     return {{"fillable mask", mask_picture(r.fillable_mask, r.width, r.height)},
             {"connected components: " + std::to_string(ccl_count), colorize(ccl, r.width, r.height)},
-            {"pyramid: " + std::to_string(r.segment_count), colorize(r.labels, r.width, r.height)}};
+            {"pyramid: " + std::to_string(r.segment_count) + (&colour_keys(r) == &r.track_ids ? ", by track" : ""),
+             colorize_segments(r)}};
 }
 
 RgbImage comparison_figure(const Result& r) {

@@ -17,6 +17,11 @@ struct RgbImage {
 };
 
 [[nodiscard]] RgbImage colorize(const std::vector<std::uint32_t>& labels, int width, int height);
+// What a result's segments are coloured by: their track ids when it has them (Outputs::track_ids, pyrseg segment
+// --track), so that a segment keeps its colour from frame to frame and a video of the pictures does not flicker as
+// the labels 1..K are renumbered; else their labels.
+[[nodiscard]] const std::vector<std::uint32_t>& colour_keys(const Result& result);
+[[nodiscard]] RgbImage colorize_segments(const Result& result);  // colorize(colour_keys(result), ...)
 [[nodiscard]] RgbImage mask_picture(const std::vector<std::uint8_t>& fillable, int width, int height);
 
 struct Panel {

@@ -61,6 +61,16 @@ const char* const kParameterHelp =
     "                        (default 2 mm), plus --planar-tolerance-per-m2 MM per square metre of depth.\n"
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
+const char* const kTrackParameterHelp =
+    "Track parameters (segment --track; docs/algorithm.md section 11):\n"
+    "  --track-max-distance MM   a segment that no segment of the previous frame overlaps enough takes the id of a\n"
+    "                        track whose centroid, moved by the camera's motion, is at most MM millimetres from its\n"
+    "                        own (default 50; 0 finds only a track exactly where it was)\n"
+    "  --track-hold FRAMES   a track not seen for more than FRAMES frames is dropped; one seen again within them\n"
+    "                        (an object hidden for a while) gets its id back (0..1000, default 10)\n";
+
+const std::set<std::string> kTrackValueOptions = {"track-max-distance", "track-hold"};
+
 const std::set<std::string> kParameterValueOptions = {"ct",
                                                       "dt",
                                                       "unit-mm",
@@ -137,6 +147,8 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("color-edge-curvature")) p.color_edge_curvature_share = *v;
     if (auto v = args.number("planar-tolerance")) p.planar_tolerance_mm = *v;
     if (auto v = args.number("planar-tolerance-per-m2")) p.planar_tolerance_per_m2 = *v;
+    if (auto v = args.number("track-max-distance")) p.track_max_distance_mm = *v;
+    if (auto v = args.integer("track-hold")) p.track_hold_frames = *v;
     p.label_edges = !args.flag("no-label-edges");
     p.compact = !args.flag("raw");
     return p;

@@ -31,6 +31,24 @@ inline constexpr int kMaxObjectCount = 1000;
 // The depth camera whose noise and missing data the frame shows.
 enum class Sensor : std::uint8_t { structured_light, kinect_v1, realsense_d435, azure_kinect };
 
+// Where the camera is, relative to where generate() puts it by default, in the default camera's frame (x right, y
+// down, z forward, mm): the moved camera's axes are the columns of rotation (row-major, orthonormal, right-handed)
+// and its centre is translation. A point at p in the default camera's frame is at rotation^T (p - translation) in
+// the moved camera's. The projector (or second imager) moves with the camera.
+struct Pose {
+    std::array<std::array<double, 3>, 3> rotation{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    std::array<double, 3> translation{};
+    friend bool operator==(const Pose&, const Pose&) = default;
+};
+
+// One object of the layout moved or left out of a frame (the objects of a sequence that move, leave and appear).
+struct ObjectChange {
+    std::uint32_t id = 0;            // an object's id (kFirstObjectId and up); ids the layout did not place are ignored
+    std::array<double, 3> offset{};  // mm, in the default camera's frame (before camera_pose)
+    bool hidden = false;             // left out of the frame: what it hid shows
+    friend bool operator==(const ObjectChange&, const ObjectChange&) = default;
+};
+
 struct SceneOptions {
     int width = 640;
     int height = 480;
@@ -52,6 +70,13 @@ struct SceneOptions {
     // hole_fraction = 0 always gives a complete frame.
     bool shadows = true;
     int threads = 0;  // 0: one per hardware thread; the output does not depend on it
+    // The frame of a sequence (sequence() sets these; the defaults give the still scene): the camera's pose relative
+    // to where camera_distance_mm puts it; objects moved or left out (at most one change per id); and the seed of
+    // the depth noise and of the sensor models' random fields (0: seed), so that frames of one scene differ in
+    // their noise as a real camera's do. The layout and the missing-data blobs follow seed alone.
+    Pose camera_pose;
+    std::vector<ObjectChange> object_changes;
+    std::uint64_t noise_seed = 0;
 };
 
 enum class Shape : std::uint8_t { plane, box, cylinder, sphere };
@@ -83,8 +108,34 @@ struct Scene {
 
 // Throws std::invalid_argument for width or height outside 1..max_image_side, object_count outside
 // 0..max_object_count, noise_mm negative or not finite, hole_fraction outside 0..1, camera_distance_mm outside
-// 300..6000, an unknown sensor, or threads negative.
+// 300..6000, an unknown sensor, threads negative, a camera_pose whose rotation is not a rotation (within 1e-6) or
+// whose numbers are not finite, or an object change with an id below kFirstObjectId, an id changed twice or an
+// offset not finite. The camera must stay outside every solid (the floor's side of it).
 PYRSEG_SYNTHETIC_EXPORT Scene generate(const SceneOptions& options);
+
+// A sequence of frames of one scene for tracking (`pyrseg eval --tracks`): the camera on a smooth random walk that
+// starts at its default pose, and, with object_motion, objects that slide, vanish for a few frames (occluded) and
+// come back, leave for good, or appear later. The walk's velocity and turn rate are sums of three cosines per axis
+// (periods 20..60 frames, seeded), scaled so that the largest step between two frames is max_step_mm and the
+// largest turn max_turn_deg (a typical step is half the largest). Sums of cosines keep the camera near its start:
+// with the defaults, seeds 1..6 stay within 161 mm and 25 degrees of it over 300 frames.
+struct SequenceOptions {
+    SceneOptions scene;       // the scene and the sensor; its camera_pose, object_changes and noise_seed are replaced
+    int frames = 300;         // 1..100000
+    double max_step_mm = 20;  // the camera moves at most this far from one frame to the next, 0..200
+    double max_turn_deg = 2;  // and turns at most this much, 0..30
+    bool object_motion = false;
+    // With object_motion, for each object in turn (seeded): with probability 0.4 it slides along the floor to and
+    // fro (15..40 mm from where it lay, one period in 60..150 frames, so at most 4.2 mm a frame); with
+    // probability 0.5 it is hidden for 2..8 frames once, anywhere after frame 0; with probability 0.1 it leaves for
+    // good after the first third, else with probability 0.1 it appears (is hidden until a frame in the first two
+    // thirds).
+};
+
+// Each frame's options for generate(): the scene's, with the frame's camera_pose, object_changes and noise_seed
+// (frame 0: the default pose and the scene's own noise). Throws std::invalid_argument for options out of range, as
+// generate() does for the scene.
+PYRSEG_SYNTHETIC_EXPORT std::vector<SceneOptions> sequence(const SequenceOptions& options);
 
 // Pairs of objects (ids a < b, sorted) that no depth data can tell apart: two upright boxes whose top faces lie in
 // one plane (within 0.05 mm) and touch along a side (within 0.05 mm), as identical parts packed side by side in a

@@ -15,6 +15,7 @@ from ._pyrseg import (  # noqa: F401
     Result,
     Scene,
     Segmenter,
+    TrackMatch,
     __version__,
     backends,
     choose_backend,
@@ -29,6 +30,7 @@ from ._pyrseg import (  # noqa: F401
     scene_support_dtype,
     segment_graph_dtype,
     segment_stats_dtype,
+    segment_track_dtype,
     synthetic,
 )
 
@@ -45,6 +47,7 @@ __all__ = [
     "Result",
     "Scene",
     "Segmenter",
+    "TrackMatch",
     "backends",
     "choose_backend",
     "default_params",
@@ -58,5 +61,6 @@ __all__ = [
     "scene_support_dtype",
     "segment_graph_dtype",
     "segment_stats_dtype",
+    "segment_track_dtype",
     "synthetic",
 ]

@@ -9,6 +9,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct Cached {
     PyObject* backend_type = nullptr;  // pyrseg.BackendInfo (a named tuple)
     PyObject* stats_dtype = nullptr;   // pyrseg.segment_stats_dtype
     PyObject* graph_dtype = nullptr;   // pyrseg.segment_graph_dtype
+    PyObject* track_dtype = nullptr;   // pyrseg.segment_track_dtype
     PyObject* uint32 = nullptr;
     PyObject* uint8 = nullptr;
     PyObject* float32 = nullptr;
@@ -131,6 +133,10 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.planar_tolerance_mm = number(kInit, name, v);
     } else if (key == "planar_tolerance_per_m2") {
         p.planar_tolerance_per_m2 = number(kInit, name, v);
+    } else if (key == "track_max_distance_mm") {
+        p.track_max_distance_mm = number(kInit, name, v);
+    } else if (key == "track_hold_frames") {
+        p.track_hold_frames = whole();
     } else {
         return false;
     }
@@ -158,9 +164,14 @@ Outputs outputs_from(const py::handle& names) {
             o.segment_stats = true;
         } else if (name == "segment_graph") {
             o.segment_graph = true;
+        } else if (name == "segment_tracks") {
+            o.segment_tracks = true;
+        } else if (name == "track_ids") {
+            o.track_ids = true;
         } else {
             throw py::value_error("unknown output '" + name +
-                                  "'; outputs: raw_labels, fillable_mask, normals, segment_stats, segment_graph");
+                                  "'; outputs: raw_labels, fillable_mask, normals, segment_stats, segment_graph, "
+                                  "segment_tracks, track_ids");
         }
     }
     return o;
@@ -191,8 +202,8 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
                                  "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
                                  "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
                                  "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
-                                 "planar_tolerance_mm, planar_tolerance_per_m2; and preset, "
-                                 "outputs, cuda_stream, threads");
+                                 "planar_tolerance_mm, planar_tolerance_per_m2, track_max_distance_mm, "
+                                 "track_hold_frames; and preset, outputs, cuda_stream, threads");
         }
     }
     return p;
@@ -360,7 +371,16 @@ public:
         if (outputs_.normals) names.append("normals");
         if (outputs_.segment_stats) names.append("segment_stats");
         if (outputs_.segment_graph) names.append("segment_graph");
+        if (outputs_.segment_tracks) names.append("segment_tracks");
+        if (outputs_.track_ids) names.append("track_ids");
         return py::tuple(names);
+    }
+    // The next frame starts a new stream of tracks (ids from 1 again). Before preset="auto" has made the Segmenter,
+    // there is no stream to restart.
+    void reset_tracks() {
+        const py::gil_scoped_release nogil;
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (segmenter_) segmenter_->reset_tracks();
     }
     [[nodiscard]] bool last_input_copied() const { return last_copied_; }
     [[nodiscard]] py::dict timings() {
@@ -459,9 +479,11 @@ private:
         py::array labels = out.is_none() ? new_array(cached.uint32, h, w) : check_labels_out(out, w, h);
         if (!out.is_none()) input.refuse_alias(labels);
         py::object raw = py::none(), mask = py::none(), normals = py::none(), segments = py::none(), graph = py::none();
+        py::object tracks = py::none(), track_ids = py::none();
         void* raw_data = nullptr;
         void* mask_data = nullptr;
         void* normals_data = nullptr;
+        void* track_ids_data = nullptr;
         if (outputs_.raw_labels) {
             auto a = new_array(cached.uint32, h, w);
             raw_data = a.mutable_data();
@@ -476,6 +498,11 @@ private:
             auto a = new_array(cached.float32, h, w, 3);
             normals_data = a.mutable_data();
             normals = std::move(a);
+        }
+        if (outputs_.track_ids) {
+            auto a = new_array(cached.uint32, h, w);
+            track_ids_data = a.mutable_data();
+            track_ids = std::move(a);
         }
         std::uint32_t count = 0;
         const std::size_t pixels = std::size_t(w) * std::size_t(h);
@@ -501,6 +528,7 @@ private:
             if (raw_data != nullptr) copy(raw_data, result_.raw_labels, pixels, "raw label");
             if (mask_data != nullptr) copy(mask_data, result_.fillable_mask, pixels, "fillable mask");
             if (normals_data != nullptr) copy(normals_data, result_.normals, pixels * 3, "normal");
+            if (track_ids_data != nullptr) copy(track_ids_data, result_.track_ids, pixels, "track id");
             count = result_.segment_count;
             // Under the lock, so that another thread's frame cannot overwrite the records being read: a structured
             // array of `dtype` holding a copy of them.
@@ -514,8 +542,13 @@ private:
             };
             if (outputs_.segment_stats) segments = records(result_.segments, cached.stats_dtype);
             if (outputs_.segment_graph) graph = records(result_.graph, cached.graph_dtype);
+            // track_ids implies segment_tracks (pyrseg::Outputs): the tracks the ids are of come with them.
+            if (outputs_.segment_tracks || outputs_.track_ids) {
+                check(result_.tracks, count, "track");
+                tracks = records(result_.tracks, cached.track_dtype);
+            }
         }
-        return obj(cached.result_type)(labels, count, segments, normals, mask, raw, graph);
+        return obj(cached.result_type)(labels, count, segments, normals, mask, raw, graph, tracks, track_ids);
     }
 
     Params params_;
@@ -619,6 +652,30 @@ py::object graph_dtype() {
     return py::module_::import("numpy").attr("dtype")(spec);
 }
 
+py::object track_dtype() {
+    py::list names, formats, offsets;
+    for (const auto& [name, offset] : {std::pair{"label", offsetof(SegmentTrack, label)},
+                                       {"id", offsetof(SegmentTrack, id)},
+                                       {"first_frame", offsetof(SegmentTrack, first_frame)},
+                                       {"age", offsetof(SegmentTrack, age)},
+                                       {"hidden_frames", offsetof(SegmentTrack, hidden_frames)}}) {
+        names.append(name);
+        formats.append("<u4");
+        offsets.append(offset);
+    }
+    // TrackMatch's value (pyrseg.TrackMatch): one byte.
+    static_assert(sizeof(TrackMatch) == 1 && std::is_trivially_copyable_v<SegmentTrack>);
+    names.append("how");
+    formats.append("u1");
+    offsets.append(offsetof(SegmentTrack, how));
+    py::dict spec;
+    spec["names"] = names;
+    spec["formats"] = formats;
+    spec["offsets"] = offsets;
+    spec["itemsize"] = sizeof(SegmentTrack);
+    return py::module_::import("numpy").attr("dtype")(spec);
+}
+
 py::list backends() {
     py::list l;
     for (const BackendInfo& b : list_backends()) {
@@ -658,10 +715,25 @@ void bind_segmenter(py::module_& m) {
     m.attr("segment_stats_dtype") = obj(cached.stats_dtype);
     cached.graph_dtype = keep(graph_dtype());
     m.attr("segment_graph_dtype") = obj(cached.graph_dtype);
-    cached.result_type = keep(namedtuple(
-        "Result",
-        py::make_tuple("labels", "segment_count", "segments", "normals", "fillable_mask", "raw_labels", "graph"),
-        py::arg("module") = module_name));
+    cached.track_dtype = keep(track_dtype());
+    m.attr("segment_track_dtype") = obj(cached.track_dtype);
+    // How a segment got its id, as segment_track_dtype's `how` holds it: an IntEnum, so that numpy compares the
+    // field with it (tracks["how"] == pyrseg.TrackMatch.overlap) and TrackMatch(code).name names a code.
+    py::list matches;
+    matches.append(py::make_tuple("new_track", int(TrackMatch::new_track)));
+    matches.append(py::make_tuple("overlap", int(TrackMatch::overlap)));
+    matches.append(py::make_tuple("position", int(TrackMatch::position)));
+    const py::object track_match =
+        py::module_::import("enum").attr("IntEnum")("TrackMatch", matches, py::arg("module") = module_name);
+    track_match.attr("__doc__") =
+        "How a segment got its track id (segment_track_dtype's how): new_track (it matched no track), overlap (the "
+        "previous frame's segment it overlaps most, and that overlaps it most), position (a track not matched by "
+        "overlap, found where the camera's motion put it) (docs/algorithm.md section 11).";
+    m.attr("TrackMatch") = track_match;
+    cached.result_type = keep(namedtuple("Result",
+                                         py::make_tuple("labels", "segment_count", "segments", "normals",
+                                                        "fillable_mask", "raw_labels", "graph", "tracks", "track_ids"),
+                                         py::arg("module") = module_name));
     m.attr("Result") = obj(cached.result_type);
     m.attr("Result").attr("__doc__") =
         "One frame's results. labels: H x W uint32 (the out= array when given), 0 for no segment; segment_count: "
@@ -669,7 +741,10 @@ void bind_segmenter(py::module_& m) {
         "normals: H x W x 3 float32, fillable_mask: H x W uint8, raw_labels: H x W uint32 (each None unless asked "
         "for in outputs=); graph: the segment graph, one segment_graph_dtype entry per pair of touching segments "
         "(a < b, their labels; length, the crossings of their boundary; flat, convex, concave, step, the crossings "
-        "of each kind), by increasing (a, b) (outputs 'segment_graph', else None).";
+        "of each kind), by increasing (a, b) (outputs 'segment_graph', else None); tracks: K entries of "
+        "segment_track_dtype, segment k at k - 1 (label, its track id, first_frame, age, hidden_frames, how: a "
+        "TrackMatch) (outputs 'segment_tracks' or 'track_ids', else None); track_ids: H x W uint32, each labelled "
+        "pixel's track id, 0 where unlabelled (outputs 'track_ids', else None).";
     cached.backend_type = keep(namedtuple(
         "BackendInfo", py::make_tuple("name", "available", "reason", "devices", "emulated", "emulated_device"),
         py::arg("module") = module_name));
@@ -690,8 +765,11 @@ metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_gro
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
 merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride, color_edge_curvature_share (the
 colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when
-a segment's statistics call it planar) (docs/algorithm.md).
-outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats", "segment_graph".
+a segment's statistics call it planar); track_max_distance_mm, track_hold_frames (tracks: how far a segment may be
+from where a track was predicted, and how many frames a track unseen is kept) (docs/algorithm.md).
+outputs: names among "raw_labels", "fillable_mask", "normals", "segment_stats", "segment_graph", "segment_tracks"
+(ids that carry over from frame to frame: the Segmenter's frames are one stream until reset_tracks(); a backend
+without tracks raises pyrseg.Error, backend_unavailable), "track_ids" (an image of them).
 cuda_stream: the CUDA stream device frames go on (backend "cuda" only): an int cudaStream_t, or a cupy/torch
 stream; None is the legacy default stream.
 threads: the CPU backend's threads, 1 to 1024, an arena of its own (backend "cpu" only); None shares the oneTBB
@@ -732,6 +810,10 @@ H x W x 3 uint8 image registered to the depth (R, G, B), for the colour edge ter
              [](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
                  return segmenter_of(self).segment_mask(args, kwargs);
              });
+    segmenter.def(
+        "reset_tracks", [](const py::object& self) { segmenter_of(self).reset_tracks(); },
+        "With outputs 'segment_tracks' or 'track_ids', the next frame starts a new stream: no track carries over "
+        "into it, and its ids start at 1 again.");
     segmenter.def_property_readonly("width", [](const py::object& self) { return segmenter_of(self).width(); })
         .def_property_readonly("height", [](const py::object& self) { return segmenter_of(self).height(); })
         .def_property_readonly("backend", [](const py::object& self) { return segmenter_of(self).backend(); })
@@ -889,6 +971,8 @@ py::dict params_to_dict(const Params& p) {
     d["color_edge_curvature_share"] = p.color_edge_curvature_share;
     d["planar_tolerance_mm"] = p.planar_tolerance_mm;
     d["planar_tolerance_per_m2"] = p.planar_tolerance_per_m2;
+    d["track_max_distance_mm"] = p.track_max_distance_mm;
+    d["track_hold_frames"] = p.track_hold_frames;
     return d;
 }
 

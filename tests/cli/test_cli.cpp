@@ -1233,4 +1233,217 @@ TEST(Cli, LabelledPcdIsPointXYZLWithTheSameLabels) {
     fs::remove_all(dir);
 }
 
+// --- Tracks (pyrseg segment --track; docs/algorithm.md section 11) ---------------------------------------------------
+
+// Three frames of a camera panning over a synthetic scene, kTrackShift pixels a frame, as binary PCDs in
+// DIR/frames: frame_N.pcd is the scene's columns N * kTrackShift .. N * kTrackShift + kTrackWidth - 1.
+constexpr int kTrackWidth = 320;
+constexpr int kTrackHeight = 240;
+constexpr int kTrackShift = 2;
+constexpr int kTrackFrames = 3;
+
+void write_pan(const fs::path& folder) {
+    fs::create_directories(folder);
+    pyrseg::synthetic::SceneOptions o;
+    o.width = kTrackWidth + kTrackShift * (kTrackFrames - 1);
+    o.height = kTrackHeight;
+    o.seed = 5;
+    o.object_count = 10;
+    o.hole_fraction = 0.0;
+    const pyrseg::synthetic::Scene wide = pyrseg::synthetic::generate(o);
+    for (int f = 0; f < kTrackFrames; ++f) {
+        pyrseg::io::PointCloud cloud;
+        cloud.width = kTrackWidth;
+        cloud.height = kTrackHeight;
+        cloud.points.resize(3 * std::size_t(kTrackWidth) * kTrackHeight);
+        for (int y = 0; y < kTrackHeight; ++y) {
+            std::copy_n(wide.points.data() + 3 * (std::size_t(y) * std::size_t(o.width) + std::size_t(f * kTrackShift)),
+                        3 * std::size_t(kTrackWidth), cloud.points.data() + 3 * std::size_t(y) * kTrackWidth);
+        }
+        pyrseg::io::write_pcd(folder / ("frame_" + std::to_string(f) + ".pcd"), cloud, pyrseg::io::PcdEncoding::binary);
+    }
+}
+
+// A frame's pixel (x, y) is the pixel (x + kTrackShift * (b - a), y) of an earlier frame a of the pan: calls
+// `both(i_a, i_b)` for the pixels the two frames share.
+template <class Both>
+void shared_pixels(int a, int b, const Both& both) {
+    const int shift = kTrackShift * (b - a);
+    for (int y = 0; y < kTrackHeight; ++y) {
+        for (int x = 0; x + shift < kTrackWidth; ++x) {
+            both(std::size_t(y) * kTrackWidth + std::size_t(x + shift), std::size_t(y) * kTrackWidth + std::size_t(x));
+        }
+    }
+}
+
+// A batch with --track is one stream: the same surface has the same track id in every frame (the labels 1..K are
+// renumbered as the camera pans), the tracks file agrees with the id image, and the colour pictures colour each
+// pixel by its id, so that a pixel that keeps its id keeps its colour.
+TEST(CliTracks, ABatchIsOneStreamWhoseIdsAndColoursCarryOver) {
+    const fs::path dir = temp_dir() / "tracks_batch";
+    fs::remove_all(dir);
+    write_pan(dir / "frames");
+    const CliRun r = run("segment " + (dir / "frames").string() + " --out-dir " + (dir / "out").string() +
+                         " --track --write labels,png,track_ids,tracks --progress none --backend cpu");
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::vector<std::vector<std::uint32_t>> labels, ids;
+    std::vector<pyrseg::io::Image> pictures;
+    for (int f = 0; f < kTrackFrames; ++f) {
+        const fs::path stem = dir / "out" / ("frame_" + std::to_string(f));
+        labels.push_back(read_labels(stem.string() + ".labels.npy"));
+        ids.push_back(read_labels(stem.string() + ".track_ids.npy"));
+        pictures.push_back(pyrseg::io::read_png(stem.string() + ".png"));
+        ASSERT_EQ(ids.back().size(), std::size_t(kTrackWidth) * kTrackHeight);
+        ASSERT_EQ(labels.back().size(), ids.back().size());
+        ASSERT_EQ(pictures.back().channels, 3);
+        std::ifstream file(stem.string() + ".tracks.json");
+        const nlohmann::json doc = nlohmann::json::parse(file);
+        EXPECT_EQ(doc["stream_frame"].get<int>(), f);
+        const nlohmann::json& tracks = doc["tracks"];
+        const std::uint32_t k = *std::max_element(labels.back().begin(), labels.back().end());
+        ASSERT_EQ(tracks.size(), k);
+        ASSERT_EQ(doc["track_count"].get<std::size_t>(), k);
+        for (std::uint32_t l = 1; l <= k; ++l) {
+            EXPECT_EQ(tracks[l - 1]["label"].get<std::uint32_t>(), l);
+            if (f == 0) {
+                EXPECT_EQ(tracks[l - 1]["how"].get<std::string>(), "new_track");
+            }
+        }
+        for (std::size_t i = 0; i < ids.back().size(); ++i) {
+            const std::uint32_t l = labels.back()[i];
+            ASSERT_EQ(ids.back()[i], l == 0 ? 0u : tracks[l - 1]["id"].get<std::uint32_t>()) << "pixel " << i;
+        }
+    }
+    for (int a = 0; a < kTrackFrames; ++a) {
+        for (int b = a + 1; b < kTrackFrames; ++b) {
+            std::size_t both = 0, same_id = 0, same_label = 0, relabelled = 0, recoloured = 0;
+            std::string first_recoloured;
+            shared_pixels(a, b, [&](std::size_t in_a, std::size_t in_b) {
+                const std::uint32_t id = ids[std::size_t(a)][in_a];
+                if (id == 0 || ids[std::size_t(b)][in_b] == 0) return;
+                ++both;
+                same_label += labels[std::size_t(a)][in_a] == labels[std::size_t(b)][in_b] ? 1 : 0;
+                if (ids[std::size_t(b)][in_b] != id) return;
+                ++same_id;
+                relabelled += labels[std::size_t(a)][in_a] != labels[std::size_t(b)][in_b] ? 1 : 0;
+                const std::uint8_t* ca = pictures[std::size_t(a)].data.data() + 3 * in_a;
+                const std::uint8_t* cb = pictures[std::size_t(b)].data.data() + 3 * in_b;
+                if (!std::equal(ca, ca + 3, cb) && recoloured++ == 0) {
+                    first_recoloured = "pixel " + std::to_string(in_b) + " keeps track id " + std::to_string(id);
+                }
+            });
+            ASSERT_GT(both, 0u);
+            EXPECT_EQ(recoloured, 0u) << "frames " << a << " and " << b << ": " << first_recoloured
+                                      << " but changes colour";
+            EXPECT_GE(double(same_id) / double(both), 0.99) << "frames " << a << " and " << b;
+            // The scene must be one whose labels change in the pan, else the colours would say nothing.
+            EXPECT_LT(same_label, same_id) << "frames " << a << " and " << b;
+            EXPECT_GT(relabelled, 1000u) << "frames " << a << " and " << b;
+        }
+    }
+    fs::remove_all(dir);
+}
+
+// The tracks' single-frame outputs, their formats, and what --track refuses.
+TEST(CliTracks, OutputsParametersAndRefusals) {
+    const fs::path dir = temp_dir() / "tracks_outputs";
+    fs::remove_all(dir);
+    write_pan(dir / "frames");
+    const std::string frame = "segment " + (dir / "frames" / "frame_0.pcd").string() + " --backend cpu";
+    CliRun r =
+        run(frame + " --track --labels " + (dir / "l.npy").string() + " --track-ids " + (dir / "t.png").string() +
+            " --tracks " + (dir / "t.csv").string() + " --track-hold 3" + " --track-max-distance 20");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const pyrseg::io::Image ids = pyrseg::io::read_png(dir / "t.png");
+    EXPECT_EQ(ids.bit_depth, 16);
+    EXPECT_EQ(ids.channels, 1);
+    const std::vector<std::uint32_t> labels = read_labels(dir / "l.npy");
+    const std::uint32_t k = *std::max_element(labels.begin(), labels.end());
+    std::ifstream csv(dir / "t.csv");
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "label,id,first_frame,age,hidden_frames,how");
+    std::uint32_t rows = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        // One frame is a stream of one: every segment is new, its id its label.
+        EXPECT_EQ(line, std::to_string(rows) + "," + std::to_string(rows) + ",0,1,0,new_track");
+    }
+    EXPECT_EQ(rows, k);
+    // Everything about tracks needs --track.
+    for (const std::string& without :
+         {frame + " --tracks " + (dir / "x.json").string(), frame + " --track-ids " + (dir / "x.npy").string(),
+          frame + " --track-hold 3", frame + " --track-max-distance 5",
+          "segment " + (dir / "frames").string() + " --out-dir " + (dir / "o").string() + " --write labels,tracks"}) {
+        r = run(without);
+        EXPECT_EQ(r.status, 2) << without << "\n" << r.output;
+        EXPECT_NE(r.output.find("needs --track"), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o"));
+    r = run(frame + " --track --raw");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("leave out --raw"), std::string::npos) << r.output;
+    // The library checks the parameters, and the CLI prints its error.
+    r = run(frame + " --track --track-hold 1001");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("track_hold_frames must be in 0..1000"), std::string::npos) << r.output;
+    r = run(frame + " --track --track-max-distance -1");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("track_max_distance_mm"), std::string::npos) << r.output;
+    r = run(frame + " --track --tracks " + (dir / "t.txt").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--tracks"), std::string::npos) << r.output;
+    // A batch with --track writes the id images by default.
+    r = run("segment " + (dir / "frames").string() + " --out-dir " + (dir / "out").string() +
+            " --track --progress none --backend cpu");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* name : {"frame_2.labels.npy", "frame_2.png", "frame_2.track_ids.npy"}) {
+        EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+    }
+    // A frame of another size starts the stream over, and says so.
+    pyrseg::io::write_pcd(dir / "frames" / "frame_3.pcd", pyrseg::cli_test::scene_cloud(160, 120, 5),
+                          pyrseg::io::PcdEncoding::binary);
+    r = run("segment " + (dir / "frames").string() + " --out-dir " + (dir / "restart").string() +
+            " --track --write tracks --progress none --backend cpu");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("frame_3.pcd: the tracks restart at this frame"), std::string::npos) << r.output;
+    for (const auto& [name, stream_frame] : {std::pair{"frame_2.tracks.json", 2}, {"frame_3.tracks.json", 0}}) {
+        std::ifstream file(dir / "restart" / name);
+        EXPECT_EQ(nlohmann::json::parse(file)["stream_frame"].get<int>(), stream_frame) << name;
+    }
+    const std::string help = run("segment --help").output;
+    for (const char* option : {"--track ", "--track-ids OUT.npy", "--tracks OUT.json", "--track-max-distance MM",
+                               "--track-hold FRAMES", "Tracks: with --track"}) {
+        EXPECT_NE(help.find(option), std::string::npos) << option;
+    }
+    fs::remove_all(dir);
+}
+
+// A backend without tracks refuses --track with the library's error (ErrorCode::backend_unavailable); one with them
+// gives the cpu backend's ids (the same on every backend).
+TEST(CliTracks, OtherBackendsRefuseOrAgree) {
+    const fs::path dir = temp_dir() / "tracks_backends";
+    fs::remove_all(dir);
+    write_pan(dir / "frames");
+    const std::string frames = "segment " + (dir / "frames").string() + " --track --progress none --write track_ids";
+    ASSERT_EQ(run(frames + " --backend cpu --out-dir " + (dir / "cpu").string()).status, 0);
+    for (const pyrseg::BackendInfo& b : pyrseg::list_backends()) {
+        if (b.name == "cpu" || !b.available) continue;
+        const CliRun single = run("segment " + (dir / "frames" / "frame_0.pcd").string() + " --track --backend " +
+                                  b.name + " --track-ids " + (dir / (b.name + ".npy")).string());
+        if (single.status != 0) {
+            EXPECT_EQ(single.status, 1) << single.output;
+            EXPECT_NE(single.output.find("tracks"), std::string::npos) << single.output;
+            continue;
+        }
+        const CliRun batch = run(frames + " --backend " + b.name + " --out-dir " + (dir / b.name).string());
+        ASSERT_EQ(batch.status, 0) << batch.output;
+        for (int f = 0; f < kTrackFrames; ++f) {
+            const std::string name = "frame_" + std::to_string(f) + ".track_ids.npy";
+            EXPECT_EQ(read_labels(dir / b.name / name), read_labels(dir / "cpu" / name)) << b.name << " " << name;
+        }
+    }
+    fs::remove_all(dir);
+}
+
 }  // namespace

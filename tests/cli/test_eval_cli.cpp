@@ -1,12 +1,14 @@
 // `pyrseg eval`, run as a user runs it: the quick sweeps (sensor models x distances, and the noise sweep) write their
 // tables and plots, and on them the pyramid merges no more ground-truth objects than plain connected components once
-// bridges are added (the paper's claim).
+// bridges are added (the paper's claim); `eval --tracks` writes its tables of ids over sequences.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -168,8 +170,8 @@ std::vector<Table> tables_of(const fs::path& report) {
     std::string heading;
     bool in_table = false;
     for (std::string line; std::getline(in, line);) {
-        if (line.rfind("#", 0) == 0) heading = line;
-        if (line.rfind("|", 0) != 0) {
+        if (line.rfind('#', 0) == 0) heading = line;
+        if (line.rfind('|', 0) != 0) {
             in_table = false;
             continue;
         }
@@ -286,6 +288,75 @@ TEST(CliEval, DefaultParamsAreScoredOnConsumerModelsToo) {
     EXPECT_EQ(text.str().find("robust metric"), std::string::npos) << text.str();
     expect_png(dir / "merge_rate_kinect-v1_320x240.png");
     fs::remove_all(dir);
+}
+
+// `pyrseg eval --tracks`: a tiny run's report has a table per scenario with every method, the acceptance checks
+// and every sequence; the methods score the same segments, so they see the same objects, frames and matches.
+TEST(CliEval, TracksReportHasTheTablesAndTheMethods) {
+    const fs::path dir = fs::temp_directory_path() / ("pyrseg_eval_tracks_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const CliRun r =
+        run("eval --tracks --frames 10 --size 160x120 --seeds 1 --sensors structured-light "
+            "--progress lines --out-dir " +
+            dir.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("[20/20] structured-light, objects, seed 1: frame 10/10"), std::string::npos) << r.output;
+    std::ifstream in(dir / "tracks.md");
+    ASSERT_TRUE(in) << "no tracks.md";
+    std::string section;
+    std::vector<std::string> header;
+    std::map<std::string, std::vector<std::vector<std::string>>> rows;  // by section
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("## ", 0) == 0) section = line.substr(3);
+        if (line.rfind("| sensor | method", 0) == 0) header = cells_of(line);
+        if (line.rfind("| structured-light", 0) == 0) rows[section].push_back(cells_of(line));
+    }
+    const std::vector<std::string> methods = {"pyrseg", "per-frame labels", "Hungarian IoU>=0.1", "Hungarian IoU>=0.3"};
+    ASSERT_EQ(header.size(), 12u);
+    const auto column = [&](const std::string& name) {
+        const auto it = std::find(header.begin(), header.end(), name);
+        EXPECT_NE(it, header.end()) << name;
+        return std::size_t(it - header.begin());
+    };
+    for (const char* scenario : {"Camera motion", "Camera and object motion"}) {
+        SCOPED_TRACE(scenario);
+        const auto& table = rows[scenario];
+        ASSERT_EQ(table.size(), methods.size());
+        for (std::size_t m = 0; m < methods.size(); ++m) {
+            ASSERT_EQ(table[m].size(), header.size());
+            EXPECT_EQ(table[m][column("method")], methods[m]);
+            for (const char* same : {"objects", "object frames", "matched", "fragmentations"}) {
+                EXPECT_EQ(table[m][column(same)], table[0][column(same)]) << same << ", " << methods[m];
+            }
+            const std::string idf1 = table[m][column("IDF1")];
+            const double value = std::stod(idf1[0] == '*' ? idf1.substr(2) : idf1);
+            EXPECT_GE(value, 0.0);
+            EXPECT_LE(value, 1.0);
+        }
+        EXPECT_GT(std::stoi(table[0][column("object frames")]), 30);
+    }
+    ASSERT_EQ(rows["Acceptance (camera motion)"].size(), 1u);
+    EXPECT_EQ(rows["Acceptance (camera motion)"][0].size(), 4u);
+    ASSERT_EQ(rows["Per sequence"].size(), 2u);
+    EXPECT_EQ(rows["Per sequence"][0][1], "camera");
+    EXPECT_EQ(rows["Per sequence"][1][1], "objects");
+    EXPECT_EQ(rows["Per sequence"][0].size(), 4 + methods.size() + 1);
+    fs::remove_all(dir);
+}
+
+TEST(CliEval, TracksHelpAndUsageErrors) {
+    CliRun r = run("eval --tracks --help");
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* word : {"--frames", "--seeds", "--scenarios", "--match-iou", "IDF1", "ID switches",
+                             "fragmentations", "Hungarian", "per-frame labels"}) {
+        EXPECT_NE(r.output.find(word), std::string::npos) << word << "\n" << r.output;
+    }
+    EXPECT_NE(run("eval --help").output.find("--tracks"), std::string::npos);
+    for (const char* bad : {"--frames 1", "--scenarios camera,walk", "--match-iou 0", "--size 10x10",
+                            "--sensors kinect-v9", "--max-turn 45", "--params tuned"}) {
+        r = run(std::string("eval --tracks --progress none ") + bad);
+        EXPECT_EQ(r.status, 2) << bad << "\n" << r.output;
+    }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "conformance/cases.hpp"
 #include "pyrseg/error.hpp"
+#include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
 #include "reference/reference_tracks.hpp"
@@ -140,6 +141,56 @@ TEST_P(TrackStreams, MatchesReference) {
         }
     }
     EXPECT_GT(matched, 100u) << "the stream must carry ids over";
+    EXPECT_GT(by_position, 0u) << "the stream must match some segments by position";
+}
+
+// A camera on the generator's random walk (up to 2 cm and 2 degrees a frame) over a scene whose objects slide,
+// hide and come back: the camera's shift of step 2, its border rule, and step 3 at work.
+TEST_P(TrackStreams, MovingCameraMatchesReference) {
+    const auto& [backend, index] = GetParam();
+    PYRSEG_SKIP_IF_UNAVAILABLE(backend);
+    const StreamCase& c = kStreams[index];
+    const int width = 200;
+    const int height = 150;
+    synthetic::SequenceOptions so;
+    so.scene.width = width;
+    so.scene.height = height;
+    so.scene.seed = 3;
+    so.scene.sensor = c.sensor;
+    so.frames = 24;
+    so.object_motion = true;
+    const std::vector<synthetic::SceneOptions> frames = synthetic::sequence(so);
+    Params params = c.robust ? sensor_preset(SensorKind::realsense_d435) : Params{};
+    params.color_edge_threshold = kMaxColorEdgeThreshold;
+    Outputs outputs;
+    outputs.segment_tracks = true;
+    Segmenter segmenter(width, height, params, backend, outputs);
+    pyrseg_ref::TrackParams track_params;
+    track_params.unit_mm = params.unit_mm;
+    track_params.max_distance_mm = params.track_max_distance_mm;
+    track_params.hold_frames = params.track_hold_frames;
+    pyrseg_ref::Tracker tracker(track_params);
+    Result result;
+    std::size_t by_position = 0;
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        const synthetic::Scene scene = synthetic::generate(frames[f]);
+        const pyrseg_ref::Output ref =
+            pyrseg_ref::segment(scene.points.data(), nullptr, width, height, to_reference(params));
+        ASSERT_TRUE(ref.ok) << ref.error;
+        const std::vector<pyrseg_ref::Track> expected = tracker.next(ref, width, height);
+        segmenter.segment(CloudView{scene.points.data(), nullptr, width, height}, result);
+        ASSERT_TRUE(same_bytes("labels", result.labels, ref.labels, width));
+        ASSERT_EQ(result.tracks.size(), expected.size());
+        for (std::size_t k = 0; k < expected.size(); ++k) {
+            EXPECT_EQ(result.tracks[k].id, expected[k].id) << "segment " << k + 1;
+            EXPECT_EQ(result.tracks[k].first_frame, expected[k].first_frame) << "segment " << k + 1;
+            EXPECT_EQ(result.tracks[k].age, expected[k].age) << "segment " << k + 1;
+            EXPECT_EQ(result.tracks[k].hidden_frames, expected[k].hidden_frames) << "segment " << k + 1;
+            EXPECT_EQ(result.tracks[k].how, to_library(expected[k].how)) << "segment " << k + 1;
+            by_position += expected[k].how == pyrseg_ref::TrackMatch::position ? 1 : 0;
+        }
+    }
     EXPECT_GT(by_position, 0u) << "the stream must match some segments by position";
 }
 
