@@ -352,11 +352,12 @@ int cmd_eval_tracks(const std::vector<std::string>& argv) {
     std::set<std::string> values = {"sensors",  "frames",    "seeds",      "size",   "scenarios", "max-step",
                                     "max-turn", "match-iou", "min-pixels", "params", "out-dir",   "progress"};
     values.insert(kParameterValueOptions.begin(), kParameterValueOptions.end());
+    values.insert(kTrackValueOptions.begin(), kTrackValueOptions.end());
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert({"help", "tracks", "quick"});
     const Args args(argv, values, flags);
     if (args.flag("help")) {
-        std::fputs(kTracksUsage, stdout);
+        std::printf("%s%s", kTracksUsage, kTrackParameterHelp);
         return 0;
     }
     if (!args.positional().empty()) throw UsageError{"--tracks takes no positional arguments"};

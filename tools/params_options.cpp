@@ -62,7 +62,7 @@ const char* const kParameterHelp =
     "  --raw                 write raw pyramid labels instead of compacted 1..K.\n";
 
 const char* const kTrackParameterHelp =
-    "Track parameters (segment --track; docs/algorithm.md section 11):\n"
+    "Track parameters (docs/algorithm.md section 11):\n"
     "  --track-max-distance MM   a segment that no segment of the previous frame overlaps enough takes the id of a\n"
     "                        track whose centroid, moved by the camera's motion, is at most MM millimetres from its\n"
     "                        own (default 50; 0 finds only a track exactly where it was)\n"
