@@ -84,8 +84,8 @@ public:
     // the pairs after read_back.
     virtual void track_overlaps();
     virtual void forget_previous_labels() {}
-    // After read_back: the last frame's pairs, PYR_TRACK_SLOT_WORDS words each (previous label, label, pixels),
-    // unsorted; `count` of them (0 on a stream's first frame).
+    // After read_back: the last frame's table slots, PYR_TRACK_SLOT_WORDS words each (previous label, label, pixels;
+    // a free slot's first word is 0), in no order; `count` of them (0 on a stream's first frame).
     [[nodiscard]] virtual const std::uint32_t* track_pairs(std::uint32_t& count) const {
         count = 0;
         return nullptr;

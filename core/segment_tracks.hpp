@@ -14,8 +14,9 @@ class TrackState {
 public:
     // The next frame starts a new stream.
     void reset();
-    // One frame: `pairs` words (previous label, label, pixels) PYR_TRACK_SLOT_WORDS each, `pair_count` of them in
-    // any order (none on the stream's first frame); `segments` the frame's K statistics (label k at k - 1).
+    // One frame of a width x height stream: `pairs` a backend's table slots (previous label, label, pixels)
+    // PYR_TRACK_SLOT_WORDS words each, `pair_count` of them in any order, free ones (a first word of 0) skipped (none
+    // on the stream's first frame); `segments` the frame's K statistics (label k at k - 1).
     // Fills `out` with K tracks. Allocates only when the frame has more segments or pairs than any before.
     void next(const std::uint32_t* pairs, std::uint32_t pair_count, const std::vector<SegmentStats>& segments,
               int width, int height, const Params& params, std::vector<SegmentTrack>& out);

@@ -21,6 +21,7 @@
 #include "tools/args.hpp"
 #include "tools/commands.hpp"
 #include "tools/eval/tracks.hpp"
+#include "tools/eval_sensors.hpp"
 #include "tools/figures.hpp"
 #include "tools/output_files.hpp"
 #include "tools/printable.hpp"
@@ -85,14 +86,6 @@ constexpr const char* kTracksUsage =
 constexpr double kMaxSwitchesPer100 = 1.0;
 constexpr double kMinIdf1 = 0.9;
 
-std::vector<std::string> split_list(const std::string& text) {
-    std::vector<std::string> items;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) items.push_back(item);
-    return items;
-}
-
 template <class... Values>
 std::string printed(const char* fmt, Values... values) {
     char buffer[256];
@@ -137,12 +130,6 @@ struct Options {
     std::uint32_t min_pixels = 300;
     bool preset = true;
 };
-
-SensorKind kind_of(synthetic::Sensor sensor) {
-    const std::optional<SensorKind> kind = sensor_kind_from_name(synthetic::sensor_name(sensor));
-    if (!kind) throw Error(ErrorCode::internal, "eval --tracks: no preset for the sensor model");
-    return *kind;
-}
 
 // Whether pyrseg's ids (method 0) are no worse than every host-side matcher's on this sequence: IDF1 at least
 // theirs and no more in-view switches.
@@ -366,15 +353,7 @@ int cmd_eval_tracks(const std::vector<std::string>& argv) {
     Options o;
     const std::string sensors = args.value("sensors").value_or(
         quick ? "structured-light,kinect-v1" : "structured-light,kinect-v1,realsense-d435,azure-kinect");
-    for (const std::string& item : split_list(sensors)) {
-        const std::optional<synthetic::Sensor> sensor = synthetic::sensor_from_name(item);
-        if (!sensor) {
-            throw UsageError{"--sensors: unknown sensor model '" + printable(item) +
-                             "'; known: structured-light, kinect-v1, realsense-d435, azure-kinect"};
-        }
-        if (std::find(o.sensors.begin(), o.sensors.end(), *sensor) == o.sensors.end()) o.sensors.push_back(*sensor);
-    }
-    if (o.sensors.empty()) throw UsageError{"--sensors is empty"};
+    o.sensors = parse_sensors(sensors);
     for (const std::string& item : split_list(args.value("scenarios").value_or("camera,objects"))) {
         Scenario s{};
         if (item == "camera") {

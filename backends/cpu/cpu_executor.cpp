@@ -40,6 +40,7 @@ CpuExecutor::CpuExecutor(const core::Plan& plan, const ThreadSetting& threads)
       fill_scratch_(fill_scratch_size(plan)),
       stats_(plan.stats_words()),
       graph_words_(plan.graph_words()),
+      previous_labels_(plan.track_slots != 0 ? plan.pixel_count() : 0),
       simd_(simd::rows_from_environment()),
       sweeps_(use_sweeps_for_fixed_points()) {}
 

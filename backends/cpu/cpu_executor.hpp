@@ -144,11 +144,11 @@ private:
     std::vector<std::uint32_t> graph_words_;  // the segment graph's counter, table and list (shaders/pyr_graph.h)
     std::size_t graph_list_ = 0;              // where this frame's list starts in it
     // Tracks: the previous frame's compacted labels, its segment count (0: no previous frame), and the overlap pairs'
-    // counter, table and list (shaders/pyr_track.h), grown to the largest frame so far.
+    // table (shaders/pyr_track.h), grown to the largest frame so far, with the slots the last frame used.
     std::vector<std::uint32_t> previous_labels_;
     std::uint32_t previous_count_ = 0;
     std::vector<std::uint32_t> track_words_;
-    std::size_t track_list_ = 0;
+    std::uint32_t track_slots_ = 0;
     // The vector row passes PYRSEG_CPU_SIMD picks (backends/cpu/simd/cpu_simd.hpp); null: the shared scalar
     // functions pixel by pixel.
     const simd::VectorRows* simd_;

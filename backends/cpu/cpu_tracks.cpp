@@ -1,7 +1,7 @@
-// Tracks' overlap counts (docs/algorithm.md section 11) with the GPUs' functions (shaders/pyr_track.h): each row's
-// runs of one (previous label, label) pair counted into the pair table at once, then the pairs gathered, in the
-// slots the two frames' segment counts can need (pyr_track_slots, as every backend). The same walk keeps the frame's
-// labels as the previous ones.
+// Tracks' overlap counts (docs/algorithm.md section 11) with the GPUs' function (shaders/pyr_track.h): each row's
+// runs of one (previous label, label) pair counted into the pair table at once, in the slots the two frames' segment
+// counts can need (pyr_track_slots, as every backend); the host reads the table's slots as a GPU's. The same walk
+// keeps the frame's labels as the previous ones.
 #include <algorithm>
 
 #include "backends/cpu/cpu_executor.hpp"
@@ -15,13 +15,12 @@ using std::uint32_t;
 void CpuExecutor::track_overlaps() {
     const PyrLevel lv = plan_.full();
     const size_t width = lv.width;
-    if (previous_labels_.size() != plan_.pixel_count()) previous_labels_.assign(plan_.pixel_count(), 0u);
     const bool count = previous_count_ != 0 && segment_count_ != 0;
-    const uint32_t slots = count ? pyr_track_slots(previous_count_, segment_count_, plan_.track_slots) : 1u;
-    const size_t list = 1 + size_t(PYR_TRACK_SLOT_WORDS) * slots;
-    const size_t words = list + size_t(PYR_TRACK_SLOT_WORDS) * (slots / 2);
-    if (track_words_.size() < words) track_words_.resize(words);
-    std::fill_n(track_words_.begin(), list, 0u);
+    track_slots_ = count ? pyr_track_slots(previous_count_, segment_count_, plan_.track_slots) : 0u;
+    const uint32_t slots = track_slots_;
+    const size_t words = size_t(PYR_TRACK_SLOT_WORDS) * slots;
+    if (track_words_.size() < words) track_words_.resize(words);  // grows with the largest frame
+    std::fill_n(track_words_.begin(), words, 0u);
     PassContext c = context();
     c.merge = track_words_.data();
     const uint32_t* lut = lut_.data();
@@ -39,23 +38,19 @@ void CpuExecutor::track_overlaps() {
                 ++run;
                 continue;
             }
-            if (count) pixel::pyr_track_count(c, run_previous, run_label, run, 1u, slots - 1);
+            if (count) pixel::pyr_track_count(c, run_previous, run_label, run, 0u, slots - 1);
             run_previous = j;
             run_label = k;
             run = 1;
         }
-        if (count) pixel::pyr_track_count(c, run_previous, run_label, run, 1u, slots - 1);
+        if (count) pixel::pyr_track_count(c, run_previous, run_label, run, 0u, slots - 1);
     });
-    if (count) {
-        for (uint32_t s = 0; s < slots; ++s) pixel::pyr_track_gather(c, 1u, s, uint32_t(list), 0u);
-    }
-    track_list_ = list;
-    previous_count_ = segment_count_ == 0 ? 0 : segment_count_;
+    previous_count_ = segment_count_;
 }
 
 const uint32_t* CpuExecutor::track_pairs(uint32_t& count) const {
-    count = track_words_.empty() ? 0 : track_words_[0];
-    return track_words_.empty() ? nullptr : track_words_.data() + track_list_;
+    count = track_slots_;
+    return track_words_.data();
 }
 
 }  // namespace pyrseg::cpu

@@ -105,6 +105,15 @@ std::string when_memory_runs_out_at(long n, const std::function<void()>& f) {
     return outcome;
 }
 
+// The Vulkan validation layer allocates on every call it checks: warm frames are counted without it.
+bool under_validation_layer(const std::string& backend) {
+    const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION");
+    return backend == "vulkan" && v != nullptr && *v == '1';
+}
+constexpr const char* kValidationLayerSkip =
+    "the Vulkan validation layer allocates on every call it checks; ctest no_allocation_without_validation_layer "
+    "runs this test without it";
+
 // The host's memory running out, anywhere in making a Segmenter or in a frame, is pyrseg::Error(out_of_memory) on
 // every backend (OpenCL's let std::bad_alloc through: Python saw a bare MemoryError).
 TEST_P(NoAllocation, HostMemoryRunningOutIsOutOfMemory) {
@@ -139,10 +148,7 @@ TEST_P(NoAllocation, HostMemoryRunningOutIsOutOfMemory) {
 }
 
 TEST_P(NoAllocation, WarmFramesAllocateNothing) {
-    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
-        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
-                        "no_allocation_without_validation_layer runs this test without it";
-    }
+    if (under_validation_layer(GetParam())) GTEST_SKIP() << kValidationLayerSkip;
     synthetic::SceneOptions o;
     o.width = 320;
     o.height = 240;
@@ -187,10 +193,7 @@ TEST_P(NoAllocation, WarmTrackedFramesAllocateNothing) {
     outputs.segment_tracks = outputs.track_ids = true;
     Params params;
     params.track_hold_frames = 2;
-    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
-        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
-                        "no_allocation_without_validation_layer runs this test without it";
-    }
+    if (under_validation_layer(GetParam())) GTEST_SKIP() << kValidationLayerSkip;
     auto segmenter = std::make_unique<Segmenter>(320, 240, params, GetParam(), outputs);
     Result result;
     const CloudView va{a.points.data(), nullptr, 320, 240};
@@ -240,10 +243,7 @@ TEST(NoAllocationScene, WarmScenesAllocateNothing) {
 
 // The same for the robust metric (texels, edge rounds) and for depth frames (their tables and packed samples).
 TEST_P(NoAllocation, WarmRobustAndDepthFramesAllocateNothing) {
-    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
-        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
-                        "no_allocation_without_validation_layer runs this test without it";
-    }
+    if (under_validation_layer(GetParam())) GTEST_SKIP() << kValidationLayerSkip;
     synthetic::SceneOptions o;
     o.width = 160;
     o.height = 120;
@@ -277,10 +277,7 @@ TEST_P(NoAllocation, WarmRobustAndDepthFramesAllocateNothing) {
 
 // Frames with a colour image (the colour edge term), clouds and depth images, with and without colour in turn.
 TEST_P(NoAllocation, WarmColourFramesAllocateNothing) {
-    if (const char* v = std::getenv("PYRSEG_VULKAN_VALIDATION"); GetParam() == "vulkan" && v != nullptr && *v == '1') {
-        GTEST_SKIP() << "the Vulkan validation layer allocates on every call it checks; ctest "
-                        "no_allocation_without_validation_layer runs this test without it";
-    }
+    if (under_validation_layer(GetParam())) GTEST_SKIP() << kValidationLayerSkip;
     synthetic::SceneOptions o;
     o.width = 160;
     o.height = 120;
