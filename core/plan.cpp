@@ -57,6 +57,11 @@ void check_metric_parameters(const Params& p) {
         bad_parameter("edge_rounds must be in 1.." + std::to_string(kMaxEdgeRounds) + ", got " +
                       std::to_string(p.edge_rounds));
     }
+    if (!(p.edge_max_depth_step == 0.0 ||
+          (p.edge_max_depth_step >= kMinEdgeMaxDepthStep && p.edge_max_depth_step <= 1.0))) {
+        bad_parameter("edge_max_depth_step must be 0 (no test) or a share of the depth in 1e-06..1, got " +
+                      std::to_string(p.edge_max_depth_step));
+    }
     if (p.metric == Metric::paper &&
         (p.normal_window != kDefaultNormalWindow || p.curvature_stride != kDefaultCurvatureStride ||
          p.dt_per_m2 != 0.0 || p.ct_growth_per_m2 != 0.0)) {
@@ -186,6 +191,7 @@ Thresholds compute_thresholds(const Params& params) {
                           std::to_string(params.dt_per_m2));
         }
     }
+    t.edge_depth_step = static_cast<float>(params.edge_max_depth_step);
     check_merge_parameters(params, t);
     check_color_parameters(params, t);
     check_planar_parameters(params);

@@ -27,10 +27,17 @@ struct Thresholds {
     std::uint32_t merge_share = 0;
     // The colour edge's curvature gate G = rint(color_edge_curvature_share * 256), 0..256 (section 2c).
     std::uint32_t color_curvature_gate = 0;
+    // Step 6c's depth test in rounds >= 2: s = (float)edge_max_depth_step, 0 for none (section 5).
+    float edge_depth_step = 0;
 };
 
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.
 [[nodiscard]] Thresholds compute_thresholds(const Params& params);
+
+// Whether step 6c's rounds test depths (section 5): edge pixels labelled, several rounds and a depth step share.
+[[nodiscard]] inline bool uses_edge_depth_step(const Params& p) {
+    return p.label_edges && p.edge_rounds >= 2 && p.edge_max_depth_step > 0.0;
+}
 
 // unit_mm (Params, sensor_preset, measure_frame_noise): a finite number of millimetres > 0, else
 // pyrseg::Error(invalid_parameter) naming it.

@@ -367,9 +367,9 @@ PYR_KERNEL_GROUPS(final_lines) {
 }
 #endif
 
-/* edges (2D, w x h): h, offset of level N, round (1..63), rounds (E). In place: only valid, non-fillable,
- * unlabelled pixels change, and no pixel of this round reads those. With more than one round, a pixel labelled here
- * records the round in its mask, for the rounds after it. */
+/* edges (2D, w x h): h, offset of level N, round (1..63), rounds (E), the depth step share s (float; 0: none). In
+ * place: only valid, non-fillable, unlabelled pixels change, and no pixel of this round reads those. With more than
+ * one round, a pixel labelled here records the round in its mask, for the rounds after it. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_EDGES)
 PYR_KERNEL_2D(edges) {
     pyr_u32 x = PYR_X;
@@ -377,7 +377,7 @@ PYR_KERNEL_2D(edges) {
     if (x >= PYR_W || y >= PYR_ARG(0)) return;
     pyr_u32 i = PYR_ARG(1) + y * PYR_W + x;
     pyr_u32 round = PYR_ARG(2);
-    pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, round);
+    pyr_u32 l = pyr_edge_label(PYR_ENTRY_CTX, pyr_level(PYR_W, PYR_ARG(0), PYR_ARG(1)), x, y, round, PYR_ARG_F32(4));
     if (l != PYR_BUF(labels)[i]) {
         PYR_BUF(labels)[i] = l;
         if (round < PYR_ARG(3)) PYR_STORE_MASK(i, PYR_MASK(i) | (round << PYR_MASK_EDGE_SHIFT));

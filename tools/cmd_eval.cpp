@@ -241,14 +241,17 @@ void evaluate_scene(const synthetic::SceneOptions& options, const std::vector<do
     const std::vector<eval::BridgeSite> sites =
         eval::find_bridge_sites(scene.object_id, from_cloud.fillable_mask, scene.width, scene.height);
     Result pyramid;
-    // Bridges are drawn into the mask, and a mask frame has no points for the merge: with the merge on, the bridged
-    // masks are labelled without it (the bridges' test is the pyramid's, which the merge only follows), and bridge
-    // width 0 takes the cloud's own labels, merge included.
-    const bool merge = segmenter.params().merge;
+    // Bridges are drawn into the mask, and a mask frame has no points for the merge or the edge rounds' depth test:
+    // with either on, the bridged masks are labelled without them (the bridges' test is the pyramid's, which the
+    // merge only follows, and the bridges are fillable, so the rounds do not cross them), and bridge width 0 takes
+    // the cloud's own labels, both included.
+    const Params& given = segmenter.params();
+    const bool merge = given.merge || (given.label_edges && given.edge_rounds >= 2 && given.edge_max_depth_step > 0.0);
     std::optional<Segmenter> unmerged;
     if (merge) {
         Params p = segmenter.params();
         p.merge = false;
+        p.edge_max_depth_step = 0.0;
         unmerged.emplace(scene.width, scene.height, p, "cpu");
     }
     for (std::size_t b = 0; b < bridges.size(); ++b) {

@@ -38,6 +38,9 @@ const char* const kParameterHelp =
     "  --ct-growth G         robust: 1 - cos(ct) grows by G per square metre of depth (default 0).\n"
     "  --edge-rounds E       label edge pixels up to E steps from a segment (1..63, default 1: the contract's one\n"
     "                        layer); the robust presets use more, to share out their wider edge bands.\n"
+    "  --edge-max-depth-step S   rounds after the first label a pixel only from neighbours whose depth is within\n"
+    "                        S times its own (0..1, default 0: no test; the robust presets use 0.02), so that a\n"
+    "                        band's labels do not cross an object's outline. Needs a cloud or depth image.\n"
     "  --no-label-edges      leave edge pixels unlabelled (0) instead of joining them to a neighbouring segment.\n"
     "  --merge               after the pyramid, join segments that meet along a convex or flat boundary (an\n"
     "                        object's faces and parts), never across a concave crease or a depth step (an object\n"
@@ -84,6 +87,7 @@ const std::set<std::string> kParameterValueOptions = {"ct",
                                                       "dt-per-m2",
                                                       "ct-growth",
                                                       "edge-rounds",
+                                                      "edge-max-depth-step",
                                                       "merge-reach",
                                                       "merge-tolerance",
                                                       "merge-tolerance-per-m2",
@@ -132,6 +136,7 @@ Params parse_params(const Args& args, std::optional<SensorKind> preset) {
     if (auto v = args.number("dt-per-m2")) p.dt_per_m2 = *v;
     if (auto v = args.number("ct-growth")) p.ct_growth_per_m2 = *v;
     if (auto v = args.integer("edge-rounds")) p.edge_rounds = *v;
+    if (auto v = args.number("edge-max-depth-step")) p.edge_max_depth_step = *v;
     if (args.flag("merge") && args.flag("no-merge")) {
         throw Error(ErrorCode::invalid_argument, "--merge and --no-merge contradict each other");
     }

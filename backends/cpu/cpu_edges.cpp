@@ -21,7 +21,7 @@ void CpuExecutor::label_edges() {
                 const uint32_t i = full.offset + uint32_t(y) * full.width + x;
                 // Only edge pixels change, and no other pixel reads them: writing only changes keeps rows
                 // free of races on the fillable labels they read.
-                const uint32_t l = pixel::pyr_edge_label(c, full, x, uint32_t(y), 1u);
+                const uint32_t l = pixel::pyr_edge_label(c, full, x, uint32_t(y), 1u, 0.0f);
                 if (l != labels_[i]) labels_[i] = l;
             }
             mark_row(y);
@@ -41,6 +41,7 @@ void CpuExecutor::label_edges() {
     std::fill_n(changed, h, std::uint8_t{1});
     const std::uint8_t* valid = validity_bytes(c);
     const size_t words = (w + 63) / 64;
+    const float depth_step = plan_.thresholds.edge_depth_step;
     if (edge_bits_.size() < h * words) edge_bits_.resize(h * words);  // once per Segmenter
     for (uint32_t round = 1; round <= rounds; ++round) {
         std::swap(changed, before);
@@ -57,15 +58,16 @@ void CpuExecutor::label_edges() {
                 const size_t i = full.offset + y * w;
                 const bool up = y > 0;
                 const bool down = y + 1 < h;
+                const simd::EdgeDepths depths{depth_step, depth_step > 0.0f ? c.quant + kQuantWords * y * w : nullptr};
                 changed[y] = std::uint8_t(simd_->edge_round_row(
                     up ? c.mask + i - w : nullptr, c.mask + i, down ? c.mask + i + w : nullptr,
                     up ? c.labels + i - w : nullptr, c.labels + i, down ? c.labels + i + w : nullptr, valid + y * w,
-                    uint32_t(w), round, next, bits));
+                    uint32_t(w), round, depths, next, bits));
                 return;
             }
             std::fill_n(bits, words, std::uint64_t{0});
             for (uint32_t x = 0; x < w; ++x) {
-                next[x] = pixel::pyr_edge_label(c, full, x, uint32_t(y), round);
+                next[x] = pixel::pyr_edge_label(c, full, x, uint32_t(y), round, depth_step);
                 if (next[x] == labels_[full.offset + y * w + x]) continue;
                 bits[x / 64] |= std::uint64_t{1} << (x % 64);
                 changed[y] = 1;

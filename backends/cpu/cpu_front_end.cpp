@@ -142,9 +142,12 @@ void CpuExecutor::points_to_mask(bool estimate_normals) {
         if (normals_.empty()) normals_.resize(3 * plan_.pixel_count());  // once per Segmenter
         f.normals_out = normals_.data();
     }
-    // The statistics, the merge and the graph read each pixel's qn; nothing else reads the quantized pixels after
-    // the metric.
-    if (plan_.stats_slots != 0 || plan_.params.merge || plan_.graph_slots != 0) f.quant_out = quant_.data();
+    // The statistics, the merge and the graph read each pixel's qn, step 6c's depth test its z; nothing else reads
+    // the quantized pixels after the metric.
+    if (plan_.stats_slots != 0 || plan_.params.merge || plan_.graph_slots != 0 ||
+        core::uses_edge_depth_step(plan_.params)) {
+        f.quant_out = quant_.data();
+    }
     f.mask_out = mask_.data() + plan_.full().offset;
     f.valid_out = mask_valid_.data();
     points_to_mask_.run(pool_, *simd_, f);

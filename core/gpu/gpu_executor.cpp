@@ -247,8 +247,9 @@ public:
 
     void label_edges() override {
         const auto rounds = uint32_t(plan_.params.edge_rounds);
+        const uint32_t step = bits(plan_.thresholds.edge_depth_step);
         for (uint32_t round = 1; round <= rounds; ++round) {
-            dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset, round, rounds}));
+            dispatch(Kernel::edges, width(), height(), args({height(), plan_.full().offset, round, rounds, step}));
         }
     }
 

@@ -15,6 +15,7 @@ inline constexpr int kDefaultCurvatureStride = 4;           // robust metric: pa
 inline constexpr int kMaxNormalWindow = 7;
 inline constexpr int kMaxCurvatureStride = 64;
 inline constexpr int kMaxEdgeRounds = 63;
+inline constexpr double kMinEdgeMaxDepthStep = 1e-6;  // the smallest edge_max_depth_step other than 0
 inline constexpr int kMaxMergeReach = 16;
 inline constexpr int kMaxTrackHoldFrames = 1000;
 inline constexpr int kMaxColorEdgeStride = 16;
@@ -37,6 +38,11 @@ struct Params {
     // further round labels the next layer of an edge band from the layer before, so that wide bands (the robust
     // metric's) are shared out among the segments on either side.
     int edge_rounds = 1;
+    // 0 (no test) or a share in [1e-6, 1]: rounds after the first label a pixel only from neighbours whose depth
+    // differs from its own by at most this share of it, so that a band's labels stay on the surface they spread
+    // along and do not cross the depth step at an object's outline (docs/algorithm.md section 5, step 6c). Needs
+    // points: a mask frame is refused when it would be used (label_edges, edge_rounds >= 2 and a share > 0).
+    double edge_max_depth_step = 0.0;
     // Step 6d, the merge (docs/algorithm.md section 5b): segments that meet along a convex or flat boundary join
     // (an object's faces and parts), never across a concave crease or a depth step (an object and its support).
     bool merge = false;

@@ -93,6 +93,8 @@ bool set_param(Params& p, const std::string& key, const py::handle& v) {
         p.label_edges = boolean(kInit, name, v);
     } else if (key == "edge_rounds") {
         p.edge_rounds = whole();
+    } else if (key == "edge_max_depth_step") {
+        p.edge_max_depth_step = number(kInit, name, v);
     } else if (key == "compact") {
         p.compact = boolean(kInit, name, v);
     } else if (key == "normal_radius") {
@@ -196,14 +198,15 @@ Params params_from(const py::dict& kwargs, Outputs& outputs, py::object& cuda_st
         } else if (key == "threads") {
             threads = v.is_none() ? 0u : unsigned(integer(kInit, "threads", v, 1, cpu::kMaxThreads));
         } else if (!set_param(p, key, v)) {
-            throw py::type_error("Segmenter() got an unexpected keyword argument '" + key +
-                                 "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
-                                 "edge_rounds, compact, normal_radius, metric, normal_window, curvature_stride, "
-                                 "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
-                                 "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
-                                 "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
-                                 "planar_tolerance_mm, planar_tolerance_per_m2, track_max_distance_mm, "
-                                 "track_hold_frames; and preset, outputs, cuda_stream, threads");
+            throw py::type_error(
+                "Segmenter() got an unexpected keyword argument '" + key +
+                "'; parameters: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, "
+                "edge_rounds, edge_max_depth_step, compact, normal_radius, metric, normal_window, curvature_stride, "
+                "dt_per_m2, ct_growth_per_m2, merge, merge_reach, merge_tolerance_mm, "
+                "merge_tolerance_per_m2, merge_min_crossings, merge_max_bad_share, "
+                "color_edge_threshold, color_edge_stride, color_edge_curvature_share, "
+                "planar_tolerance_mm, planar_tolerance_per_m2, track_max_distance_mm, "
+                "track_hold_frames; and preset, outputs, cuda_stream, threads");
         }
     }
     return p;
@@ -760,8 +763,9 @@ backend: @BACKENDS@"auto", or None for $PYRSEG_BACKEND (else "auto").
 preset: a sensor preset (pyrseg.presets()); the parameters given beside it override it. "auto" chooses one from
 the first frame's depth (pyrseg.measure_frame_noise) and keeps it: .preset and .preset_reason say which and why,
 and .params is None until then.
-params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, compact, normal_radius,
-metric ("paper" or "robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
+params: ct, dt, unit_mm, bridge_levels, unjoinable_gap, label_edges, edge_rounds, edge_max_depth_step (edge
+rounds after the first stay on surfaces whose depth is within this share), compact, normal_radius, metric ("paper" or
+"robust"), normal_window, curvature_stride, dt_per_m2, ct_growth_per_m2; merge (join segments
 that meet along a convex or flat boundary), merge_reach, merge_tolerance_mm, merge_tolerance_per_m2,
 merge_min_crossings, merge_max_bad_share; color_edge_threshold, color_edge_stride, color_edge_curvature_share (the
 colour edge term on frames given color=, and its curvature gate); planar_tolerance_mm, planar_tolerance_per_m2 (when
@@ -953,6 +957,7 @@ py::dict params_to_dict(const Params& p) {
     d["unjoinable_gap"] = p.unjoinable_gap ? py::object(py::int_(*p.unjoinable_gap)) : py::object(py::none());
     d["label_edges"] = p.label_edges;
     d["edge_rounds"] = p.edge_rounds;
+    d["edge_max_depth_step"] = p.edge_max_depth_step;
     d["compact"] = p.compact;
     d["normal_radius"] = p.normal_radius;
     d["metric"] = metric_name(p.metric);

@@ -375,6 +375,49 @@ INSTANTIATE_TEST_SUITE_P(Backends, StridedClouds, ::testing::ValuesIn(available_
 
 class RealScans : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
+// Step 6c's depth test (edge_max_depth_step) on a depth step with a wide edge band between a far surface (left)
+// and a near one (right), given normals: without the test the far surface's smaller label crosses the step into the
+// near side's band; with it the near side's label fills its band. Both as the reference, on every backend.
+class EdgeDepthStep : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EdgeDepthStep, KeepsBandsOnTheirSurfaceLikeTheReference) {
+    PYRSEG_SKIP_IF_UNAVAILABLE(GetParam());
+    constexpr int kSize = 16;
+    std::vector<float> points;
+    std::vector<float> normals;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const float z = x <= 5 ? 2000.0f : (x == 6 || x == 8 ? 1015.0f : 1000.0f);
+            points.insert(points.end(), {float(x), float(y), z});
+            normals.insert(normals.end(), {0.0f, 0.0f, -1.0f});
+        }
+    }
+    Params params;
+    params.edge_rounds = 8;
+    std::vector<std::uint32_t> band[2];
+    for (const double step : {0.0, 0.02}) {
+        params.edge_max_depth_step = step;
+        expect_conformance(GetParam(), points.data(), normals.data(), kSize, kSize, params);
+        Outputs outputs;
+        outputs.raw_labels = true;
+        Segmenter segmenter(kSize, kSize, params, GetParam(), outputs);
+        CloudView view;
+        view.points = points.data();
+        view.normals = normals.data();
+        view.width = kSize;
+        view.height = kSize;
+        const Result r = segmenter.segment(view);
+        band[step > 0.0 ? 1 : 0] = {r.raw_labels.begin() + 5, r.raw_labels.begin() + 10};  // row 0, x = 5..9
+    }
+    // The far side's label (that of x = 0) crosses to x = 7 without the test and stops at x = 5 with it.
+    EXPECT_EQ(band[0][2], band[0][0]);
+    EXPECT_NE(band[1][1], band[1][0]);
+    EXPECT_EQ(band[1][1], band[1][4]);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, EdgeDepthStep, ::testing::ValuesIn(available_backend_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
 TEST_P(RealScans, MatchesReference) {
     const auto& [backend, file] = GetParam();
     PYRSEG_SKIP_IF_UNAVAILABLE(backend);

@@ -17,7 +17,7 @@ PYR_FN pyr_i32 pyr_check_all(PYR_CTX_PARAM, pyr_u32 x, pyr_u32 y) {
     r += pyr_label_init_texel(PYR_CTX_ARG, lv, lv, x, y, PYR_INIT_NEW);
     r += pyr_sweep_line(PYR_CTX_ARG, y * 64u, 1u, 64u, 0u);
     r += pyr_anchor_mask(1u, 2u, 3u) + pyr_fill_relax(1u, 1u, 2u, 1u) + pyr_fill_once(0u, 1u, 1u);
-    r += pyr_edge_label(PYR_CTX_ARG, lv, x, y, 2u);
+    r += pyr_edge_label(PYR_CTX_ARG, lv, x, y, 2u, 0.02f);
     r += PYR_U32(PYR_FLOAT_BITS(pyr_depth_point(x, PYR_DEPTH_F32, 0.5f, 0.25f, -0.25f).x));
     r += pyr_compact_label(PYR_CTX_ARG, 3u);
     r += pyr_sweep_row(PYR_CTX_ARG, lv, y, 0u) + pyr_sweep_column(PYR_CTX_ARG, lv, x, 1u);

@@ -166,6 +166,7 @@ SEGMENTER_KEYWORDS = {
     "unjoinable_gap": ("2", "integer"),
     "label_edges": ("yes", "True or False"),
     "edge_rounds": (2.5, "integer"),
+    "edge_max_depth_step": ("x", "number"),
     "compact": ("no", "True or False"),
     "normal_radius": ("2", "integer"),
     "metric": (1, "str"),

@@ -284,6 +284,33 @@ def test_merge_joins_segments_and_refuses_masks():
     assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "merge_reach" in e.value.message
 
 
+def test_edge_max_depth_step_keeps_bands_on_their_surface():
+    # A far surface (left, z 2000) and a near one (right, z 1000 and 1015) with a band of edge pixels between them.
+    h, w = 16, 16
+    ys, xs = np.mgrid[0:h, 0:w].astype(np.float32)
+    z = np.where(xs <= 5, 2000.0, np.where((xs == 6) | (xs == 8), 1015.0, 1000.0)).astype(np.float32)
+    points = np.dstack([xs, ys, z])
+    normals = np.zeros_like(points)
+    normals[..., 2] = -1
+    out = ("raw_labels",)
+    crossed = pyrseg.Segmenter(w, h, "cpu", edge_rounds=8, outputs=out).segment(points, normals)
+    seg = pyrseg.Segmenter(w, h, "cpu", edge_rounds=8, edge_max_depth_step=0.02, outputs=out)
+    assert seg.params["edge_max_depth_step"] == 0.02
+    kept = seg.segment(points, normals)
+    far, near = crossed.raw_labels[0, 0], crossed.raw_labels[0, 15]
+    assert crossed.raw_labels[0, 7] == far  # without the test the far label crosses the step
+    assert kept.raw_labels[0, 5] == far and (kept.raw_labels[0, 6:] == near).all()
+    assert pyrseg.preset("realsense-d435")["edge_max_depth_step"] == 0.02
+    assert pyrseg.preset("structured-light")["edge_max_depth_step"] == 0
+    with pytest.raises(pyrseg.Error) as e:
+        seg.segment_mask(np.ones((h, w), bool))
+    assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "edge_max_depth_step" in e.value.message
+    for bad in (-0.1, 1.5, float("nan"), 1e-9):
+        with pytest.raises(pyrseg.Error) as e:
+            pyrseg.Segmenter(w, h, "cpu", edge_max_depth_step=bad)
+        assert e.value.code == pyrseg.ErrorCode.invalid_parameter and "edge_max_depth_step" in e.value.message
+
+
 def test_frame_noise_suggests_a_preset():
     s = pyrseg.synthetic.generate(160, 120, sensor="kinect-v1")
     n = pyrseg.measure_frame_noise(s.points)

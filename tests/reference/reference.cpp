@@ -61,6 +61,10 @@ int level_count(int width, int height) {
 // Section 2b's four parameters: in range with the robust metric, at their defaults with the paper one.
 std::string check_metric_params(const Params& p) {
     if (p.edge_rounds < 1 || p.edge_rounds > 63) return "edge_rounds must be in 1..63";
+    // Section 5 step 6c: c is 0 (no test) or in [1e-6, 1]. Written so that NaN fails too; -0.0 equals 0.
+    if (!(p.edge_max_depth_step == 0.0 || (p.edge_max_depth_step >= 1e-6 && p.edge_max_depth_step <= 1.0))) {
+        return "edge_max_depth_step must be 0 or in [1e-6, 1]";
+    }
     if (p.metric == Metric::paper) {
         const Params defaults;
         if (p.normal_window != defaults.normal_window)
@@ -673,9 +677,11 @@ std::vector<std::uint32_t> fallback_labels(const std::vector<std::uint8_t>& fill
     return labels;
 }
 
+// points: the frame's points (3 per pixel, row-major), read only for step 6c's depth test (edge_max_depth_step > 0 and
+// edge_rounds >= 2); null for a mask, which segment_mask() refuses in that case.
 std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& fillable,
                                           const std::vector<std::uint8_t>& valid, const Plan& plan, bool label_edges,
-                                          int edge_rounds) {
+                                          int edge_rounds, double edge_max_depth_step, const float* points) {
     const auto n = static_cast<std::size_t>(plan.n);
     const auto m = static_cast<std::size_t>(plan.m);
     const auto dim = [&](std::size_t k) { return plan.dims[k]; };
@@ -798,7 +804,19 @@ std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& filla
     }
     // 6c, rounds 1..E: round k reads the state after round k-1 only. A neighbour counts when it is labelled and
     // fillable, or was labelled by an earlier round (round 1: fillable ones only, the contract's step).
+    // edge_max_depth_step c > 0: in rounds k >= 2 (never round 1) a neighbour q counts for p only when also
+    // |z_p - z_q| <= s * z_p, s = (float)c computed once, z the points' float32 z.
     if (label_edges) {
+        const bool depth_test = edge_max_depth_step > 0.0;
+        const auto s = static_cast<float>(edge_max_depth_step);
+        const auto z = [&](std::size_t t) { return points[3 * t + 2]; };
+        // Each float operation its own statement: one correctly rounded float32 result each, no contraction.
+        const auto same_surface = [&](std::size_t p, std::size_t q) {
+            const float diff = z(p) - z(q);
+            const float step = std::fabs(diff);  // exact
+            const float limit = s * z(p);
+            return step <= limit;
+        };
         std::vector<int> labelled_in(lab.size(), 0);  // the round that labelled an edge pixel, 0: none
         for (int round = 1; round <= edge_rounds; ++round) {
             const std::vector<std::uint32_t> before = lab;
@@ -807,7 +825,8 @@ std::vector<std::uint32_t> pyramid_labels(const std::vector<std::uint8_t>& filla
                 std::uint32_t best = 0;
                 for_each_4_neighbour(t, d.w, d.h, [&](std::size_t nb) {
                     const std::uint32_t l = before[nb];
-                    const bool counts = fill[n][nb] != 0 || (labelled_in[nb] != 0 && labelled_in[nb] < round);
+                    bool counts = fill[n][nb] != 0 || (labelled_in[nb] != 0 && labelled_in[nb] < round);
+                    if (counts && l != 0 && round >= 2 && depth_test) counts = same_surface(t, nb);
                     if (counts && l != 0 && (best == 0 || l < best)) best = l;
                 });
                 if (best != 0) {
@@ -1184,14 +1203,15 @@ DepthPoints depth_to_points(const DepthInput& depth, double unit_mm) {
 
 namespace {
 
-// points and normals are what the merge (step 6d) reads; null for a mask, which segment_mask() refuses to merge.
+// points and normals are what the merge (step 6d) reads, and points what step 6c's depth test (edge_max_depth_step)
+// reads; null for a mask, which segment_mask() refuses to merge or to give that test.
 Output label_from_mask(std::vector<std::uint8_t> fillable, const std::vector<std::uint8_t>& valid, int width,
                        int height, const Params& p, const Plan& plan, const float* points = nullptr,
                        const float* normals = nullptr) {
     Output out;
-    std::vector<std::uint32_t> raw = plan.fallback
-                                         ? fallback_labels(fillable, width, height)
-                                         : pyramid_labels(fillable, valid, plan, p.label_edges, p.edge_rounds);
+    std::vector<std::uint32_t> raw = plan.fallback ? fallback_labels(fillable, width, height)
+                                                   : pyramid_labels(fillable, valid, plan, p.label_edges, p.edge_rounds,
+                                                                    p.edge_max_depth_step, points);
     // Step 6d, after 6c (or 6b) and before compaction; not in the small-image fallback.
     if (p.merge && !plan.fallback) merge_labels(raw, points, quantize_normals(normals, valid), width, height, p);
     out.fillable = std::move(fillable);
@@ -1315,6 +1335,10 @@ Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int
     if (std::string why = check_params(width, height, params); !why.empty()) return failure(std::move(why));
     // Section 5b: the merge needs points and normals, which a mask does not have.
     if (params.merge) return failure("merge needs points and normals: a mask cannot be merged");
+    // Section 5 step 6c: the depth test of edge_max_depth_step needs depths, which a mask does not have.
+    if (params.label_edges && params.edge_rounds >= 2 && params.edge_max_depth_step > 0.0) {
+        return failure("edge_max_depth_step > 0 with edge_rounds >= 2 needs depths: a mask has none");
+    }
     Plan plan;
     if (std::string why = make_plan(width, height, params, plan); !why.empty()) return failure(std::move(why));
 

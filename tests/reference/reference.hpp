@@ -26,6 +26,10 @@ struct Params {
     bool bg_explicit = false;  // true: b/g that do not fit the image are an error (ok=false) instead of the fallback
     bool label_edges = true;
     int edge_rounds = 1;  // rounds of step 6c, 1..63 (docs/algorithm.md section 5)
+    // c of step 6c (docs/algorithm.md section 5): 0 (no test) or finite in [1e-6, 1]. In rounds k >= 2 a neighbour q
+    // counts for pixel p only when |z_p - z_q| <= (float)c * z_p. segment_mask refuses c > 0 when the test would be
+    // used (label_edges on, edge_rounds >= 2): a mask has no depths.
+    double edge_max_depth_step = 0.0;
     bool compact = true;
     int normal_radius = 1;
     // Section 2b. With Metric::paper the four numbers below must keep their defaults (else ok = false); with
@@ -95,7 +99,8 @@ Output segment(const float* points, const float* normals, int width, int height,
                const std::uint8_t* color = nullptr);
 
 // Steps 3..7 only, from a given mask: fillable[i] is B; valid[i] (nullptr = every pixel valid) is used by edge
-// labelling (step 6c). Output::fillable echoes the mask, Output::normals stays empty.
+// labelling (step 6c). Output::fillable echoes the mask, Output::normals stays empty. Refused (ok = false) with merge
+// on, and with edge_max_depth_step > 0 while label_edges is on and edge_rounds >= 2 (no points, so no depths).
 Output segment_mask(const std::uint8_t* fillable, const std::uint8_t* valid, int width, int height,
                     const Params& params);
 

@@ -769,6 +769,225 @@ TEST(ReferenceEdgeRounds, RangeIsOneToSixtyThree) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// edge_max_depth_step c (docs/algorithm.md section 5 step 6c): in rounds k >= 2 a neighbour q counts for pixel p only
+// when also |z_p - z_q| <= s * z_p, s = (float)c, each of the two operations one float32 rounding. Round 1 is the
+// contract's step, without the test.
+//
+// The scenes: 16 x 16, every row the same depth profile z(x), x and y the pixel's coordinates, given normals (0,0,-1),
+// the paper metric with its defaults (dt = 10 mm). Every pixel has a vertical neighbour at its own depth (dd = 0), so
+// it is fillable iff its horizontal neighbours lie within 10 of it. The profile:
+//   x:  0..4   5   6   7     8     9     10..15
+//   z:  F      G   A   1000  1015  1000  1000
+// F is the far surface, A the first pixel of the near side's band. With |F - G| <= 10 and |G - A| > 10: x = 0..4 and
+// 10..15 are fillable, x = 5..9 are not (5 and 6 see |G - A|, 7, 8 and 9 see 15) but valid. The pyramid is that of
+// ReferenceEndToEnd.TwoPlanesWithDepthStep: level 3 (4x4) has column 0 (x 0..3) -> 6 and column 3 (x 12..15) -> 9
+// after step 2 (level 2 has nothing: x = 5..9 cut both of its columns); level 4 column 5 (x 10..11) has no labelled
+// parent and takes 9 in step 4; (4, y) takes 6 in step 6a. So after 6b: x = 0..4 carry 6 (the far side, the smaller
+// label), x = 10..15 carry 9 (near), the band x = 5..9 is 0. Every row behaves the same (its vertical neighbours are
+// labelled in the same round as the pixel), so each expected picture is one row.
+
+std::vector<float> depth_step_points(float f, float g, float a) {
+    return grid_points(16, 16, [=](int x, int) {
+        if (x <= 4) return f;
+        if (x == 5) return g;
+        if (x == 6) return a;
+        return x == 8 ? 1015.0f : 1000.0f;
+    });
+}
+
+Output run_depth_step(float f, float g, float a, int edge_rounds, double c) {
+    const std::vector<float> pts = depth_step_points(f, g, a);
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    Params p;
+    p.edge_rounds = edge_rounds;
+    p.edge_max_depth_step = c;
+    return pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+}
+
+// One row repeated 16 times: 'f' the far side's 6, 'n' the near side's 9, '.' 0.
+std::vector<std::uint32_t> step_rows(const std::string& row) {
+    return labels_of(std::vector<std::string>(16, row), {{'f', 6}, {'n', 9}});
+}
+
+// The expected mask: x = 5..9 not fillable.
+std::vector<std::uint8_t> step_mask() {
+    return mask_of(std::vector<std::string>(16, "#####-----######"));
+}
+
+TEST(ReferenceEdgeDepthStep, FarLabelCrossesTheStepWithoutTheTestNotWithIt) {
+    // F = G = 2000, A = 1015: the far band is x = 5, the near band x = 6..9 (A = 1015, then 1000, 1015, 1000).
+    // Without the test (c = 0): round 1 gives x = 5 the 6 of (4, y) and x = 9 the 9 of (10, y); round 2 gives x = 6
+    // the 6 of x = 5 and x = 8 the 9 of x = 9; round 3 gives x = 7 the smaller of 6 (x = 6) and 9 (x = 8): 6. The
+    // far surface's label takes x = 6 and 7 of the near side's band.
+    // c = 1 (s = 1) is no test here either: |1015 - 2000| = 985 <= 1015.
+    // With c = 0.02 (s * z_p = 20 at z 1000, 20.3 at 1015): round 2 refuses 6 to x = 6 (|1015 - 2000| = 985 > 20.3)
+    // and x = 7 is not labelled yet, so x = 6 stays 0; x = 8 takes 9 (|1015 - 1000| = 15). Round 3: x = 7 takes 9
+    // from x = 8 (15 <= 20), x = 6 is still refused the 6. Round 4: x = 6 takes 9 from x = 7 (15 <= 20.3). The near
+    // side's label fills its band; the far side keeps its own band pixel x = 5.
+    struct Case {
+        double c;
+        int e;
+        const char* row;
+    };
+    const std::vector<Case> cases = {
+        {0.0, 1, "ffffff...nnnnnnn"},  {0.0, 2, "fffffff.nnnnnnnn"},   {0.0, 3, "ffffffffnnnnnnnn"},
+        {0.0, 63, "ffffffffnnnnnnnn"}, {1.0, 2, "fffffff.nnnnnnnn"},   {1.0, 63, "ffffffffnnnnnnnn"},
+        {0.02, 1, "ffffff...nnnnnnn"}, {0.02, 2, "ffffff..nnnnnnnn"},  {0.02, 3, "ffffff.nnnnnnnnn"},
+        {0.02, 4, "ffffffnnnnnnnnnn"}, {0.02, 63, "ffffffnnnnnnnnnn"},
+    };
+    for (const Case& k : cases) {
+        const Output out = run_depth_step(2000.0f, 2000.0f, 1015.0f, k.e, k.c);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_EQ(out.fillable, step_mask()) << "c = " << k.c << ", E = " << k.e;
+        EXPECT_LABELS(out.raw_labels, step_rows(k.row), 16) << "c = " << k.c << ", E = " << k.e;
+        EXPECT_EQ(out.segment_count, 2u);
+    }
+    // Compacted: 6 -> 1, 9 -> 2.
+    const Output out = run_depth_step(2000.0f, 2000.0f, 1015.0f, 10, 0.02);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_LABELS(out.labels, labels_of(std::vector<std::string>(16, "1111112222222222"), {{'1', 1}, {'2', 2}}), 16);
+    // label_edges off: no round, whatever c.
+    const std::vector<float> pts = depth_step_points(2000.0f, 2000.0f, 1015.0f);
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    Params off;
+    off.label_edges = false;
+    off.edge_rounds = 10;
+    off.edge_max_depth_step = 0.02;
+    const Output none = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, off);
+    ASSERT_TRUE(none.ok) << none.error;
+    EXPECT_LABELS(none.raw_labels, step_rows("fffff.....nnnnnn"), 16);
+}
+
+TEST(ReferenceEdgeDepthStep, RoundOneHasNoDepthTest) {
+    // F = 2000, G = 2008, A = 1015: (4, y) is still fillable (it sees 0 and 8 <= 10), x = 5 is not (|2008 - 1015|).
+    // c = 0.002: s * z_p = 4.016 at 2008 and 2.03 at 1015, so every depth difference here fails the test, the 8
+    // between x = 5 and its fillable neighbour x = 4 included. Round 1 still gives x = 5 the 6 of x = 4 (and x = 9
+    // the 9 of x = 10, at the same depth); rounds 2.. refuse everything: x = 6 (|1015 - 2008|), x = 8 (|1015 - 1000|
+    // = 15 > 2.03), and x = 7 never has a labelled neighbour.
+    for (const int e : {1, 2, 5}) {
+        const Output out = run_depth_step(2000.0f, 2008.0f, 1015.0f, e, 0.002);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_EQ(out.fillable, step_mask());
+        EXPECT_LABELS(out.raw_labels, step_rows("ffffff...nnnnnnn"), 16) << "E = " << e;
+    }
+    // Without the test the same scene spreads as usual: x = 6 takes 6 and x = 8 takes 9 in round 2, x = 7 the smaller
+    // 6 in round 3.
+    const Output untested = run_depth_step(2000.0f, 2008.0f, 1015.0f, 5, 0.0);
+    ASSERT_TRUE(untested.ok) << untested.error;
+    EXPECT_LABELS(untested.raw_labels, step_rows("ffffffffnnnnnnnn"), 16);
+}
+
+TEST(ReferenceEdgeDepthStep, BoundaryCountsAndTheLimitIsSTimesTheOwnDepth) {
+    // E = 2, F = G, A = 1015: after round 2, x = 6 carries 6 iff the test passes for p = x = 6 (z_p = 1015) and
+    // q = x = 5 (z_q = F); x = 8 takes 9 in round 2 (|1015 - 1000| = 15 passes every c below), x = 7 stays 0.
+    // c = 0.5: s * z_p = 507.5, exact.
+    struct Case {
+        float f;
+        double c;
+        bool passes;
+        const char* why;
+    };
+    const std::vector<Case> cases = {
+        {1522.5f, 0.5, true, "|dz| = 507.5 == s * z_p: counts (<=)"},
+        {1523.0f, 0.5, false, "|dz| = 508 > 507.5"},
+        {1600.0f, 0.5, false, "|dz| = 585 > s * z_p = 507.5 (though <= s * z_q = 800)"},
+        {507.5f, 0.5, true, "the far side nearer: |dz| = 507.5 == s * z_p (though > s * z_q = 253.75)"},
+        {507.0f, 0.5, false, "|dz| = 508 > 507.5"},
+    };
+    for (const Case& k : cases) {
+        const Output out = run_depth_step(k.f, k.f, 1015.0f, 2, k.c);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_EQ(out.fillable, step_mask()) << k.why;
+        EXPECT_LABELS(out.raw_labels, step_rows(k.passes ? "fffffff.nnnnnnnn" : "ffffff..nnnnnnnn"), 16) << k.why;
+    }
+}
+
+TEST(ReferenceEdgeDepthStep, LimitIsOneFloat32Product) {
+    // c = 0.02: s = (float)0.02 = 0.0199999995529651641845703125. s * 1000 = 19.99999955... rounds to the float32
+    // 20 (half an ulp of 20 is 2^-20 = 9.5e-7), so |1000 - 1020| = 20 counts; the product kept in double (19.9999996)
+    // would refuse it. F = G = 1020, A = 1000 (x = 5 and 6 see 20 > 10: not fillable). E = 2.
+    const Output at = run_depth_step(1020.0f, 1020.0f, 1000.0f, 2, 0.02);
+    ASSERT_TRUE(at.ok) << at.error;
+    EXPECT_EQ(at.fillable, step_mask());
+    EXPECT_LABELS(at.raw_labels, step_rows("fffffff.nnnnnnnn"), 16);
+    // One float step more (|dz| = 20.00006) is refused.
+    const float above = std::nextafter(1020.0f, 2000.0f);
+    const Output over = run_depth_step(above, above, 1000.0f, 2, 0.02);
+    ASSERT_TRUE(over.ok) << over.error;
+    EXPECT_LABELS(over.raw_labels, step_rows("ffffff..nnnnnnnn"), 16);
+
+    // s is c rounded to float32 first: c = 0.3, s = 0.300000011920928955078125, z_p = A = 402. s * 402 =
+    // 120.6000047922... rounds to the float32 120.600006103515625, while c * z_p rounded once (0.3 * 402 = 120.6) gives
+    // 120.59999847412109375, one ulp (2^-17) below. F = G = 281.4f = 281.399993896484375: |402 - F| =
+    // 120.600006103515625 (exact) counts with s, not with c. (s * z_q = 84.4 would refuse it too.)
+    const Output rounded = run_depth_step(281.4f, 281.4f, 402.0f, 2, 0.3);
+    ASSERT_TRUE(rounded.ok) << rounded.error;
+    EXPECT_EQ(rounded.fillable, step_mask());
+    EXPECT_LABELS(rounded.raw_labels, step_rows("fffffff.nnnnnnnn"), 16);
+    const float below = std::nextafter(281.4f, 0.0f);  // |dz| = 120.60003662109375 > the limit: refused
+    const Output beyond = run_depth_step(below, below, 402.0f, 2, 0.3);
+    ASSERT_TRUE(beyond.ok) << beyond.error;
+    EXPECT_LABELS(beyond.raw_labels, step_rows("ffffff..nnnnnnnn"), 16);
+}
+
+TEST(ReferenceEdgeDepthStep, RangeIsZeroOrOneMillionthToOne) {
+    const std::vector<std::uint8_t> mask(256, 1);
+    const std::vector<float> pts = grid_points(16, 16, [](int, int) { return 1000.0f; });
+    const std::vector<float> nrm = constant_normals(256, 0.0f, 0.0f, -1.0f);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // Refused by every entry point (edge_rounds 1, so the mask is not refused for its missing depths), naming it.
+    for (const double c :
+         {-1e-3, -1.0, nan, inf, -inf, 0.5e-6, std::nextafter(1e-6, 0.0), 1.5, std::nextafter(1.0, 2.0)}) {
+        Params p;
+        p.edge_max_depth_step = c;
+        const Output a = pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p);
+        const Output b = pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p);
+        const Output m = pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+        for (const Output* o : {&a, &b, &m}) {
+            EXPECT_FALSE(o->ok) << c;
+            EXPECT_NE(o->error.find("edge_max_depth_step"), std::string::npos) << c << ": " << o->error;
+        }
+    }
+    for (const double c : {0.0, -0.0, 1e-6, 0.02, 1.0}) {
+        for (const int e : {1, 63}) {
+            Params p;
+            p.edge_max_depth_step = c;
+            p.edge_rounds = e;
+            EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nrm.data(), 16, 16, p).ok) << c << ", E = " << e;
+            EXPECT_TRUE(pyrseg_ref::segment(pts.data(), nullptr, 16, 16, p).ok) << c << ", E = " << e;
+        }
+    }
+}
+
+TEST(ReferenceEdgeDepthStep, MaskIsRefusedWhenTheTestWouldBeUsed) {
+    // A mask has no depths: refused when label_edges is on, E >= 2 and c > 0; accepted otherwise.
+    const std::vector<std::uint8_t> mask(256, 1);
+    const auto run = [&](bool label_edges, int e, double c) {
+        Params p;
+        p.label_edges = label_edges;
+        p.edge_rounds = e;
+        p.edge_max_depth_step = c;
+        return pyrseg_ref::segment_mask(mask.data(), nullptr, 16, 16, p);
+    };
+    for (const int e : {2, 63}) {
+        for (const double c : {1e-6, 0.02, 1.0}) {
+            const Output refused = run(true, e, c);
+            EXPECT_FALSE(refused.ok) << "E = " << e << ", c = " << c;
+            EXPECT_NE(refused.error.find("edge_max_depth_step"), std::string::npos) << refused.error;
+            EXPECT_TRUE(run(false, e, c).ok) << "label_edges off, E = " << e << ", c = " << c;
+        }
+        EXPECT_TRUE(run(true, e, 0.0).ok) << "c = 0, E = " << e;
+        EXPECT_TRUE(run(true, e, -0.0).ok) << "c = -0, E = " << e;
+    }
+    EXPECT_TRUE(run(true, 1, 0.02).ok) << "E = 1";
+    EXPECT_TRUE(run(true, 1, 1.0).ok) << "E = 1";
+    // An accepted mask is labelled as before: all fillable, one segment.
+    const Output ok = run(true, 1, 0.02);
+    EXPECT_EQ(ok.raw_labels, (std::vector<std::uint32_t>(256, 1)));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Parameters.
 
 TEST(ReferenceParams, Rejection) {

@@ -39,6 +39,7 @@ inline pyrseg_ref::Params to_reference(const Params& p) {
     r.bg_explicit = p.bridge_levels.has_value() || p.unjoinable_gap.has_value();
     r.label_edges = p.label_edges;
     r.edge_rounds = p.edge_rounds;
+    r.edge_max_depth_step = p.edge_max_depth_step;
     r.compact = p.compact;
     r.normal_radius = p.normal_radius;
     r.metric = p.metric == Metric::robust ? pyrseg_ref::Metric::robust : pyrseg_ref::Metric::paper;

@@ -4,6 +4,8 @@
 // target against the scalar path, whose steps are the shared functions pixel by pixel.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -27,6 +29,7 @@ namespace {
 
 namespace simd = ::pyrseg::cpu::simd;
 namespace pixel = ::pyrseg::cpu::pixel;
+using ::pyrseg::cpu::kQuantWords;
 using ::pyrseg::cpu::PassContext;
 
 const std::uint32_t kWidths[] = {1, 2, 3, 4, 5, 7, 8, 15, 16, 17, 31, 32, 33, 63, 64, 65, 66, 127, 129, 130, 257, 1000};
@@ -226,14 +229,14 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
                     for (std::uint32_t x = 0; x < w; ++x) {
                         const std::size_t i = std::size_t(y) * w + x;
                         if (!own_labels) {
-                            expected[i] = pixel::pyr_edge_label(c, level, x, y, 1u);
+                            expected[i] = pixel::pyr_edge_label(c, level, x, y, 1u, 0.0f);
                             continue;
                         }
                         // With its own label: the minimum of it and what it would get unlabelled.
                         const std::uint32_t own = labels[i];
                         const bool edge = (mask[i] & PYR_MASK_FILLABLE) == 0 && valid[i] != 0;
                         if (edge) labels[i] = 0;
-                        const std::uint32_t fresh = pixel::pyr_edge_label(c, level, x, y, 1u);
+                        const std::uint32_t fresh = pixel::pyr_edge_label(c, level, x, y, 1u, 0.0f);
                         labels[i] = own;
                         if (edge && own != 0 && (fresh == 0 || own < fresh))
                             expected[i] = own;
@@ -276,67 +279,80 @@ TEST_P(CpuStageRows, EdgeRowMatchesTheSharedFunction) {
 }
 
 // Rounds 1 .. 12 of step 6c with several rounds: masks with earlier rounds in their upper bits (and rounds from later
-// ones, which must not count), labels on fillable pixels and on pixels labelled in a round; exactly the pixels whose
-// label pyr_edge_label changes are marked, with that label, and nothing is written past the row.
+// ones, which must not count), labels on fillable pixels and on pixels labelled in a round, without and with the
+// depth test (depths a few steps apart, some exactly at the limit); exactly the pixels whose label pyr_edge_label
+// changes are marked, with that label, and nothing is written past the row.
 TEST_P(CpuStageRows, EdgeRoundRowMatchesTheSharedFunction) {
     const simd::VectorRows& k = rows_named(GetParam());
     std::mt19937 rng(13);
     std::size_t taken = 0;
-    for (const std::uint32_t w : kWidths) {
-        for (std::uint32_t h = 1; h <= 3; ++h) {
-            for (std::uint32_t round = 1; round <= 12; round += (w > 100 ? 5 : 1)) {
-                const std::size_t n = std::size_t(w) * h;
-                std::vector<std::uint8_t> mask(n);
-                std::vector<std::uint8_t> valid(n);
-                std::vector<std::uint32_t> labels(n);
-                for (std::size_t i = 0; i < n; ++i) {
-                    const bool fillable = rng() % 3 == 0;
-                    const std::uint32_t labelled_round = rng() % 2 == 0 ? 0u : std::uint32_t(rng() % 14 + 1);
-                    mask[i] = std::uint8_t((fillable ? PYR_MASK_FILLABLE : 0u) | (rng() % 2 != 0 ? 2u : 0u) |
-                                           (labelled_round << PYR_MASK_EDGE_SHIFT));
-                    valid[i] = std::uint8_t(rng() % 5 == 0 ? 0 : rng() % 255 + 1);
-                    const bool labelled = fillable ? rng() % 4 != 0 : labelled_round != 0;
-                    labels[i] = labelled ? std::uint32_t(rng() % (round % 2 == 0 ? 5 : 1000000) + 1) : 0u;
-                }
-                PassContext c;
-                c.mask = mask.data();
-                c.labels = labels.data();
-                c.mask_valid = valid.data();
-                const PyrLevel level{w, h, 0};
-                for (std::uint32_t y = 0; y < h; ++y) {
-                    const std::size_t i = std::size_t(y) * w;
-                    const bool up = y > 0;
-                    const bool down = y + 1 < h;
-                    // Both end at a guard page.
-                    GuardedArray<std::uint32_t> out(std::vector<std::uint32_t>(w, 0x5a5a5a5au));
-                    const std::size_t words = (std::size_t(w) + 63) / 64;
-                    GuardedArray<std::uint64_t> changed(std::vector<std::uint64_t>(words, ~std::uint64_t{0}));
-                    const bool any = k.edge_round_row(
-                        up ? mask.data() + i - w : nullptr, mask.data() + i, down ? mask.data() + i + w : nullptr,
-                        up ? labels.data() + i - w : nullptr, labels.data() + i, down ? labels.data() + i + w : nullptr,
-                        valid.data() + i, w, round, out.data(), changed.data());
-                    bool expected_any = false;
-                    for (std::uint32_t x = 0; x < w; ++x) {
-                        const std::uint32_t expected = pixel::pyr_edge_label(c, level, x, y, round);
-                        const bool takes = expected != labels[i + x];
-                        const bool marked = ((changed.data()[x / 64] >> (x % 64)) & 1u) != 0;
-                        ASSERT_EQ(marked, takes) << w << "x" << h << " round " << round << " pixel " << x << "," << y;
-                        if (takes) {
-                            ASSERT_EQ(out.data()[x], expected)
-                                << w << "x" << h << " round " << round << " pixel " << x << "," << y;
-                        }
-                        expected_any |= takes;
-                        taken += takes ? 1 : 0;
+    std::size_t refused_by_depth = 0;
+    for (const float depth_step : {0.0f, 0.02f})
+        for (const std::uint32_t w : kWidths) {
+            for (std::uint32_t h = 1; h <= 3; ++h) {
+                for (std::uint32_t round = 1; round <= 12; round += (w > 100 ? 5 : 1)) {
+                    const std::size_t n = std::size_t(w) * h;
+                    std::vector<std::uint8_t> mask(n);
+                    std::vector<std::uint8_t> valid(n);
+                    std::vector<std::uint32_t> labels(n);
+                    std::vector<std::uint32_t> quant(kQuantWords * n);
+                    for (std::size_t i = 0; i < n; ++i) {
+                        // |1000 - 1020| is exactly 0.02 * 1000 (both exact in float32): the test's boundary.
+                        constexpr std::array<float, 5> kDepths = {1000.0f, 1010.0f, 1020.0f, 1050.0f, 2000.0f};
+                        quant[kQuantWords * i + 2] = std::bit_cast<std::uint32_t>(kDepths[rng() % kDepths.size()]);
+                        const bool fillable = rng() % 3 == 0;
+                        const std::uint32_t labelled_round = rng() % 2 == 0 ? 0u : std::uint32_t(rng() % 14 + 1);
+                        mask[i] = std::uint8_t((fillable ? PYR_MASK_FILLABLE : 0u) | (rng() % 2 != 0 ? 2u : 0u) |
+                                               (labelled_round << PYR_MASK_EDGE_SHIFT));
+                        valid[i] = std::uint8_t(rng() % 5 == 0 ? 0 : rng() % 255 + 1);
+                        const bool labelled = fillable ? rng() % 4 != 0 : labelled_round != 0;
+                        labels[i] = labelled ? std::uint32_t(rng() % (round % 2 == 0 ? 5 : 1000000) + 1) : 0u;
                     }
-                    EXPECT_EQ(any, expected_any);
-                    for (std::size_t b = w; b < 64 * words; ++b) {
-                        ASSERT_EQ((changed.data()[b / 64] >> (b % 64)) & 1u, 0u) << "a bit past the row";
+                    PassContext c;
+                    c.mask = mask.data();
+                    c.labels = labels.data();
+                    c.mask_valid = valid.data();
+                    c.quant = quant.data();
+                    const PyrLevel level{w, h, 0};
+                    for (std::uint32_t y = 0; y < h; ++y) {
+                        const std::size_t i = std::size_t(y) * w;
+                        const bool up = y > 0;
+                        const bool down = y + 1 < h;
+                        // Both end at a guard page.
+                        GuardedArray<std::uint32_t> out(std::vector<std::uint32_t>(w, 0x5a5a5a5au));
+                        const std::size_t words = (std::size_t(w) + 63) / 64;
+                        GuardedArray<std::uint64_t> changed(std::vector<std::uint64_t>(words, ~std::uint64_t{0}));
+                        const bool any = k.edge_round_row(
+                            up ? mask.data() + i - w : nullptr, mask.data() + i, down ? mask.data() + i + w : nullptr,
+                            up ? labels.data() + i - w : nullptr, labels.data() + i,
+                            down ? labels.data() + i + w : nullptr, valid.data() + i, w, round,
+                            simd::EdgeDepths{depth_step, depth_step > 0.0f ? quant.data() + kQuantWords * i : nullptr},
+                            out.data(), changed.data());
+                        bool expected_any = false;
+                        for (std::uint32_t x = 0; x < w; ++x) {
+                            const std::uint32_t expected = pixel::pyr_edge_label(c, level, x, y, round, depth_step);
+                            if (pixel::pyr_edge_label(c, level, x, y, round, 0.0f) != expected) ++refused_by_depth;
+                            const bool takes = expected != labels[i + x];
+                            const bool marked = ((changed.data()[x / 64] >> (x % 64)) & 1u) != 0;
+                            ASSERT_EQ(marked, takes)
+                                << w << "x" << h << " round " << round << " pixel " << x << "," << y;
+                            if (takes) {
+                                ASSERT_EQ(out.data()[x], expected)
+                                    << w << "x" << h << " round " << round << " pixel " << x << "," << y;
+                            }
+                            expected_any |= takes;
+                            taken += takes ? 1 : 0;
+                        }
+                        EXPECT_EQ(any, expected_any);
+                        for (std::size_t b = w; b < 64 * words; ++b) {
+                            ASSERT_EQ((changed.data()[b / 64] >> (b % 64)) & 1u, 0u) << "a bit past the row";
+                        }
                     }
                 }
             }
         }
-    }
     EXPECT_GT(taken, 1000u) << "too few pixels labelled in a round to test much";
+    EXPECT_GT(refused_by_depth, 100u) << "too few labels changed by the depth test to test it";
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, CpuStageRows, ::testing::ValuesIn(target_names()),

@@ -48,6 +48,14 @@ struct QuantRow {
     std::int32_t* sum[4] = {nullptr, nullptr, nullptr, nullptr};
 };
 
+// Step 6c's depth test in rounds >= 2 (shaders/pyr_edges.h): the share s (0: no test) and the row's first pixel in
+// the quant buffer (kQuantWords words a pixel, its z in word 2; the rows above and below at -/+ w pixels), null
+// when s is 0.
+struct EdgeDepths {
+    float step = 0.0f;
+    const std::uint32_t* quant = nullptr;
+};
+
 // Memory that the next row function will read and this one reads ahead into the L2 cache, a few lines with each of
 // its vectors (its arithmetic then hides the wait): the spans at[i] of `bytes` bytes each, null for none.
 struct ReadAhead {
@@ -162,8 +170,8 @@ struct VectorRows {
     // bottom.
     bool (*edge_round_row)(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
                            const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
-                           const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, std::uint32_t* out,
-                           std::uint64_t* changed) = nullptr;
+                           const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, const EdgeDepths& depths,
+                           std::uint32_t* out, std::uint64_t* changed) = nullptr;
     // The robust metric's rows (docs/algorithm.md sections 2b and 8b).
     // Row y of the robust normals' texels with radius r (pyr_robust_texel): into c.robust_texels.
     void (*robust_texels_row)(const PassContext& c, std::uint32_t w, std::uint32_t h, std::uint32_t y, std::uint32_t r,

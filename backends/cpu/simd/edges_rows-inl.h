@@ -77,29 +77,38 @@ void edge_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const st
 }
 
 // Round `round` of step 6c with several rounds (pyr_edge_label) on one row (cpu_simd.hpp): the same minimum over
-// candidates as edge_row, where a neighbour is a candidate when it is fillable or its mask holds an earlier round.
-// Only the pixels that take a label are written (few: a round labels the edge pixels next to the last one's).
+// candidates as edge_row, where a neighbour is a candidate when it is fillable or its mask holds an earlier round
+// (and, with the depth test, lies near in depth). Only the pixels that take a label are written (few: a round labels
+// the edge pixels next to the last one's).
 bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, const std::uint8_t* mask_below,
                     const std::uint32_t* above, const std::uint32_t* labels, const std::uint32_t* below,
-                    const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, std::uint32_t* out,
-                    std::uint64_t* changed) {
+                    const std::uint8_t* valid, std::uint32_t w, std::uint32_t round, const EdgeDepths& depths,
+                    std::uint32_t* out, std::uint64_t* changed) {
     std::memset(changed, 0, (std::size_t(w) + 63) / 64 * sizeof(std::uint64_t));
     bool any = false;
+    const float step = round >= 2 ? depths.step : 0.0f;
     const auto usable = [&](std::uint8_t m) {
         const std::uint32_t labelled_round = std::uint32_t(m) >> PYR_MASK_EDGE_SHIFT;
         return (m & PYR_MASK_FILLABLE) != 0 || (labelled_round != 0 && labelled_round < round);
     };
+    const auto depth = [&](std::size_t x, std::ptrdiff_t rows) {
+        return std::bit_cast<float>(
+            depths.quant[std::ptrdiff_t(kQuantWords * x) + rows * std::ptrdiff_t(kQuantWords * w) + 2]);
+    };
     const auto scalar = [&](std::size_t x) {
         if ((mask[x] & PYR_MASK_FILLABLE) != 0 || labels[x] != 0 || valid[x] == 0) return;
+        const float z = step > 0.0f ? depth(x, 0) : 0.0f;
         // Labels minus 1 (0 wraps to the largest value): the minimum then skips 0, and adding 1 back gives 0 for none.
         std::uint32_t best = ~0u;
-        const auto take = [&](std::uint8_t m, std::uint32_t l) {
-            if (usable(m)) best = std::min(best, l - 1u);
+        const auto take = [&](std::uint8_t m, std::uint32_t l, std::size_t nx, std::ptrdiff_t rows) {
+            if (!usable(m)) return;
+            if (step > 0.0f && pixel::pyr_edge_depth_near(z, depth(nx, rows), step) == 0u) return;
+            best = std::min(best, l - 1u);
         };
-        if (x > 0) take(mask[x - 1], labels[x - 1]);
-        if (x + 1 < w) take(mask[x + 1], labels[x + 1]);
-        if (above != nullptr) take(mask_above[x], above[x]);
-        if (below != nullptr) take(mask_below[x], below[x]);
+        if (x > 0) take(mask[x - 1], labels[x - 1], x - 1, 0);
+        if (x + 1 < w) take(mask[x + 1], labels[x + 1], x + 1, 0);
+        if (above != nullptr) take(mask_above[x], above[x], x, -1);
+        if (below != nullptr) take(mask_below[x], below[x], x, 1);
         if (best == ~0u) return;
         out[x] = best + 1u;
         changed[x / 64] |= std::uint64_t{1} << (x % 64);
@@ -127,6 +136,13 @@ bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
         if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
         const auto takes = hn::And(open, hn::Ne(best, none));
         if (hn::AllFalse(du, takes)) return;
+        if (step > 0.0f) {
+            // The depth test only removes candidates: the lanes that take a label without it are the only ones
+            // that can with it, and they are few, so each is decided one at a time.
+            for (std::uint64_t b = mask_to_bits(du, takes); b != 0; b &= b - 1)
+                scalar(s + std::size_t(std::countr_zero(b)));
+            return;
+        }
         hn::StoreU(hn::Add(best, one), du, out + s);
         or_mask_bits(du, takes, changed, s);
         any = true;
