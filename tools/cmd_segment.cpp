@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pyrseg/backend.hpp"
+#include "pyrseg/cpu.hpp"
 #include "pyrseg/error.hpp"
 #include "pyrseg/io.hpp"
 #include "pyrseg/scene.hpp"
@@ -37,7 +38,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kSegmentUsage =
-    "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [input options] [parameters]\n"
+    "Usage: pyrseg segment INPUT [outputs] [--backend NAME] [--threads N] [input options] [parameters]\n"
     "       pyrseg segment INPUT... --out-dir DIR [--write labels,png,mask,figure,ply,pcd,stats,graph,scene,\n"
     "                      track_ids,tracks] [--track] [--progress auto|bar|lines|none] [--backend NAME]\n"
     "                      [input options] [parameters]\n"
@@ -82,6 +83,9 @@ constexpr const char* kSegmentUsage =
     "                        PCL): with the settings pyrseg eval tuned for the --sensor named or chosen, else\n"
     "                        PCL's defaults\n"
     "  --backend NAME        @BACKENDS@ or auto (default: $PYRSEG_BACKEND, else auto)\n"
+    "  --threads N           the CPU backend with an arena of N threads of its own (1..1024; implies --backend\n"
+    "                        cpu). Without it the CPU backend shares the process's oneTBB threads, or takes\n"
+    "                        $PYRSEG_THREADS of its own; the labels never depend on the threads.\n"
     "  --quiet, -q           nothing on stderr but warnings and errors (no backend line, notes, hints or progress\n"
     "                        unless --progress is given); stdout still has the results: the frame's line, a batch's\n"
     "                        summary (redirect it to drop them)\n"
@@ -386,8 +390,13 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
                          printable(input).c_str());
         }
         segmenter.reset();  // the old one's memory goes before the new one's is taken
-        segmenter =
-            std::make_unique<Segmenter>(cloud.width, cloud.height, params, args.value("backend").value_or(""), outputs);
+        if (const std::optional<int> threads = args.integer("threads")) {  // checked by cmd_segment: 1..kMaxThreads
+            segmenter = std::make_unique<Segmenter>(
+                cpu::make_segmenter(cloud.width, cloud.height, unsigned(*threads), params, outputs));
+        } else {
+            segmenter = std::make_unique<Segmenter>(cloud.width, cloud.height, params,
+                                                    args.value("backend").value_or(""), outputs);
+        }
         notes.stream_frame = 0;
     }
     const auto start = std::chrono::steady_clock::now();
@@ -659,6 +668,11 @@ int run_batch(const Args& args, const Params& params, RunNotes& notes) {
 // line says the gist, -v the whole.
 void say_backend_choice(const Args& args, const RunNotes& notes) {
     if (notes.quiet || (args.value("backend") && *args.value("backend") != "auto")) return;
+    if (const std::optional<int> threads = args.integer("threads")) {
+        std::fprintf(stderr, "pyrseg: backend cpu (--threads %d: an arena of %d threads of its own)\n", *threads,
+                     *threads);
+        return;
+    }
     const BackendChoice choice = choose_backend(args.value("backend").value_or(""));
     std::string reason = choice.reason;
     if (!args.flag("verbose")) {
@@ -675,7 +689,7 @@ int cmd_segment(const std::vector<std::string>& argv) {
     values.insert(kInputValueOptions.begin(), kInputValueOptions.end());
     values.insert(kTrackValueOptions.begin(), kTrackValueOptions.end());
     for (const OutputOption& o : output_options()) values.insert(o.name);
-    values.insert({"backend", "out-dir", "write", "progress", "color"});
+    values.insert({"backend", "out-dir", "write", "progress", "color", "threads"});
     std::set<std::string> flags = kParameterFlagOptions;
     flags.insert({"help", "quiet", "verbose", "track"});
     const Args args(argv, values, flags, {{"-q", "quiet"}, {"-v", "verbose"}});
@@ -688,6 +702,17 @@ int cmd_segment(const std::vector<std::string>& argv) {
     // Every option is checked before the first input is read: a mistake costs a message, not a partial run.
     const OutputPaths out = output_paths(args);
     if (args.flag("quiet") && args.flag("verbose")) throw UsageError{"give --quiet or --verbose, not both"};
+    if (const std::optional<int> threads = args.integer("threads")) {
+        if (*threads < 1 || *threads > int(cpu::kMaxThreads)) {
+            throw UsageError{"--threads must be in 1.." + std::to_string(cpu::kMaxThreads) + ", got " +
+                             std::to_string(*threads)};
+        }
+        const std::string backend = args.value("backend").value_or("cpu");
+        if (backend != "cpu" && backend != "auto") {
+            throw UsageError{"--threads sets the CPU backend's threads: --backend " + printable(backend) +
+                             " has none (give --backend cpu, or leave --threads out)"};
+        }
+    }
     RunNotes notes;
     notes.quiet = args.flag("quiet");
     notes.track = args.flag("track");

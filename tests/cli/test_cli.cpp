@@ -1447,3 +1447,29 @@ TEST(CliTracks, OtherBackendsRefuseOrAgree) {
 }
 
 }  // namespace
+
+// --threads N: the CPU backend with N threads of its own, the same labels as the shared arena's; out of range, or
+// beside another backend, a usage error that names it.
+TEST(Cli, ThreadsGiveTheCpuBackendItsOwnThreadsAndTheSameLabels) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "s.pcd", pyrseg::cli_test::scene_cloud(160, 120, 7), pyrseg::io::PcdEncoding::binary);
+    CliRun r = run("segment " + (dir / "s.pcd").string() + " --backend cpu --labels " + (dir / "shared.npy").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* threads : {"1", "3"}) {
+        const fs::path own = dir / (std::string("own") + threads + ".npy");
+        r = run("segment " + (dir / "s.pcd").string() + " --threads " + threads + " --labels " + own.string());
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(std::string("backend cpu (--threads ") + threads), std::string::npos) << r.output;
+        EXPECT_EQ(read_labels(own), read_labels(dir / "shared.npy")) << "--threads " << threads;
+    }
+    for (const char* bad : {"0", "1025", "-2"}) {
+        r = run("segment " + (dir / "s.pcd").string() + " --threads " + bad + " --labels " + (dir / "x.npy").string());
+        EXPECT_EQ(r.status, 2) << r.output;
+        EXPECT_NE(r.output.find("--threads must be in 1..1024"), std::string::npos) << r.output;
+    }
+    r = run("segment " + (dir / "s.pcd").string() + " --threads 2 --backend vulkan --labels " +
+            (dir / "x.npy").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--threads sets the CPU backend's threads"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "x.npy"));
+}
