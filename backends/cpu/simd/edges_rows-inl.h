@@ -120,29 +120,42 @@ bool edge_round_row(const std::uint8_t* mask_above, const std::uint8_t* mask, co
     const VU none = hn::Set(du, ~0u);
     const VU fillable_bit = hn::Set(du, PYR_MASK_FILLABLE);
     const VU this_round = hn::Set(du, round);
-    // Labels minus 1 of usable neighbours, the largest value for the others.
-    const auto candidate = [&](const std::uint32_t* l, const std::uint8_t* m) {
+    const DF df;
+    const VF step_v = hn::Set(df, step);
+    // The z of the lanes' pixels `dx` columns and `rows` rows away (the third word of each quantized pixel).
+    const auto depth_at = [&](std::size_t s, std::ptrdiff_t dx, std::ptrdiff_t rows) {
+        VU w0;
+        VU w1;
+        VU w2;
+        const std::ptrdiff_t pixel = std::ptrdiff_t(s) + dx + rows * std::ptrdiff_t(w);
+        hn::LoadInterleaved3(du, depths.quant + std::ptrdiff_t(kQuantWords) * pixel, w0, w1, w2);
+        return hn::BitCast(df, w2);
+    };
+    // Labels minus 1 of usable neighbours, the largest value for the others; with the depth test (pyr_edge_depth_near:
+    // |z_p - z_q| <= s * z_p, the same correctly rounded float operations lane by lane) only of those near in depth.
+    const bool test = step > 0.0f;
+    const auto candidate = [&](const std::uint32_t* l, const std::uint8_t* m, const VF& z, std::size_t s,
+                               std::ptrdiff_t dx, std::ptrdiff_t rows) {
         const VU bits = hn::PromoteTo(du, hn::LoadU(d8q, m));
         const VU labelled_round = hn::ShiftRight<PYR_MASK_EDGE_SHIFT>(bits);
-        const auto use = hn::Or(hn::Ne(hn::And(bits, fillable_bit), hn::Zero(du)),
-                                hn::And(hn::Ne(labelled_round, hn::Zero(du)), hn::Lt(labelled_round, this_round)));
+        auto use = hn::Or(hn::Ne(hn::And(bits, fillable_bit), hn::Zero(du)),
+                          hn::And(hn::Ne(labelled_round, hn::Zero(du)), hn::Lt(labelled_round, this_round)));
+        if (test) {
+            const VF dz = hn::Abs(hn::Sub(z, depth_at(s, dx, rows)));
+            use = hn::And(use, hn::RebindMask(du, hn::Le(dz, hn::Mul(step_v, z))));
+        }
         return hn::IfThenElse(use, hn::Sub(hn::LoadU(du, l), one), none);
     };
     const std::size_t x = for_each_edge_part(mask, valid, w, [&](std::size_t s, auto is_edge) {
         const auto open = hn::And(is_edge, hn::Eq(hn::LoadU(du, labels + s), hn::Zero(du)));
         if (hn::AllFalse(du, open)) return;
-        VU best = hn::Min(candidate(labels + s - 1, mask + s - 1), candidate(labels + s + 1, mask + s + 1));
-        if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s));
-        if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s));
+        const VF z = test ? depth_at(s, 0, 0) : hn::Zero(df);
+        VU best = hn::Min(candidate(labels + s - 1, mask + s - 1, z, s, -1, 0),
+                          candidate(labels + s + 1, mask + s + 1, z, s, 1, 0));
+        if (above != nullptr) best = hn::Min(best, candidate(above + s, mask_above + s, z, s, 0, -1));
+        if (below != nullptr) best = hn::Min(best, candidate(below + s, mask_below + s, z, s, 0, 1));
         const auto takes = hn::And(open, hn::Ne(best, none));
         if (hn::AllFalse(du, takes)) return;
-        if (step > 0.0f) {
-            // The depth test only removes candidates: the lanes that take a label without it are the only ones
-            // that can with it, and they are few, so each is decided one at a time.
-            for (std::uint64_t b = mask_to_bits(du, takes); b != 0; b &= b - 1)
-                scalar(s + std::size_t(std::countr_zero(b)));
-            return;
-        }
         hn::StoreU(hn::Add(best, one), du, out + s);
         or_mask_bits(du, takes, changed, s);
         any = true;
