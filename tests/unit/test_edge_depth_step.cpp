@@ -12,19 +12,12 @@
 #include "pyrseg/error.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "support/plan_error.hpp"
 
 namespace pyrseg {
 namespace {
 
-std::string plan_error(const Params& p) {
-    try {
-        (void)core::make_plan(64, 48, p);
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::invalid_parameter) << e.what();
-        return e.what();
-    }
-    return "";
-}
+using test::plan_error;
 
 TEST(EdgeDepthStep, OutOfRangeIsRefusedByName) {
     Params p;
