@@ -1,10 +1,12 @@
-// Writing PCD files the way PCL does: fields x y z [normal_x normal_y normal_z] as F 4 [label as U 4], VERSION 0.7.
+// Writing PCD files the way PCL does: fields x y z [normal_x normal_y normal_z] as F 4 [label and other per-point
+// integers as U 4], VERSION 0.7.
 #include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,15 +22,32 @@ using detail::fail;
 
 static_assert(std::endian::native == std::endian::little, "PCD binary writing assumes a little-endian host");
 
-// What one point holds, in file order: x y z, then normal_x normal_y normal_z, then label (PCL's PointXYZL and
-// PointXYZLNormal name it so; pcl::io::loadPCDFile matches fields by name, so the order is free).
+// What one point holds, in file order: x y z, then normal_x normal_y normal_z, then the integer fields (label first
+// where given: PCL's PointXYZL and PointXYZLNormal name it so; pcl::io::loadPCDFile matches fields by name, so the
+// order is free).
 struct Layout {
     bool normals = false;
-    const std::uint32_t* labels = nullptr;
+    std::span<const PcdField> integers;
     [[nodiscard]] std::size_t float_fields() const { return normals ? 6 : 3; }
-    [[nodiscard]] std::size_t fields() const { return float_fields() + (labels != nullptr ? 1 : 0); }
+    [[nodiscard]] std::size_t fields() const { return float_fields() + integers.size(); }
     [[nodiscard]] std::size_t point_bytes() const { return 4 * fields(); }
 };
+
+// A field name PCL's header reader takes (one token of letters, digits and '_') that no other field has.
+void check_fields(const std::filesystem::path& path, std::span<const PcdField> fields) {
+    std::vector<std::string> taken = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
+    for (const PcdField& f : fields) {
+        const bool word = !f.name.empty() && f.name.find_first_not_of(
+                                                 "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTU"
+                                                 "VWXYZ0123456789_") == std::string::npos;
+        if (!word) fail(ErrorCode::invalid_argument, path, "PCD field name '" + f.name + "' is not one word");
+        for (const std::string& t : taken) {
+            if (t == f.name) fail(ErrorCode::invalid_argument, path, "PCD field '" + f.name + "' is given twice");
+        }
+        if (f.values == nullptr) fail(ErrorCode::invalid_argument, path, "PCD field '" + f.name + "' has no values");
+        taken.push_back(f.name);
+    }
+}
 
 std::string header(const PointCloud& cloud, const Layout& layout, const char* data) {
     const std::string n = std::to_string(static_cast<long long>(cloud.width) * cloud.height);
@@ -39,8 +58,8 @@ std::string header(const PointCloud& cloud, const Layout& layout, const char* da
         types += " F F F";
         counts += " 1 1 1";
     }
-    if (layout.labels != nullptr) {
-        names += " label";
+    for (const PcdField& f : layout.integers) {
+        names += " " + f.name;
         sizes += " 4";
         types += " U";
         counts += " 1";
@@ -79,9 +98,9 @@ std::string ascii_body(const PointCloud& cloud, std::size_t n, const Layout& lay
             out += ' ';
             append_float(out, cloud.normals[3 * i + static_cast<std::size_t>(c)]);
         }
-        if (layout.labels != nullptr) {
+        for (const PcdField& f : layout.integers) {
             char buf[16];
-            const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, layout.labels[i]);
+            const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, f.values[i]);
             out += ' ';
             out.append(buf, end);
         }
@@ -96,7 +115,7 @@ std::string binary_body(const PointCloud& cloud, std::size_t n, const Layout& la
     for (std::size_t i = 0; i < n; ++i) {
         append_bytes(out, &cloud.points[3 * i], 3 * sizeof(float));
         if (layout.normals) append_bytes(out, &cloud.normals[3 * i], 3 * sizeof(float));
-        if (layout.labels != nullptr) append_bytes(out, &layout.labels[i], sizeof(std::uint32_t));
+        for (const PcdField& f : layout.integers) append_bytes(out, &f.values[i], sizeof(std::uint32_t));
     }
     return out;
 }
@@ -109,14 +128,17 @@ std::string compressed_body(const std::filesystem::path& path, const PointCloud&
              "cloud too large for DATA binary_compressed (" + std::to_string(raw_size) +
                  " bytes; the format stores sizes in 32 bits): write it as binary");
     }
-    // Structure of arrays: all x, then all y, ... (then all labels) as PCL's reader expects.
+    // Structure of arrays: all x, then all y, ... (then each integer field's values) as PCL's reader expects.
     std::vector<unsigned char> soa(raw_size);
     unsigned char* block = soa.data();
     for (std::size_t f = 0; f < layout.float_fields(); ++f, block += 4 * n) {
         const std::vector<float>& src = f < 3 ? cloud.points : cloud.normals;
         for (std::size_t i = 0; i < n; ++i) std::memcpy(block + 4 * i, &src[3 * i + f % 3], sizeof(float));
     }
-    if (layout.labels != nullptr) std::memcpy(block, layout.labels, n * sizeof(std::uint32_t));
+    for (const PcdField& f : layout.integers) {
+        std::memcpy(block, f.values, n * sizeof(std::uint32_t));
+        block += 4 * n;
+    }
     const std::vector<unsigned char> packed = detail::lzf_pack(soa.data(), raw_size);
     if (packed.empty()) fail(ErrorCode::internal, path, "LZF compression failed");
     const auto compressed = static_cast<std::uint32_t>(packed.size());
@@ -130,11 +152,12 @@ std::string compressed_body(const std::filesystem::path& path, const PointCloud&
 
 }  // namespace
 
-void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, std::span<const PcdField> fields,
                PcdEncoding encoding) {
     detail::check_cloud_to_write(path, cloud);
+    check_fields(path, fields);
     const auto n = static_cast<std::size_t>(cloud.width) * static_cast<std::size_t>(cloud.height);
-    const Layout layout{!cloud.normals.empty(), labels};
+    const Layout layout{!cloud.normals.empty(), fields};
     std::string out;
     switch (encoding) {
         case PcdEncoding::ascii:
@@ -152,8 +175,18 @@ void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const
     detail::write_file(path, out.data(), out.size());
 }
 
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
+               PcdEncoding encoding) {
+    if (labels == nullptr) {
+        write_pcd(path, cloud, std::span<const PcdField>{}, encoding);
+        return;
+    }
+    const PcdField label{"label", labels};
+    write_pcd(path, cloud, std::span<const PcdField>(&label, 1), encoding);
+}
+
 void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, PcdEncoding encoding) {
-    write_pcd(path, cloud, nullptr, encoding);
+    write_pcd(path, cloud, std::span<const PcdField>{}, encoding);
 }
 
 }  // namespace pyrseg::io

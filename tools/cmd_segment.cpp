@@ -60,7 +60,10 @@ constexpr const char* kSegmentUsage =
     "                        num_cols/num_rows and a range_grid), for CloudCompare, MeshLab or PCL\n"
     "  --pcd OUT.pcd         the cloud with each point's segment in a 'label' field (0: none), binary PCD in PCL's\n"
     "                        PointXYZL layout: pcl::io::loadPCDFile reads it into pcl::PointCloud<pcl::PointXYZL>.\n"
-    "                        Organized, invalid points NaN, in the input's unit (millimetres for depth images)\n"
+    "                        Organized, invalid points NaN, in the input's unit (millimetres for depth images).\n"
+    "                        With --scene also 'object' and 'support' (the scene object or support the point's\n"
+    "                        segment is: 1 + its index in the scene's JSON, 0: none), with --track 'track' (the\n"
+    "                        track id); PCL reads them by name from a pcl::PCLPointCloud2\n"
     "  --stats OUT.json      per segment: label, pixel count, bounding box, 3D centroid (the cloud's units), mean\n"
     "  --stats OUT.csv       normal, depth range, plane (normal towards the camera, offset, RMS distance, curvature,\n"
     "                        planar or not) and oriented box (axes, side lengths), from exact sums the backend\n"
@@ -225,6 +228,27 @@ void write_id_image(const fs::path& path, const std::vector<std::uint32_t>& valu
     }
     std::vector<std::uint16_t> gray(values.begin(), values.end());
     io::write_png_gray16(path, gray.data(), width, height);
+}
+
+// Per pixel, 1 + the index of the scene object (support) that its segment is, 0 for none: the labelled PCD's object
+// and support fields, whose numbers are the scene JSON's objects[k] and supports[k] plus one.
+void scene_index_images(const Scene& scene, const std::vector<std::uint32_t>& labels,
+                        std::vector<std::uint32_t>& object, std::vector<std::uint32_t>& support) {
+    const std::uint32_t largest = labels.empty() ? 0u : *std::max_element(labels.begin(), labels.end());
+    std::vector<std::uint32_t> object_of(std::size_t(largest) + 1, 0);
+    std::vector<std::uint32_t> support_of(object_of.size(), 0);
+    for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+        if (scene.objects[k].label <= largest) object_of[scene.objects[k].label] = std::uint32_t(k + 1);
+    }
+    for (std::size_t k = 0; k < scene.supports.size(); ++k) {
+        if (scene.supports[k].label <= largest) support_of[scene.supports[k].label] = std::uint32_t(k + 1);
+    }
+    object.resize(labels.size());
+    support.resize(labels.size());
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        object[i] = object_of[labels[i]];
+        support[i] = support_of[labels[i]];
+    }
 }
 
 // The scene as its pictures show it (--scene OUT.ply, the figure's scene panel): with tracks, each support and
@@ -460,9 +484,18 @@ FrameReport segment_frame(const fs::path& input, const Args& args, const Params&
         files.stage(*out.ply, [&](const fs::path& to) { io::write_ply(to, cloud, colour_keys(result).data(), true); });
     }
     if (out.pcd) {
-        files.stage(*out.pcd, [&](const fs::path& to) {
-            io::write_pcd(to, cloud, result.labels.data(), io::PcdEncoding::binary);
-        });
+        // The segment's label, and with --scene the scene object and support each point's segment is (1 + its
+        // index in the scene's JSON, 0: none), with --track its track id.
+        std::vector<io::PcdField> fields = {{"label", result.labels.data()}};
+        std::vector<std::uint32_t> object;
+        std::vector<std::uint32_t> support;
+        if (out.scene) {
+            scene_index_images(scene, result.labels, object, support);
+            fields.push_back({"object", object.data()});
+            fields.push_back({"support", support.data()});
+        }
+        if (notes.track) fields.push_back({"track", result.track_ids.data()});
+        files.stage(*out.pcd, [&](const fs::path& to) { io::write_pcd(to, cloud, fields, io::PcdEncoding::binary); });
     }
     std::string pcl_note;
     if (out.pcl_png) {

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,17 @@ PYRSEG_IO_EXPORT void write_pcd(const std::filesystem::path& path, const PointCl
 // pcl::PointCloud<pcl::PointXYZL>. Label 0 is no segment.
 PYRSEG_IO_EXPORT void write_pcd(const std::filesystem::path& path, const PointCloud& cloud, const std::uint32_t* labels,
                                 PcdEncoding encoding);
+// A per-point unsigned integer field (U 4): W*H values, row-major.
+struct PcdField {
+    std::string name;  // one word of letters, digits and '_', not x, y, z or normal_*, and no other field's
+    const std::uint32_t* values = nullptr;
+};
+// The same with any integer fields after the points (and normals), in the order given: {"label", labels} first
+// gives pcl::PointXYZL's layout, and further fields (a segment's object, support or track) are read by name from
+// pcl::PCLPointCloud2. A name that is not one word, is taken twice or has no values is pyrseg::Error
+// (invalid_argument), and nothing is written.
+PYRSEG_IO_EXPORT void write_pcd(const std::filesystem::path& path, const PointCloud& cloud,
+                                std::span<const PcdField> fields, PcdEncoding encoding);
 
 // PLY through PCL's PLY reader and writer (pcl_io). Without PCL at build time (PYRSEG_HAVE_PLY=0) both throw
 // ErrorCode::format saying that pyrseg was built without PLY support.

@@ -112,13 +112,13 @@ io::PointCloud cloud_of(const char* function, const char* store, const py::objec
 
 // Labels (H x W, values 0..2^32-1, or None) checked against the cloud's size, kept alive by `keep`.
 const std::uint32_t* labels_of(const char* function, const char* store, const py::object& labels, int width, int height,
-                               py::array_t<std::uint32_t, py::array::c_style>& keep) {
+                               py::array_t<std::uint32_t, py::array::c_style>& keep, const char* what = "labels") {
     if (labels.is_none()) return nullptr;
-    const py::array a = numeric(function, "labels", labels);
+    const py::array a = numeric(function, what, labels);
     if (a.ndim() != 2 || a.shape(0) != height || a.shape(1) != width) {
-        throw py::value_error(std::string(function) + ": labels must be an H x W array of the cloud's size");
+        throw py::value_error(std::string(function) + ": " + what + " must be an H x W array of the cloud's size");
     }
-    keep = exact<std::uint32_t>(a, function, "labels", store);
+    keep = exact<std::uint32_t>(a, function, what, store);
     return keep.data();
 }
 
@@ -150,7 +150,8 @@ io::Intrinsics& intrinsics_of(py::handle self) {
 
 // The functions' parameters (Args binds them; their docstrings show them).
 constexpr Param kPath[] = {{"path"}};
-constexpr Param kWritePcd[] = {{"path"}, {"points"}, {"normals", "None"}, {"labels", "None"}, {"encoding", "'binary'"}};
+constexpr Param kWritePcd[] = {
+    {"path"}, {"points"}, {"normals", "None"}, {"labels", "None"}, {"encoding", "'binary'"}, {"fields", "None"}};
 constexpr Param kWritePly[] = {{"path"}, {"points"}, {"normals", "None"}, {"labels", "None"}, {"binary", "True"}};
 constexpr Param kWriteDepth[] = {{"path"}, {"depth"}};
 constexpr Param kWriteImage[] = {{"path"}, {"image"}};
@@ -230,18 +231,42 @@ void bind_io(py::module_& io) {
                [](const fs::path& path) { return cloud_tuple(io::read_ply(path)); });
     def_reader(io, "read_npy_cloud", "read_npy_cloud()", "An H x W x 3 or H x W x 6 .npy cloud as (points, normals).",
                [](const fs::path& path) { return cloud_tuple(io::read_npy_cloud(path)); });
-    def_args(io, "write_pcd", kWritePcd,
-             "Writes x y z (normal_x normal_y normal_z with normals; a label field, PCL's PointXYZL, with labels). "
-             "Points and normals are stored as float32, labels as uint32: a value they cannot hold is a ValueError.",
-             [](const py::args& args, const py::kwargs& kwargs) {
-                 const char* f = "write_pcd()";
-                 const Args a(f, kWritePcd, args, kwargs);
-                 const fs::path path = a.path(0);
-                 const io::PcdEncoding encoding = encoding_of(a.text(4, "binary"));
-                 const io::PointCloud c = cloud_of(f, "a PCD file", a.object(1), a.object(2));
-                 py::array_t<std::uint32_t, py::array::c_style> keep;
-                 io::write_pcd(path, c, labels_of(f, "a PCD file", a.object(3), c.width, c.height, keep), encoding);
-             });
+    def_args(
+        io, "write_pcd", kWritePcd,
+        "Writes x y z (normal_x normal_y normal_z with normals; a label field, PCL's PointXYZL, with labels; "
+        "then one uint32 field per item of fields, a dict of name -> H x W array, in its order). Points and "
+        "normals are stored as float32, labels and fields as uint32: a value they cannot hold is a ValueError.",
+        [](const py::args& args, const py::kwargs& kwargs) {
+            const char* f = "write_pcd()";
+            const Args a(f, kWritePcd, args, kwargs);
+            const fs::path path = a.path(0);
+            const io::PcdEncoding encoding = encoding_of(a.text(4, "binary"));
+            const io::PointCloud c = cloud_of(f, "a PCD file", a.object(1), a.object(2));
+            std::vector<py::array_t<std::uint32_t, py::array::c_style>> keep(1);
+            std::vector<io::PcdField> fields;
+            if (const std::uint32_t* labels = labels_of(f, "a PCD file", a.object(3), c.width, c.height, keep[0])) {
+                fields.push_back({"label", labels});
+            }
+            const py::object given = a.object(5);
+            if (!given.is_none()) {
+                if (!py::isinstance<py::dict>(given)) {
+                    throw py::type_error("write_pcd(): fields must be a dict of name -> H x W array, got " +
+                                         std::string(py::str(given.get_type().attr("__name__"))));
+                }
+                const py::dict named = given.cast<py::dict>();
+                keep.resize(1 + named.size());
+                std::size_t k = 1;
+                for (const auto& [name, values] : named) {
+                    if (!py::isinstance<py::str>(name))
+                        throw py::type_error("write_pcd(): a field's name must be a str");
+                    const std::string text = name.cast<std::string>();
+                    const std::string what = "field '" + text + "'";
+                    fields.push_back({text, labels_of(f, "a PCD file", py::reinterpret_borrow<py::object>(values),
+                                                      c.width, c.height, keep[k++], what.c_str())});
+                }
+            }
+            io::write_pcd(path, c, fields, encoding);
+        });
     def_args(io, "write_ply", kWritePly,
              "Writes an organized PLY, coloured by segment when labels are given (points and normals float32, labels "
              "uint32: a value they cannot hold is a ValueError).",

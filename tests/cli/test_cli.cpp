@@ -1473,3 +1473,64 @@ TEST(Cli, ThreadsGiveTheCpuBackendItsOwnThreadsAndTheSameLabels) {
     EXPECT_NE(r.output.find("--threads sets the CPU backend's threads"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "x.npy"));
 }
+
+// The labelled PCD with --scene: beside 'label', 'object' and 'support' name the scene JSON's objects[k] and
+// supports[k] as k + 1 (0: none), so a PCL user finds each point's object without the labels' image.
+TEST(Cli, LabelledPcdNamesEachPointsSceneObjectAndSupport) {
+    const fs::path dir = temp_dir();
+    pyrseg::io::write_pcd(dir / "s.pcd", pyrseg::cli_test::scene_cloud(160, 120, 3), pyrseg::io::PcdEncoding::binary);
+    CliRun r = run("segment " + (dir / "s.pcd").string() + " --backend cpu --scene " + (dir / "scene.json").string() +
+                   " --pcd " + (dir / "out.pcd").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "scene.json");
+    const nlohmann::json scene = nlohmann::json::parse(in);
+    ASSERT_FALSE(scene["objects"].empty());
+    ASSERT_FALSE(scene["supports"].empty());
+    std::ifstream pcd_in(dir / "out.pcd", std::ios::binary);
+    const std::string pcd((std::istreambuf_iterator<char>(pcd_in)), std::istreambuf_iterator<char>());
+    const std::size_t fields_at = pcd.find("FIELDS ");
+    const std::string fields = pcd.substr(fields_at + 7, pcd.find('\n', fields_at) - fields_at - 7);
+    EXPECT_TRUE(fields == "x y z label object support" ||
+                fields == "x y z normal_x normal_y normal_z label object support")
+        << fields;
+    const std::size_t floats = fields.starts_with("x y z normal_x") ? 6 : 3;
+    const std::size_t step = 4 * (floats + 3);
+    const std::size_t data = pcd.find("DATA binary\n") + 12;
+    ASSERT_EQ(pcd.size() - data, std::size_t{160} * 120 * step);
+    std::size_t object_points = 0;
+    std::size_t support_points = 0;
+    for (std::size_t i = 0; i < std::size_t{160} * 120; ++i) {
+        std::uint32_t v[3];
+        std::memcpy(v, pcd.data() + data + i * step + 4 * floats, sizeof v);
+        const auto [label, object, support] = std::tuple{v[0], v[1], v[2]};
+        ASSERT_FALSE(object != 0 && support != 0) << "a segment is an object or a support, not both: " << i;
+        if (object != 0) {
+            ASSERT_LE(object, scene["objects"].size());
+            ASSERT_EQ(scene["objects"][object - 1]["label"].get<std::uint32_t>(), label) << i;
+            ++object_points;
+        }
+        if (support != 0) {
+            ASSERT_LE(support, scene["supports"].size());
+            ASSERT_EQ(scene["supports"][support - 1]["label"].get<std::uint32_t>(), label) << i;
+            ++support_points;
+        }
+        if (label != 0 && object == 0 && support == 0) {
+            for (const nlohmann::json& o : scene["objects"]) ASSERT_NE(o["label"].get<std::uint32_t>(), label) << i;
+        }
+    }
+    EXPECT_GT(object_points, 0u);
+    EXPECT_GT(support_points, 0u);
+    // Without --scene the PCD is PointXYZL's: the label alone.
+    r = run("segment " + (dir / "s.pcd").string() + " --backend cpu --pcd " + (dir / "plain.pcd").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream plain_in(dir / "plain.pcd", std::ios::binary);
+    const std::string plain((std::istreambuf_iterator<char>(plain_in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(plain.find("label\nSIZE"), std::string::npos);
+    // With --track the track ids follow (a lone frame's tracks are new: ids 1..K, as its labels).
+    r = run("segment " + (dir / "s.pcd").string() + " --backend cpu --track --pcd " + (dir / "tracked.pcd").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream tracked_in(dir / "tracked.pcd", std::ios::binary);
+    const std::string tracked((std::istreambuf_iterator<char>(tracked_in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(tracked.find(" label track\nSIZE"), std::string::npos);
+    fs::remove_all(dir);
+}

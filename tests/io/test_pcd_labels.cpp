@@ -1,11 +1,14 @@
 // Labelled PCD output (PCL's PointXYZL layout) read back by pyrseg and by PCL itself, and the writers' promise that
 // a failed write never leaves part of a file.
 
+#include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "io_test_util.hpp"
 
 #if PYRSEG_TEST_PCL
+#include <pcl/PCLPointCloud2.h>
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -121,12 +124,61 @@ TEST_P(PcdLabelsRoundTrip, PclLoadsItAsPointXYZL) {
 }
 #endif
 
+// Further integer fields (the CLI's object, support, track) after the label: PCL reads each by name, in every
+// encoding, and pyrseg's own reader still reads the points.
+TEST_P(PcdLabelsRoundTrip, FurtherFieldsReadBackByName) {
+    const auto& [encoding, normals] = GetParam();
+    ScratchDir dir;
+    const PointCloud cloud = make_cloud(23, 17, normals);
+    const std::vector<std::uint32_t> labels = make_labels(cloud);
+    std::vector<std::uint32_t> object(labels.size());
+    std::vector<std::uint32_t> track(labels.size());
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        object[i] = labels[i] % 4;
+        track[i] = 4000000000u - static_cast<std::uint32_t>(i);
+    }
+    const std::vector<PcdField> fields = {{"label", labels.data()}, {"object", object.data()}, {"track", track.data()}};
+    write_pcd(dir / "f.pcd", cloud, fields, encoding_of(encoding));
+    expect_same_cloud(cloud, read_pcd(dir / "f.pcd"));
+#if PYRSEG_TEST_PCL
+    pcl::PCLPointCloud2 blob;
+    ASSERT_EQ(pcl::io::loadPCDFile((dir / "f.pcd").string(), blob), 0);
+    ASSERT_EQ(blob.width * blob.height, labels.size());
+    using Named = std::pair<const char*, const std::vector<std::uint32_t>*>;
+    for (const auto& [name, values] : {Named{"label", &labels}, Named{"object", &object}, Named{"track", &track}}) {
+        const auto field = std::find_if(blob.fields.begin(), blob.fields.end(),
+                                        [&](const pcl::PCLPointField& f) { return f.name == name; });
+        ASSERT_NE(field, blob.fields.end()) << name;
+        EXPECT_EQ(field->datatype, pcl::PCLPointField::UINT32) << name;
+        for (std::size_t i = 0; i < labels.size(); ++i) {
+            std::uint32_t v = 0;
+            std::memcpy(&v, blob.data.data() + i * blob.point_step + field->offset, 4);
+            ASSERT_EQ(v, (*values)[i]) << name << " " << i;
+        }
+    }
+#endif
+}
+
 INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdLabelsRoundTrip,
                          ::testing::Combine(::testing::Values("ascii", "binary", "binary_compressed"),
                                             ::testing::Bool()),
                          [](const auto& p) {
                              return std::get<0>(p.param) + (std::get<1>(p.param) ? "_normals" : "_xyz");
                          });
+
+// A field name PCL's header could not hold, or one taken twice, is refused before anything is written.
+TEST(PcdLabels, FieldNamesMustBeOneNewWord) {
+    ScratchDir dir;
+    const PointCloud cloud = make_cloud(2, 2, false);
+    const std::vector<std::uint32_t> values(4, 1);
+    for (const std::string bad : {"", "two words", "x", "normal_y", "label", "tab\t"}) {
+        const std::vector<PcdField> fields = {{"label", values.data()}, {bad, values.data()}};
+        EXPECT_THROW(write_pcd(dir / "b.pcd", cloud, fields, PcdEncoding::binary), Error) << bad;
+    }
+    const std::vector<PcdField> missing = {{"object", nullptr}};
+    EXPECT_THROW(write_pcd(dir / "b.pcd", cloud, missing, PcdEncoding::binary), Error);
+    EXPECT_TRUE(files_in(dir.path()).empty());
+}
 
 TEST(AtomicWrite, ReplacesTheFileAndLeavesNothingElse) {
     ScratchDir dir;

@@ -87,3 +87,24 @@ def test_errors_name_the_file(tmp_path):
     with pytest.raises(pyrseg.Error) as e:
         pyrseg.io.read_pcd(tmp_path / "missing.pcd")
     assert e.value.code == pyrseg.ErrorCode.io and "missing.pcd" in e.value.message
+
+
+def test_write_pcd_takes_further_integer_fields(tmp_path):
+    points = np.arange(4 * 3 * 3, dtype=np.float32).reshape(4, 3, 3) + 1
+    labels = np.arange(12, dtype=np.uint32).reshape(4, 3)
+    track = (4000000000 - np.arange(12)).astype(np.uint32).reshape(4, 3)
+    path = tmp_path / "f.pcd"
+    pyrseg.io.write_pcd(path, points, labels=labels, fields={"object": labels % 3, "track": track}, encoding="ascii")
+    text = path.read_text()
+    assert "FIELDS x y z label object track\n" in text and "TYPE F F F U U U\n" in text
+    rows = text.split("DATA ascii\n")[1].split("\n")
+    assert rows[5].split()[3:] == ["5", "2", str(4000000000 - 5)]
+    back, _ = pyrseg.io.read_pcd(path)
+    np.testing.assert_array_equal(back, points)
+    with pytest.raises(pyrseg.Error):  # a name PCL's header cannot hold, nothing written
+        pyrseg.io.write_pcd(tmp_path / "bad.pcd", points, fields={"two words": labels})
+    assert not (tmp_path / "bad.pcd").exists()
+    with pytest.raises(ValueError, match="field 'object'"):
+        pyrseg.io.write_pcd(tmp_path / "bad.pcd", points, fields={"object": labels[:2]})
+    with pytest.raises(TypeError, match="dict"):
+        pyrseg.io.write_pcd(tmp_path / "bad.pcd", points, fields=[labels])
