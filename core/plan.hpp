@@ -34,11 +34,6 @@ struct Thresholds {
 // Throws pyrseg::Error(invalid_parameter) naming the parameter.
 [[nodiscard]] Thresholds compute_thresholds(const Params& params);
 
-// Whether step 6c's rounds test depths (section 5): edge pixels labelled, several rounds and a depth step share.
-[[nodiscard]] inline bool uses_edge_depth_step(const Params& p) {
-    return p.label_edges && p.edge_rounds >= 2 && p.edge_max_depth_step > 0.0;
-}
-
 // unit_mm (Params, sensor_preset, measure_frame_noise): a finite number of millimetres > 0, else
 // pyrseg::Error(invalid_parameter) naming it.
 void check_unit_mm(double unit_mm);

@@ -270,7 +270,7 @@ void Segmenter::segment_mask(const MaskView& mask, Result& out) {
                     "merge measures the boundaries on points and normals: a mask has none (segment a cloud or a "
                     "depth image, or turn merge off)");
     }
-    if (core::uses_edge_depth_step(impl.plan.params)) {
+    if (uses_edge_depth_step(impl.plan.params)) {
         throw Error(ErrorCode::invalid_parameter,
                     "edge_max_depth_step compares the depths of edge pixels: a mask has none (segment a cloud or a "
                     "depth image, or set edge_max_depth_step to 0)");

@@ -245,8 +245,7 @@ void evaluate_scene(const synthetic::SceneOptions& options, const std::vector<do
     // with either on, the bridged masks are labelled without them (the bridges' test is the pyramid's, which the
     // merge only follows, and the bridges are fillable, so the rounds do not cross them), and bridge width 0 takes
     // the cloud's own labels, both included.
-    const Params& given = segmenter.params();
-    const bool merge = given.merge || (given.label_edges && given.edge_rounds >= 2 && given.edge_max_depth_step > 0.0);
+    const bool merge = segmenter.params().merge || uses_edge_depth_step(segmenter.params());
     std::optional<Segmenter> unmerged;
     if (merge) {
         Params p = segmenter.params();

@@ -144,8 +144,7 @@ void CpuExecutor::points_to_mask(bool estimate_normals) {
     }
     // The statistics, the merge and the graph read each pixel's qn, step 6c's depth test its z; nothing else reads
     // the quantized pixels after the metric.
-    if (plan_.stats_slots != 0 || plan_.params.merge || plan_.graph_slots != 0 ||
-        core::uses_edge_depth_step(plan_.params)) {
+    if (plan_.stats_slots != 0 || plan_.params.merge || plan_.graph_slots != 0 || uses_edge_depth_step(plan_.params)) {
         f.quant_out = quant_.data();
     }
     f.mask_out = mask_.data() + plan_.full().offset;

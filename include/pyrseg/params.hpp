@@ -85,4 +85,10 @@ struct Params {
     double ct_growth_per_m2 = 0.0;  // 1 - cos(ct) grows by this factor per square metre of depth
 };
 
+// Whether step 6c's rounds test depths (docs/algorithm.md section 5): edge pixels labelled, several rounds and an
+// edge_max_depth_step above 0. A mask frame, which has no depths, is refused then.
+[[nodiscard]] inline bool uses_edge_depth_step(const Params& p) {
+    return p.label_edges && p.edge_rounds >= 2 && p.edge_max_depth_step > 0.0;
+}
+
 }  // namespace pyrseg

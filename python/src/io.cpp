@@ -122,6 +122,29 @@ const std::uint32_t* labels_of(const char* function, const char* store, const py
     return keep.data();
 }
 
+// write_pcd's fields=: a dict of name -> H x W array, each appended to `fields` as a uint32 field, its array kept
+// alive in `keep`.
+void append_named_fields(const char* function, const py::object& given, int width, int height,
+                         std::vector<py::array_t<std::uint32_t, py::array::c_style>>& keep,
+                         std::vector<io::PcdField>& fields) {
+    if (given.is_none()) return;
+    if (!py::isinstance<py::dict>(given)) {
+        throw py::type_error(std::string(function) + ": fields must be a dict of name -> H x W array, got " +
+                             std::string(py::str(given.get_type().attr("__name__"))));
+    }
+    const py::dict named = given.cast<py::dict>();
+    keep.reserve(keep.size() + named.size());
+    for (const auto& [name, values] : named) {
+        if (!py::isinstance<py::str>(name))
+            throw py::type_error(std::string(function) + ": a field's name must be a str");
+        const std::string text = name.cast<std::string>();
+        const std::string what = "field '" + text + "'";
+        keep.emplace_back();
+        fields.push_back({text, labels_of(function, "a PCD file", py::reinterpret_borrow<py::object>(values), width,
+                                          height, keep.back(), what.c_str())});
+    }
+}
+
 template <class T>
 py::array_t<T, py::array::c_style> image_of(const char* function, const py::object& obj, const char* what, int channels,
                                             const char* store) {
@@ -247,24 +270,7 @@ void bind_io(py::module_& io) {
             if (const std::uint32_t* labels = labels_of(f, "a PCD file", a.object(3), c.width, c.height, keep[0])) {
                 fields.push_back({"label", labels});
             }
-            const py::object given = a.object(5);
-            if (!given.is_none()) {
-                if (!py::isinstance<py::dict>(given)) {
-                    throw py::type_error("write_pcd(): fields must be a dict of name -> H x W array, got " +
-                                         std::string(py::str(given.get_type().attr("__name__"))));
-                }
-                const py::dict named = given.cast<py::dict>();
-                keep.resize(1 + named.size());
-                std::size_t k = 1;
-                for (const auto& [name, values] : named) {
-                    if (!py::isinstance<py::str>(name))
-                        throw py::type_error("write_pcd(): a field's name must be a str");
-                    const std::string text = name.cast<std::string>();
-                    const std::string what = "field '" + text + "'";
-                    fields.push_back({text, labels_of(f, "a PCD file", py::reinterpret_borrow<py::object>(values),
-                                                      c.width, c.height, keep[k++], what.c_str())});
-                }
-            }
+            append_named_fields(f, a.object(5), c.width, c.height, keep, fields);
             io::write_pcd(path, c, fields, encoding);
         });
     def_args(io, "write_ply", kWritePly,

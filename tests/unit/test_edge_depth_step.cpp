@@ -45,7 +45,7 @@ TEST(EdgeDepthStep, ConsumerPresetsTestDepthsTheScannerPresetDoesNot) {
         const Params p = sensor_preset(kind);
         const bool consumer = kind != SensorKind::structured_light;
         EXPECT_EQ(p.edge_max_depth_step, consumer ? 0.02 : 0.0) << sensor_kind_name(kind);
-        EXPECT_EQ(core::uses_edge_depth_step(p), consumer) << sensor_kind_name(kind);
+        EXPECT_EQ(uses_edge_depth_step(p), consumer) << sensor_kind_name(kind);
     }
 }
 
