@@ -101,6 +101,13 @@ void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
         const std::size_t bytes = 4 * plan.stats_words();
         check_rows("statistics", labels.statistics, bytes, bytes, 1, 4, width, height);
     }
+    if (labels.graph.handle != 0) {
+        if (plan.graph_slots == 0) {
+            bad("a segment graph buffer was given but the Segmenter was made without Outputs::segment_graph");
+        }
+        const std::size_t bytes = 4 * plan.graph_words();
+        check_rows("segment graph", labels.graph, bytes, bytes, 1, 4, width, height);
+    }
 }
 
 }  // namespace

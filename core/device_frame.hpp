@@ -61,6 +61,9 @@ struct DeviceLabels {
     ExternalBuffer count;
     // The statistics' words (Segmenter::device_statistics_bytes), for a Segmenter made with Outputs::segment_stats.
     ExternalBuffer statistics;
+    // The segment graph's words (Segmenter::device_segment_graph_bytes), for a Segmenter made with
+    // Outputs::segment_graph.
+    ExternalBuffer graph;
 };
 
 // A Segmenter over an executor a backend made on the caller's context (the interop functions' constructors).
@@ -75,8 +78,9 @@ struct DeviceLabels {
 // offset, the steps fit the rows and are multiples of 4 (of 2 for u16 depth), depth's units and intrinsics are
 // positive and finite; a pyrseg::Error names the problem), then `checked` (where an API queues what the frame waits
 // for: nothing is queued before every check passed), the input bound, every pass, the labels (and K) written to the
-// caller's buffers; then the executor submits without waiting. The results of Outputs other than the labels and K are
-// not produced (they are host results); Segmenter::last_timings() is empty after such a frame.
+// caller's buffers; then the executor submits without waiting. The results of Outputs other than the labels, K, the
+// statistics and the graph are not produced (they are host results); Segmenter::last_timings() is empty after such a
+// frame.
 void run_device_frame(Segmenter& segmenter, const DeviceCloud& cloud, const DeviceLabels& labels,
                       const std::function<void()>& checked = {});
 void run_device_frame(Segmenter& segmenter, const DeviceDepth& depth, const DeviceLabels& labels,

@@ -15,6 +15,7 @@
 #include "core/depth_tables.hpp"
 #include "core/pipeline.hpp"
 #include "core/plan.hpp"
+#include "core/segment_graph.hpp"
 #include "core/segment_stats.hpp"
 #include "core/segmenter_impl.hpp"
 #include "pyrseg/backend.hpp"
@@ -330,6 +331,30 @@ void Segmenter::decode_device_statistics(const std::uint32_t* words, std::uint32
     }
     if (words == nullptr && count != 0) throw Error(ErrorCode::invalid_argument, "decode_device_statistics: no words");
     core::decode_segment_stats(words, count, plan, true, out);  // device frames are clouds or depth images
+}
+
+std::size_t Segmenter::device_segment_graph_bytes() const {
+    return 4 * live(impl_).plan.graph_words();
+}
+
+// The words as the device left them (shaders/pyr_graph.h): the pair count, the table of the slots K needs, then the
+// gathered pairs.
+void Segmenter::decode_device_segment_graph(const std::uint32_t* words, std::uint32_t count,
+                                            std::vector<SegmentEdge>& out) const {
+    const core::Plan& plan = live(impl_).plan;
+    if (plan.graph_slots == 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    "decode_device_segment_graph: the Segmenter was made without Outputs::segment_graph");
+    }
+    if (count > plan.max_label) {
+        throw Error(ErrorCode::invalid_argument, "decode_device_segment_graph: a segment count of " +
+                                                     std::to_string(count) + " is more than the Segmenter's " +
+                                                     std::to_string(plan.max_label) + " labels");
+    }
+    if (words == nullptr) throw Error(ErrorCode::invalid_argument, "decode_device_segment_graph: no words");
+    const std::uint32_t pairs = std::min(words[0], plan.graph_slots / 2);
+    const std::size_t list = 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * pyr_graph_slots(count, plan.graph_slots);
+    core::decode_segment_graph(words + list, pairs, out);
 }
 
 }  // namespace pyrseg

@@ -143,6 +143,7 @@ core::DeviceLabels labels_of(const CudaDevice& device, const LabelPointers& out)
     l.row_step_bytes = out.row_step_bytes;
     l.count = external(device, out.count, 4, "segment count");
     l.statistics = external(device, out.statistics, out.statistics_bytes, "statistics");
+    l.graph = external(device, out.graph, out.graph_bytes, "segment graph");
     return l;
 }
 

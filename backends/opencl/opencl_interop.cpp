@@ -101,6 +101,7 @@ core::DeviceLabels labels_of(const OpenclDevice& device, const LabelBuffers& out
     l.row_step_bytes = out.row_step_bytes;
     l.count = external(device, out.count, out.count_offset, "segment count");
     l.statistics = external(device, out.statistics, out.statistics_offset, "statistics");
+    l.graph = external(device, out.graph, out.graph_offset, "segment graph");
     return l;
 }
 

@@ -124,6 +124,7 @@ core::DeviceLabels labels_of(const LabelBuffers& out) {
     l.row_step_bytes = std::size_t(out.row_step_bytes);
     l.count = external(out.count, out.count_offset, out.count_bytes);
     l.statistics = external(out.statistics, out.statistics_offset, out.statistics_bytes);
+    l.graph = external(out.graph, out.graph_offset, out.graph_bytes);
     return l;
 }
 

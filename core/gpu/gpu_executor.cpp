@@ -155,6 +155,10 @@ public:
             const size_t bytes = 4 * plan_.stats_words();
             device_->copy_out(labels.statistics, bytes, Buffer::lut, 4 * size_t(plan_.lut_size()), bytes, 1);
         }
+        if (labels.graph.handle != 0) {
+            const size_t bytes = 4 * plan_.graph_words();
+            device_->copy_out(labels.graph, bytes, Buffer::fill, 0, bytes, 1);
+        }
         device_->submit();
         frame_done();
     }
@@ -291,9 +295,9 @@ public:
     }
 
     // The graph's table and list in the fill buffer, which nothing needs after the merge, sized for K on the device
-    // (pyr_graph_slots); read_back fetches the pair count with the labels, then the pairs.
+    // (pyr_graph_slots); read_back fetches the pair count with the labels, then the pairs (a device frame's go to
+    // the caller's graph buffer, write_device_labels).
     void segment_graph() override {
-        if (device_frame_) return;  // a host result
         const core::Thresholds& t = plan_.thresholds;
         const uint32_t k_word = plan_.scan_chunks();
         const uint32_t max_slots = plan_.graph_slots;

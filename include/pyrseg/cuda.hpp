@@ -81,7 +81,10 @@ struct DepthPointers {
 // Where the results go: uint32 labels packed within each row, rows row_step_bytes apart (0: 4 * width, else a
 // multiple of 4 no smaller than a row); and, when `count` is set, the segment count K as one uint32 (4 bytes); and,
 // when `statistics` is set (a Segmenter made with Outputs::segment_stats), the statistics' words,
-// Segmenter::device_statistics_bytes() of them, which Segmenter::decode_device_statistics turns into segments.
+// Segmenter::device_statistics_bytes() of them, which Segmenter::decode_device_statistics turns into segments; and,
+// when `graph` is set (a Segmenter made with Outputs::segment_graph), the segment graph's words,
+// Segmenter::device_segment_graph_bytes() of them, which Segmenter::decode_device_segment_graph turns into
+// Result::graph.
 struct LabelPointers {
     std::uint32_t* labels = nullptr;
     std::size_t labels_bytes = 0;
@@ -89,6 +92,8 @@ struct LabelPointers {
     std::uint32_t* count = nullptr;
     std::uint32_t* statistics = nullptr;
     std::size_t statistics_bytes = 0;
+    std::uint32_t* graph = nullptr;
+    std::size_t graph_bytes = 0;
 };
 
 // Queues one frame on the Segmenter's stream and returns without waiting: the input copied device to device into
@@ -104,9 +109,9 @@ struct LabelPointers {
 // intrinsics not finite and positive, a non-null view.depth, a Segmenter not made by make_segmenter above.
 //
 // Frames of one Segmenter run in stream order; its buffers serve one frame at a time, so two frames at once (on two
-// streams) need two Segmenters. Outputs other than the labels and the statistics (mask, normals, raw labels, the
-// segment graph) are host results and are not produced; Segmenter::last_timings() is empty after it (time the frame
-// with cudaEvents).
+// streams) need two Segmenters. Outputs other than the labels, the statistics and the segment graph (mask, normals,
+// raw labels) are host results and are not produced; tracks are refused; Segmenter::last_timings() is empty after
+// it (time the frame with cudaEvents).
 //
 // CUDA graphs: the call may come between cudaStreamBeginCapture(stream, any mode) and cudaStreamEndCapture; it then
 // adds the frame's copies, memsets and kernels to the graph and calls nothing a capture forbids (no

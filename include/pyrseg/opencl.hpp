@@ -74,6 +74,11 @@ struct LabelBuffers {
     // which Segmenter::decode_device_statistics turns into segments; nullptr: not written.
     cl_mem statistics = nullptr;
     std::size_t statistics_offset = 0;
+    // A Segmenter made with Outputs::segment_graph: the segment graph's words
+    // (Segmenter::device_segment_graph_bytes()), which Segmenter::decode_device_segment_graph turns into Result::graph;
+    // nullptr: not written.
+    cl_mem graph = nullptr;
+    std::size_t graph_offset = 0;
 };
 
 // Enqueues one frame on the Segmenter's queue, after the events in `wait` (and, the queue being in order, after
@@ -81,9 +86,9 @@ struct LabelBuffers {
 // releases it (clReleaseEvent). The buffers must belong to the Segmenter's context, be large enough for the frame
 // at their offsets, and stay valid until that event completes; nothing is enqueued when a check fails (a
 // pyrseg::Error names the problem). Frames of one Segmenter run in queue order; its buffers serve one frame at a
-// time, so two Segmenters are needed for two frames at once. Outputs other than the labels and the statistics (mask,
-// normals, raw labels, the segment graph) are host results and are not produced; Segmenter::last_timings() is empty
-// after it.
+// time, so two Segmenters are needed for two frames at once. Outputs other than the labels, the statistics and the
+// segment graph (mask, normals, raw labels) are host results and are not produced; tracks are refused;
+// Segmenter::last_timings() is empty after it.
 [[nodiscard]] PYRSEG_EXPORT cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
                                              std::span<const cl_event> wait = {});
 [[nodiscard]] PYRSEG_EXPORT cl_event segment(Segmenter& segmenter, const DepthBuffer& depth, const LabelBuffers& out,

@@ -83,6 +83,13 @@ public:
     [[nodiscard]] std::size_t device_statistics_bytes() const;
     void decode_device_statistics(const std::uint32_t* words, std::uint32_t count,
                                   std::vector<SegmentStats>& out) const;
+    // The same for the segment graph: device frames of a Segmenter made with Outputs::segment_graph write the graph's
+    // words into the caller's graph buffer, this many bytes of them (0 without Outputs::segment_graph); with the
+    // words and K on the host, decode_device_segment_graph gives Result::graph as a host frame would (section 10d).
+    // Throws pyrseg::Error when the Segmenter has no graph, `words` is null or `count` is more than its labels.
+    [[nodiscard]] std::size_t device_segment_graph_bytes() const;
+    void decode_device_segment_graph(const std::uint32_t* words, std::uint32_t count,
+                                     std::vector<SegmentEdge>& out) const;
 
 private:
     friend struct core::SegmenterAccess;

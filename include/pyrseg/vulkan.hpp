@@ -106,6 +106,12 @@ struct LabelBuffers {
     VkBuffer statistics = VK_NULL_HANDLE;
     VkDeviceSize statistics_offset = 0;
     VkDeviceSize statistics_bytes = 0;
+    // A Segmenter made with Outputs::segment_graph: the segment graph's words
+    // (Segmenter::device_segment_graph_bytes()), which Segmenter::decode_device_segment_graph turns into Result::graph;
+    // VK_NULL_HANDLE: not written.
+    VkBuffer graph = VK_NULL_HANDLE;
+    VkDeviceSize graph_offset = 0;
+    VkDeviceSize graph_bytes = 0;
 };
 
 // Records one frame into the application's command buffer, which must be in the recording state, outside a render
@@ -121,9 +127,9 @@ struct LabelBuffers {
 // Frames of one Segmenter share its buffers: they must execute in the order they were recorded or submitted (one
 // after the other in one command buffer, or command buffers submitted in that order to the Segmenter's queue), and
 // a command buffer recorded here must be submitted before the Segmenter's next host frame. Nothing is recorded when
-// a check fails (a pyrseg::Error names the problem). Outputs other than the labels and the statistics (mask,
-// normals, raw labels, the segment graph) are host results and are not produced; Segmenter::last_timings() is empty
-// after it.
+// a check fails (a pyrseg::Error names the problem). Outputs other than the labels, the statistics and the segment
+// graph (mask, normals, raw labels) are host results and are not produced; tracks are refused;
+// Segmenter::last_timings() is empty after it.
 PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const CloudBuffers& cloud,
                           const LabelBuffers& out);
 PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const DepthBuffer& depth,

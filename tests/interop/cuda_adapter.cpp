@@ -152,6 +152,10 @@ cuda::LabelPointers CudaAdapter::labels(const LabelFrame& frame) const {
         l.statistics = reinterpret_cast<std::uint32_t*>(pointer(frame.statistics.buffer) + frame.statistics.offset);
         l.statistics_bytes = size(frame.statistics.buffer) - frame.statistics.offset;
     }
+    if (frame.graph.buffer != Region::kNone) {
+        l.graph = reinterpret_cast<std::uint32_t*>(pointer(frame.graph.buffer) + frame.graph.offset);
+        l.graph_bytes = size(frame.graph.buffer) - frame.graph.offset;
+    }
     return l;
 }
 

@@ -429,6 +429,16 @@ TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     o.statistics = {api().allocate(with_stats.device_statistics_bytes() - 4), 0};
     r.expect(with_stats, {r.cloud, o}, "statistics buffer holds");
 
+    // The segment graph: the same two.
+    o = r.out;
+    o.graph = {api().allocate(64), 0};
+    cloud_refused(r.cloud, o, "without Outputs::segment_graph");
+    Outputs graph;
+    graph.segment_graph = true;
+    Segmenter with_graph = api().make_segmenter(Wall::kWidth, Wall::kHeight, {}, graph);
+    o.graph = {api().allocate(with_graph.device_segment_graph_bytes() - 4), 0};
+    r.expect(with_graph, {r.cloud, o}, "segment graph buffer holds");
+
     // Tracks follow host frames only so far.
     Outputs tracks;
     tracks.segment_tracks = true;
@@ -517,6 +527,86 @@ TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
     EXPECT_THROW(segmenter.decode_device_statistics(nullptr, 1u << 30, none), Error);
     Segmenter without = api().make_segmenter(o.width, o.height, params);
     EXPECT_EQ(without.device_statistics_bytes(), 0u);
+}
+
+// The segment graph of device frames (a Segmenter made with Outputs::segment_graph, here beside the statistics): its
+// words go to the caller's buffer with the labels, and Segmenter::decode_device_segment_graph gives the host path's
+// graph from them, edge for edge; a cloud and a depth image, several frames queued before any is read.
+TEST_P(DeviceFrames, SegmentGraphMatchesTheHostPath) {
+    synthetic::SceneOptions o;
+    o.width = 96;
+    o.height = 72;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene scene = synthetic::generate(o);
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Outputs outputs;
+    outputs.segment_stats = true;
+    outputs.segment_graph = true;
+    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = scene.points[3 * i + 2];
+        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+    }
+    const DepthView view{depth.data(), DepthFormat::u16, o.width,  o.height, 0,
+                         0.001,        scene.fx,         scene.fy, scene.cx, scene.cy};
+    Segmenter cpu(o.width, o.height, params, "cpu", outputs);
+    const Result from_cloud = cpu.segment(CloudView{scene.points.data(), nullptr, o.width, o.height});
+    const Result from_depth = cpu.segment(view);
+    ASSERT_GT(from_cloud.graph.size(), 2u);
+    ASSERT_GT(from_depth.graph.size(), 2u);
+    Segmenter segmenter = api().make_segmenter(o.width, o.height, params, outputs);
+    const std::size_t bytes = segmenter.device_segment_graph_bytes();
+    ASSERT_GT(bytes, 0u);
+    CloudFrame cloud_in;
+    cloud_in.points = put(scene.points.data(), 4 * scene.points.size());
+    DepthFrame depth_in{put(depth.data(), 2 * depth.size()), view};
+    depth_in.view.depth = nullptr;
+    std::vector<Frame> frames;
+    for (int f = 0; f < 4; ++f) {
+        LabelFrame out;
+        out.labels = {api().allocate(4 * depth.size()), 0};
+        out.count = {api().allocate(4), 0};
+        out.statistics = {api().allocate(segmenter.device_statistics_bytes()), 0};
+        out.graph = {api().allocate(bytes + 12), 12};
+        frames.push_back(f % 2 == 0 ? Frame{cloud_in, out} : Frame{depth_in, out});
+    }
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        api().run(segmenter, frames, way);
+        for (std::size_t f = 0; f < frames.size(); ++f) {
+            SCOPED_TRACE(ways[way].name + ", frame " + std::to_string(f));
+            const Result& expected = f % 2 == 0 ? from_cloud : from_depth;
+            const std::uint32_t count = words(frames[f].out.count.buffer, 0, 1)[0];
+            ASSERT_EQ(count, expected.segment_count);
+            EXPECT_EQ(words(frames[f].out.graph.buffer, 8, 1)[0], kUntouched) << "written before the offset";
+            const std::vector<std::uint32_t> graph_words = words(frames[f].out.graph.buffer, 12, bytes / 4);
+            std::vector<SegmentEdge> graph;
+            segmenter.decode_device_segment_graph(graph_words.data(), count, graph);
+            ASSERT_EQ(graph.size(), expected.graph.size());
+            for (std::size_t k = 0; k < graph.size(); ++k) {
+                SCOPED_TRACE("edge " + std::to_string(k));
+                EXPECT_EQ(graph[k].a, expected.graph[k].a);
+                EXPECT_EQ(graph[k].b, expected.graph[k].b);
+                EXPECT_EQ(graph[k].length, expected.graph[k].length);
+                EXPECT_EQ(graph[k].flat, expected.graph[k].flat);
+                EXPECT_EQ(graph[k].convex, expected.graph[k].convex);
+                EXPECT_EQ(graph[k].concave, expected.graph[k].concave);
+                EXPECT_EQ(graph[k].step, expected.graph[k].step);
+            }
+            std::vector<unsigned char> blank(bytes, 0xAB);
+            api().upload(frames[f].out.graph.buffer, 12, blank.data(), blank.size());
+        }
+    }
+    std::vector<SegmentEdge> none;
+    const std::vector<std::uint32_t> zeros(bytes / 4, 0);
+    EXPECT_THROW(segmenter.decode_device_segment_graph(zeros.data(), 1u << 30, none), Error);
+    EXPECT_THROW(segmenter.decode_device_segment_graph(nullptr, 1, none), Error);
+    segmenter.decode_device_segment_graph(zeros.data(), 0, none);
+    EXPECT_TRUE(none.empty());
+    Segmenter without = api().make_segmenter(o.width, o.height, params);
+    EXPECT_EQ(without.device_segment_graph_bytes(), 0u);
+    EXPECT_THROW(without.decode_device_segment_graph(zeros.data(), 1, none), Error);
 }
 
 }  // namespace pyrseg::test

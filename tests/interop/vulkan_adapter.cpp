@@ -330,6 +330,11 @@ vulkan::LabelBuffers VulkanAdapter::labels(const LabelFrame& frame) const {
         l.statistics_offset = frame.statistics.offset;
         l.statistics_bytes = buffer(frame.statistics.buffer).bytes;
     }
+    if (frame.graph.buffer != Region::kNone) {
+        l.graph = buffer(frame.graph.buffer).buffer;
+        l.graph_offset = frame.graph.offset;
+        l.graph_bytes = buffer(frame.graph.buffer).bytes;
+    }
     return l;
 }
 
