@@ -122,6 +122,16 @@ std::string pass_cell(const Entry* e, const char* pass) {
     return text;
 }
 
+// A pass's time as a share of a frame's, or a dash.
+std::string share_cell(const Entry* e, const char* pass, const Entry* frame) {
+    if (e == nullptr || frame == nullptr || !frame->error.empty() || !(frame->ms > 0)) return "—";
+    const auto it = e->counters.find(pass);
+    if (it == e->counters.end()) return "—";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f%%", 100.0 * it->second / frame->ms);
+    return text;
+}
+
 // Points to fillable mask: normals (when estimated), quantize and metric, or the one pass that fuses them where a
 // backend does (points_to_mask), so that fused and separate passes compare.
 std::string front_end_cell(const Entry* e) {
@@ -209,6 +219,57 @@ std::string header(const std::vector<std::string>& cells) {
     std::string row = table_row(cells) + "|";
     for (std::size_t i = 0; i < cells.size(); ++i) row += i == 0 ? "---|" : "---:|";
     return row + "\n";
+}
+
+// What the outputs beyond the labels cost on the robust frames with the merge (pipeline_robust_merge*/): the
+// statistics (the segments' exact moments), the segment graph, the scene on the host (supports, objects and their
+// boxes fitted to the points), the colour edge term. Shares of the robust frame with the merge, from the passes' own
+// times (frame differences are as noisy as the frames).
+std::string outputs_cost_section(const Entries& entries, const std::vector<Size>& sizes,
+                                 const std::vector<std::string>& backends) {
+    std::string md =
+        "## What statistics, the segment graph, the scene and colour cost\n\nThe robust frames with the merge "
+        "(pipeline_robust_merge/, kinect-v1 preset, normals estimated) and the same frames with Outputs::segment_stats "
+        "(_stats: the statistics pass, docs/algorithm.md section 10), Outputs::segment_graph (_graph: the graph pass, "
+        "section 10d), the scene (_scene: the statistics, the fillable mask downloaded, then on the host "
+        "`describe_scene` and `fit_object_boxes`, section 10c) and a colour image with the colour edge term (_color: "
+        "the colour pass, step 0c; the colour changes the segments, so that frame differs by more than the pass). "
+        "Shares: each pass's time in the robust frame with the merge (the targets on the CPU: statistics, graph "
+        "and fits together at most 10%; the merge and the colour term at most 15%).\n\n";
+    std::string rows;
+    for (const Size& s : sizes) {
+        for (const std::string& b : backends) {
+            const std::string tail = "/" + b + "/" + s.name + "/estimated_normals";
+            const Entry* frame = find(entries, "pipeline_robust_merge" + tail);
+            const Entry* stats = find(entries, "pipeline_robust_merge_stats" + tail);
+            const Entry* graph = find(entries, "pipeline_robust_merge_graph" + tail);
+            const Entry* scene = find(entries, "pipeline_robust_merge_scene" + tail);
+            const Entry* color = find(entries, "pipeline_robust_merge_color" + tail);
+            if (frame == nullptr || (stats == nullptr && graph == nullptr && scene == nullptr && color == nullptr))
+                continue;
+            std::string together = "—";
+            const auto counter = [](const Entry* e, const char* name) {
+                if (e == nullptr) return std::numeric_limits<double>::quiet_NaN();
+                const auto it = e->counters.find(name);
+                return it == e->counters.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+            };
+            const double sum = counter(stats, "stats_ms") + counter(graph, "graph_ms") + counter(scene, "scene_ms");
+            if (std::isfinite(sum) && frame->error.empty() && frame->ms > 0) {
+                char text[32];
+                std::snprintf(text, sizeof text, "%.1f%%", 100.0 * sum / frame->ms);
+                together = text;
+            }
+            rows += table_row({s.name, b, ms_cell(frame), pass_cell(stats, "stats_ms"),
+                               share_cell(stats, "stats_ms", frame), pass_cell(graph, "graph_ms"),
+                               share_cell(graph, "graph_ms", frame), pass_cell(scene, "scene_ms"), together,
+                               ms_cell(color), pass_cell(color, "color_ms"), share_cell(color, "color_ms", frame)});
+        }
+    }
+    if (rows.empty()) return md + "No pipeline_robust_merge_stats/, _graph/, _scene/ or _color/ rows in this run.\n\n";
+    return md +
+           header({"frame", "backend", "robust + merge", "statistics pass", "share", "graph pass", "share",
+                   "scene on the host", "statistics + graph + scene", "with colour", "colour pass", "share"}) +
+           rows + "\n";
 }
 
 std::string machine(const nlohmann::json& doc) {
@@ -486,6 +547,8 @@ Report build_report(const nlohmann::json& doc, const std::string& source, const 
         md += header({"frame", "backend", "robust", "robust + merge", "merge pass", "merge pass ÷ robust"}) +
               merge_rows + "\n";
     }
+
+    md += outputs_cost_section(entries, sizes, backends);
 
     // The fills' worst cases.
     md +=
