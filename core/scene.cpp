@@ -191,6 +191,31 @@ std::array<double, 3> box_corner(const std::array<double, 3>& centre, const std:
     return p;
 }
 
+namespace {
+
+// The least and greatest coordinates along o's axes (kept in o.box_centre and o.extents during the fit) over the
+// pixels begin..end of one object's run that are fillable and have a point.
+void project_run(std::span<const float> points, std::span<const std::uint8_t> fillable, std::size_t begin,
+                 std::size_t end, SceneObject& o) {
+    const std::array<Vec3, 3> axes = o.axes;
+    Vec3 low = o.box_centre;
+    Vec3 high = o.extents;
+    for (std::size_t i = begin; i < end; ++i) {
+        if (!fillable.empty() && fillable[i] == 0) continue;
+        const Vec3 p = {points[3 * i], points[3 * i + 1], points[3 * i + 2]};
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+        for (std::size_t a = 0; a < 3; ++a) {
+            const double along = dot(axes[a], p);
+            low[a] = std::min(low[a], along);
+            high[a] = std::max(high[a], along);
+        }
+    }
+    o.box_centre = low;
+    o.extents = high;
+}
+
+}  // namespace
+
 void fit_object_boxes(std::span<const float> points, std::span<const std::uint32_t> labels,
                       std::span<const std::uint8_t> fillable, Scene& scene) {
     if (points.size() != 3 * labels.size()) {
@@ -204,33 +229,24 @@ void fit_object_boxes(std::span<const float> points, std::span<const std::uint32
                                                      std::to_string(labels.size()) + " labels");
     }
     // Each object's box centre and extents hold, during the pass, the least and the greatest coordinate along its
-    // axes (no scratch to allocate). Objects are sorted by label: a pixel finds its object by binary search.
+    // axes (no scratch to allocate). The labels come in runs (a row of one segment): each run finds its object by
+    // binary search (objects are sorted by label) and is projected with the object's axes and bounds in locals.
     constexpr double kInf = std::numeric_limits<double>::infinity();
     for (SceneObject& o : scene.objects) {
         o.box_centre = {kInf, kInf, kInf};
         o.extents = {-kInf, -kInf, -kInf};
     }
-    std::uint32_t last_label = 0;
-    std::size_t last = scene.objects.size();
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        const std::uint32_t l = labels[i];
-        if (l == 0 || (!fillable.empty() && fillable[i] == 0)) continue;
-        if (l != last_label) {
-            last_label = l;
+    const std::size_t n = labels.size();
+    for (std::size_t begin = 0; begin < n;) {
+        const std::uint32_t l = labels[begin];
+        std::size_t end = begin + 1;
+        while (end < n && labels[end] == l) ++end;
+        if (l != 0) {
             const auto it = std::lower_bound(scene.objects.begin(), scene.objects.end(), l,
                                              [](const SceneObject& o, std::uint32_t v) { return o.label < v; });
-            last = (it != scene.objects.end() && it->label == l) ? std::size_t(it - scene.objects.begin())
-                                                                 : scene.objects.size();
+            if (it != scene.objects.end() && it->label == l) project_run(points, fillable, begin, end, *it);
         }
-        if (last == scene.objects.size()) continue;
-        const Vec3 p = {points[3 * i], points[3 * i + 1], points[3 * i + 2]};
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
-        SceneObject& o = scene.objects[last];
-        for (std::size_t a = 0; a < 3; ++a) {
-            const double along = dot(o.axes[a], p);
-            o.box_centre[a] = std::min(o.box_centre[a], along);
-            o.extents[a] = std::max(o.extents[a], along);
-        }
+        begin = end;
     }
     for (SceneObject& o : scene.objects) {
         Vec3 low = o.box_centre;
