@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <string>
 
 #include "pyrseg/presets.hpp"
@@ -454,51 +455,80 @@ TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     r.expect_still_segments();
 }
 
-// The statistics of device frames (a Segmenter made with Outputs::segment_stats): the words go to the caller's buffer
-// with the labels, and Segmenter::decode_device_statistics gives the host path's segments from them, field for field;
-// a cloud and a depth image, several frames queued before any is read.
-TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
+namespace {
+
+// A kinect-v1 scene as a cloud and as a uint16 depth image in millimetres, each segmented on the CPU (the host
+// results device frames must give), and its inputs in the adapter's buffers.
+struct HostResults {
+    synthetic::Scene scene;
+    std::vector<std::uint16_t> depth;
+    Params params = sensor_preset(SensorKind::kinect_v1);
+    Result from_cloud;
+    Result from_depth;
+    CloudFrame cloud_in;
+    DepthFrame depth_in;
+};
+
+HostResults host_results(Adapter& api, const Outputs& outputs) {
     synthetic::SceneOptions o;
     o.width = 96;
     o.height = 72;
     o.sensor = synthetic::Sensor::kinect_v1;
-    const synthetic::Scene scene = synthetic::generate(o);
-    const Params params = sensor_preset(SensorKind::kinect_v1);
-    Outputs outputs;
-    outputs.segment_stats = true;
-    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
-    for (std::size_t i = 0; i < depth.size(); ++i) {
-        const float z = scene.points[3 * i + 2];
-        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+    HostResults h;
+    h.scene = synthetic::generate(o);
+    h.depth.resize(std::size_t(o.width) * std::size_t(o.height));
+    for (std::size_t i = 0; i < h.depth.size(); ++i) {
+        const float z = h.scene.points[3 * i + 2];
+        h.depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
     }
-    const DepthView view{depth.data(), DepthFormat::u16, o.width,  o.height, 0,
-                         0.001,        scene.fx,         scene.fy, scene.cx, scene.cy};
-    Segmenter cpu(o.width, o.height, params, "cpu", outputs);
-    const Result from_cloud = cpu.segment(CloudView{scene.points.data(), nullptr, o.width, o.height});
-    const Result from_depth = cpu.segment(view);
-    ASSERT_GT(from_cloud.segment_count, 2u);
-    Segmenter segmenter = api().make_segmenter(o.width, o.height, params, outputs);
-    const std::size_t bytes = segmenter.device_statistics_bytes();
-    ASSERT_GT(bytes, 0u);
-    CloudFrame cloud_in;
-    cloud_in.points = put(scene.points.data(), 4 * scene.points.size());
-    DepthFrame depth_in{put(depth.data(), 2 * depth.size()), view};
-    depth_in.view.depth = nullptr;
+    const DepthView view{h.depth.data(), DepthFormat::u16, o.width,    o.height,   0,
+                         0.001,          h.scene.fx,       h.scene.fy, h.scene.cx, h.scene.cy};
+    Segmenter cpu(o.width, o.height, h.params, "cpu", outputs);
+    h.from_cloud = cpu.segment(CloudView{h.scene.points.data(), nullptr, o.width, o.height});
+    h.from_depth = cpu.segment(view);
+    h.cloud_in.points = put(api, h.scene.points.data(), 4 * h.scene.points.size(), 0);
+    h.depth_in = {put(api, h.depth.data(), 2 * h.depth.size(), 0), view};
+    h.depth_in.view.depth = nullptr;
+    return h;
+}
+
+// Four frames, cloud and depth image in turn, each with its labels and K; `more` adds each frame's other buffers.
+std::vector<Frame> alternating_frames(Adapter& api, const HostResults& h,
+                                      const std::function<void(LabelFrame&)>& more) {
     std::vector<Frame> frames;
     for (int f = 0; f < 4; ++f) {
         LabelFrame out;
-        out.labels = {api().allocate(4 * depth.size()), 0};
-        out.count = {api().allocate(4), 0};
-        out.statistics = {api().allocate(bytes + 12), 12};
-        frames.push_back(f % 2 == 0 ? Frame{cloud_in, out} : Frame{depth_in, out});
+        out.labels = {api.allocate(4 * h.depth.size()), 0};
+        out.count = {api.allocate(4), 0};
+        more(out);
+        frames.push_back(f % 2 == 0 ? Frame{h.cloud_in, out} : Frame{h.depth_in, out});
     }
+    return frames;
+}
+
+}  // namespace
+
+// The statistics of device frames (a Segmenter made with Outputs::segment_stats): the words go to the caller's buffer
+// with the labels, and Segmenter::decode_device_statistics gives the host path's segments from them, field for field;
+// a cloud and a depth image, several frames queued before any is read.
+TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
+    Outputs outputs;
+    outputs.segment_stats = true;
+    const HostResults h = host_results(api(), outputs);
+    ASSERT_GT(h.from_cloud.segment_count, 2u);
+    Segmenter segmenter = api().make_segmenter(h.scene.width, h.scene.height, h.params, outputs);
+    const std::size_t bytes = segmenter.device_statistics_bytes();
+    ASSERT_GT(bytes, 0u);
+    std::vector<Frame> frames = alternating_frames(api(), h, [&](LabelFrame& out) {
+        out.statistics = {api().allocate(bytes + 12), 12};
+    });
     const std::vector<Way> ways = api().ways();
     for (std::size_t way = 0; way < ways.size(); ++way) {
         if (ways[way].refusals_only) continue;
         api().run(segmenter, frames, way);
         for (std::size_t f = 0; f < frames.size(); ++f) {
             SCOPED_TRACE(ways[way].name + ", frame " + std::to_string(f));
-            const Result& expected = f % 2 == 0 ? from_cloud : from_depth;
+            const Result& expected = f % 2 == 0 ? h.from_cloud : h.from_depth;
             const std::uint32_t count = words(frames[f].out.count.buffer, 0, 1)[0];
             ASSERT_EQ(count, expected.segment_count);
             EXPECT_EQ(words(frames[f].out.statistics.buffer, 8, 1)[0], kUntouched) << "written before the offset";
@@ -525,7 +555,7 @@ TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
     }
     std::vector<SegmentStats> none;
     EXPECT_THROW(segmenter.decode_device_statistics(nullptr, 1u << 30, none), Error);
-    Segmenter without = api().make_segmenter(o.width, o.height, params);
+    Segmenter without = api().make_segmenter(h.scene.width, h.scene.height, h.params);
     EXPECT_EQ(without.device_statistics_bytes(), 0u);
 }
 
@@ -533,50 +563,26 @@ TEST_P(DeviceFrames, StatisticsMatchTheHostPath) {
 // words go to the caller's buffer with the labels, and Segmenter::decode_device_segment_graph gives the host path's
 // graph from them, edge for edge; a cloud and a depth image, several frames queued before any is read.
 TEST_P(DeviceFrames, SegmentGraphMatchesTheHostPath) {
-    synthetic::SceneOptions o;
-    o.width = 96;
-    o.height = 72;
-    o.sensor = synthetic::Sensor::kinect_v1;
-    const synthetic::Scene scene = synthetic::generate(o);
-    const Params params = sensor_preset(SensorKind::kinect_v1);
     Outputs outputs;
     outputs.segment_stats = true;
     outputs.segment_graph = true;
-    std::vector<std::uint16_t> depth(std::size_t(o.width) * std::size_t(o.height));
-    for (std::size_t i = 0; i < depth.size(); ++i) {
-        const float z = scene.points[3 * i + 2];
-        depth[i] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
-    }
-    const DepthView view{depth.data(), DepthFormat::u16, o.width,  o.height, 0,
-                         0.001,        scene.fx,         scene.fy, scene.cx, scene.cy};
-    Segmenter cpu(o.width, o.height, params, "cpu", outputs);
-    const Result from_cloud = cpu.segment(CloudView{scene.points.data(), nullptr, o.width, o.height});
-    const Result from_depth = cpu.segment(view);
-    ASSERT_GT(from_cloud.graph.size(), 2u);
-    ASSERT_GT(from_depth.graph.size(), 2u);
-    Segmenter segmenter = api().make_segmenter(o.width, o.height, params, outputs);
+    const HostResults h = host_results(api(), outputs);
+    ASSERT_GT(h.from_cloud.graph.size(), 2u);
+    ASSERT_GT(h.from_depth.graph.size(), 2u);
+    Segmenter segmenter = api().make_segmenter(h.scene.width, h.scene.height, h.params, outputs);
     const std::size_t bytes = segmenter.device_segment_graph_bytes();
     ASSERT_GT(bytes, 0u);
-    CloudFrame cloud_in;
-    cloud_in.points = put(scene.points.data(), 4 * scene.points.size());
-    DepthFrame depth_in{put(depth.data(), 2 * depth.size()), view};
-    depth_in.view.depth = nullptr;
-    std::vector<Frame> frames;
-    for (int f = 0; f < 4; ++f) {
-        LabelFrame out;
-        out.labels = {api().allocate(4 * depth.size()), 0};
-        out.count = {api().allocate(4), 0};
+    std::vector<Frame> frames = alternating_frames(api(), h, [&](LabelFrame& out) {
         out.statistics = {api().allocate(segmenter.device_statistics_bytes()), 0};
         out.graph = {api().allocate(bytes + 12), 12};
-        frames.push_back(f % 2 == 0 ? Frame{cloud_in, out} : Frame{depth_in, out});
-    }
+    });
     const std::vector<Way> ways = api().ways();
     for (std::size_t way = 0; way < ways.size(); ++way) {
         if (ways[way].refusals_only) continue;
         api().run(segmenter, frames, way);
         for (std::size_t f = 0; f < frames.size(); ++f) {
             SCOPED_TRACE(ways[way].name + ", frame " + std::to_string(f));
-            const Result& expected = f % 2 == 0 ? from_cloud : from_depth;
+            const Result& expected = f % 2 == 0 ? h.from_cloud : h.from_depth;
             const std::uint32_t count = words(frames[f].out.count.buffer, 0, 1)[0];
             ASSERT_EQ(count, expected.segment_count);
             EXPECT_EQ(words(frames[f].out.graph.buffer, 8, 1)[0], kUntouched) << "written before the offset";
@@ -604,7 +610,7 @@ TEST_P(DeviceFrames, SegmentGraphMatchesTheHostPath) {
     EXPECT_THROW(segmenter.decode_device_segment_graph(nullptr, 1, none), Error);
     segmenter.decode_device_segment_graph(zeros.data(), 0, none);
     EXPECT_TRUE(none.empty());
-    Segmenter without = api().make_segmenter(o.width, o.height, params);
+    Segmenter without = api().make_segmenter(h.scene.width, h.scene.height, h.params);
     EXPECT_EQ(without.device_segment_graph_bytes(), 0u);
     EXPECT_THROW(without.decode_device_segment_graph(zeros.data(), 1, none), Error);
 }
