@@ -9,7 +9,7 @@
 #                                             # copied to docs/data/bench.json (the ctest docs_performance_tables
 #                                             # checks the doc against it) and its plots to docs/images/
 #
-# Takes about 5 to 10 minutes on 2 cores.
+# Takes about 11 minutes on 2 cores (2026-12-07: 381 rows, the GPU-path backends on the CPU most of it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 update_docs=0
