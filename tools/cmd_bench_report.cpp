@@ -280,21 +280,24 @@ std::string machine(const nlohmann::json& doc) {
       << c.value("mhz_per_cpu", 0) << " MHz, run " << c.value("date", std::string("?"))
       << " (Google Benchmark's own library is a " << c.value("library_build_type", std::string("?"))
       << " build: Debian's package).\n\n";
-    // Google Benchmark's load averages when the run started; scripts/bench.sh adds them at its end.
-    const auto load = [&](const char* key) -> std::string {
+    // Google Benchmark's load averages when the run started; scripts/bench.sh adds them at its end. Only the start's
+    // says whether other work ran: at the end the load counts the bench's own threads and the processes its cpu_load
+    // rows spin.
+    const auto load = [&](const char* key, bool judge) -> std::string {
         const nlohmann::json& l = c.value(key, nlohmann::json::array());
         if (!l.is_array() || l.empty() || !l[0].is_number()) return {};
         std::string text;
         for (const nlohmann::json& v : l) text += (text.empty() ? "" : ", ") + fixed(v.get<double>(), 2);
-        busy = busy || l[0].get<double>() >= 0.5;
+        busy = busy || (judge && l[0].get<double>() >= 0.5);
         return text;
     };
-    const std::string before = load("load_avg");
-    const std::string after = load("load_avg_after");
+    const std::string before = load("load_avg", true);
+    const std::string after = load("load_avg_after", false);
     if (!before.empty()) {
         s << "Load average (1, 5, 15 min) at the start: " << before;
-        if (!after.empty()) s << "; at the end: " << after;
-        s << (busy ? ". **The machine was not idle** (load 0.5 or more): times are longer than a quiet machine's and "
+        if (!after.empty()) s << "; at the end: " << after << " (the bench's own threads count in it)";
+        s << (busy ? ". **The machine was not idle** (load 0.5 or more at the start): times are longer than a quiet "
+                     "machine's and "
                      "vary more, and so do the ratios of rows measured at different moments.\n\n"
                    : ".\n\n");
     }

@@ -947,6 +947,19 @@ TEST(Cli, BenchReportUpdatesAndChecksADocumentsSection) {
     EXPECT_NE(text.find("### Whole pipeline"), std::string::npos) << "headings one level down\n" << text;
     EXPECT_NE(text.find("[data/bench.json](data/bench.json)"), std::string::npos) << text;
     EXPECT_NE(text.find("The machine was not idle"), std::string::npos) << "load 1.5 at the start\n" << text;
+    // A quiet start is idle, whatever the load the bench itself makes by its end.
+    nlohmann::json quiet = doc;
+    quiet["context"]["load_avg"] = {0.1, 0.2, 0.3};
+    quiet["context"]["load_avg_after"] = {1.8, 1.1, 0.6};
+    std::ofstream(dir / "data" / "quiet.json") << quiet.dump();
+    const fs::path quiet_md = dir / "quiet.md";
+    std::ofstream(quiet_md) << "<!-- bench-report:begin (generated) -->\n<!-- bench-report:end -->\n";
+    ASSERT_EQ(run("bench-report " + (dir / "data" / "quiet.json").string() + " --update " + quiet_md.string()).status,
+              0);
+    const std::string quiet_text = read_file(quiet_md);
+    EXPECT_EQ(quiet_text.find("not idle"), std::string::npos) << quiet_text;
+    EXPECT_NE(quiet_text.find("at the end: 1.80, 1.10, 0.60 (the bench's own threads count in it)"), std::string::npos)
+        << quiet_text;
     EXPECT_NE(text.find("(images/bench_vs_pcl.png)"), std::string::npos) << text;
     EXPECT_TRUE(fs::exists(dir / "images" / "bench_vs_pcl.png"));
     EXPECT_EQ(run("bench-report " + json + " --update " + md.string()).status, 0);
