@@ -122,14 +122,24 @@ std::string pass_cell(const Entry* e, const char* pass) {
     return text;
 }
 
+// A benchmark's counter ("stats_ms", ...), NaN when the benchmark or the counter is missing.
+double counter(const Entry* e, const char* name) {
+    if (e == nullptr) return std::numeric_limits<double>::quiet_NaN();
+    const auto it = e->counters.find(name);
+    return it == e->counters.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+}
+
+// Milliseconds as a share of a frame's time, or a dash when either is unknown.
+std::string percent_of_frame(double ms, const Entry* frame) {
+    if (!std::isfinite(ms) || frame == nullptr || !frame->error.empty() || !(frame->ms > 0)) return "—";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f%%", 100.0 * ms / frame->ms);
+    return text;
+}
+
 // A pass's time as a share of a frame's, or a dash.
 std::string share_cell(const Entry* e, const char* pass, const Entry* frame) {
-    if (e == nullptr || frame == nullptr || !frame->error.empty() || !(frame->ms > 0)) return "—";
-    const auto it = e->counters.find(pass);
-    if (it == e->counters.end()) return "—";
-    char text[32];
-    std::snprintf(text, sizeof text, "%.1f%%", 100.0 * it->second / frame->ms);
-    return text;
+    return percent_of_frame(counter(e, pass), frame);
 }
 
 // Points to fillable mask: normals (when estimated), quantize and metric, or the one pass that fuses them where a
@@ -247,22 +257,13 @@ std::string outputs_cost_section(const Entries& entries, const std::vector<Size>
             const Entry* color = find(entries, "pipeline_robust_merge_color" + tail);
             if (frame == nullptr || (stats == nullptr && graph == nullptr && scene == nullptr && color == nullptr))
                 continue;
-            std::string together = "—";
-            const auto counter = [](const Entry* e, const char* name) {
-                if (e == nullptr) return std::numeric_limits<double>::quiet_NaN();
-                const auto it = e->counters.find(name);
-                return it == e->counters.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
-            };
-            const double sum = counter(stats, "stats_ms") + counter(graph, "graph_ms") + counter(scene, "scene_ms");
-            if (std::isfinite(sum) && frame->error.empty() && frame->ms > 0) {
-                char text[32];
-                std::snprintf(text, sizeof text, "%.1f%%", 100.0 * sum / frame->ms);
-                together = text;
-            }
+            const double together =
+                counter(stats, "stats_ms") + counter(graph, "graph_ms") + counter(scene, "scene_ms");
             rows += table_row({s.name, b, ms_cell(frame), pass_cell(stats, "stats_ms"),
                                share_cell(stats, "stats_ms", frame), pass_cell(graph, "graph_ms"),
-                               share_cell(graph, "graph_ms", frame), pass_cell(scene, "scene_ms"), together,
-                               ms_cell(color), pass_cell(color, "color_ms"), share_cell(color, "color_ms", frame)});
+                               share_cell(graph, "graph_ms", frame), pass_cell(scene, "scene_ms"),
+                               percent_of_frame(together, frame), ms_cell(color), pass_cell(color, "color_ms"),
+                               share_cell(color, "color_ms", frame)});
         }
     }
     if (rows.empty()) return md + "No pipeline_robust_merge_stats/, _graph/, _scene/ or _color/ rows in this run.\n\n";
@@ -275,7 +276,6 @@ std::string outputs_cost_section(const Entries& entries, const std::vector<Size>
 std::string machine(const nlohmann::json& doc) {
     const nlohmann::json& c = doc.value("context", nlohmann::json::object());
     std::ostringstream s;
-    bool busy = false;
     s << "Machine: " << c.value("host_name", std::string("?")) << ", " << c.value("num_cpus", 0) << " CPUs at "
       << c.value("mhz_per_cpu", 0) << " MHz, run " << c.value("date", std::string("?"))
       << " (Google Benchmark's own library is a " << c.value("library_build_type", std::string("?"))
@@ -283,22 +283,22 @@ std::string machine(const nlohmann::json& doc) {
     // Google Benchmark's load averages when the run started; scripts/bench.sh adds them at its end. Only the start's
     // says whether other work ran: at the end the load counts the bench's own threads and the processes its cpu_load
     // rows spin.
-    const auto load = [&](const char* key, bool judge) -> std::string {
+    const auto load = [&](const char* key) -> std::string {
         const nlohmann::json& l = c.value(key, nlohmann::json::array());
         if (!l.is_array() || l.empty() || !l[0].is_number()) return {};
         std::string text;
         for (const nlohmann::json& v : l) text += (text.empty() ? "" : ", ") + fixed(v.get<double>(), 2);
-        busy = busy || (judge && l[0].get<double>() >= 0.5);
         return text;
     };
-    const std::string before = load("load_avg", true);
-    const std::string after = load("load_avg_after", false);
+    const std::string before = load("load_avg");
+    const std::string after = load("load_avg_after");
+    const nlohmann::json& start = c.value("load_avg", nlohmann::json::array());
+    const bool busy = !before.empty() && start[0].get<double>() >= 0.5;
     if (!before.empty()) {
         s << "Load average (1, 5, 15 min) at the start: " << before;
         if (!after.empty()) s << "; at the end: " << after << " (the bench's own threads count in it)";
         s << (busy ? ". **The machine was not idle** (load 0.5 or more at the start): times are longer than a quiet "
-                     "machine's and "
-                     "vary more, and so do the ratios of rows measured at different moments.\n\n"
+                     "machine's and vary more, and so do the ratios of rows measured at different moments.\n\n"
                    : ".\n\n");
     }
     for (const auto& [key, value] : c.items()) {
@@ -533,15 +533,8 @@ Report build_report(const nlohmann::json& doc, const std::string& source, const 
             const Entry* robust = find(entries, "pipeline_robust/" + b + "/" + s.name + "/estimated_normals");
             const Entry* merged = find(entries, "pipeline_robust_merge/" + b + "/" + s.name + "/estimated_normals");
             if (merged == nullptr) continue;
-            const auto pass = merged->counters.find("merge_ms");
-            std::string share = "—";
-            if (pass != merged->counters.end() && robust != nullptr && std::isfinite(robust->ms) && robust->ms > 0) {
-                char text[32];
-                std::snprintf(text, sizeof text, "%.1f%%", 100.0 * pass->second / robust->ms);
-                share = text;
-            }
-            merge_rows +=
-                table_row({s.name, b, ms_cell(robust), ms_cell(merged), pass_cell(merged, "merge_ms"), share});
+            merge_rows += table_row({s.name, b, ms_cell(robust), ms_cell(merged), pass_cell(merged, "merge_ms"),
+                                     share_cell(merged, "merge_ms", robust)});
         }
     }
     if (merge_rows.empty()) {
