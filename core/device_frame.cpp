@@ -55,6 +55,7 @@ void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceC
     if (with_color) impl.executor->bind_device_color(color);
     run_pipeline(impl.plan, input, with_color, *impl.executor, impl.timings);
     impl.executor->write_device_labels(labels);
+    if (impl.plan.track_slots != 0) ++impl.undecoded_track_frames;
     impl.timings.clear();  // host times of queued work: meaningless, and no device times were kept
 }
 
@@ -84,10 +85,6 @@ void check_device_color(const DeviceColor& color, int width, int height) {
 }
 
 void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
-    if (plan.track_slots != 0) {
-        bad("tracks (Outputs::segment_tracks) follow host frames only so far: segment device frames with a "
-            "Segmenter made without them");
-    }
     const int width = plan.width;
     const int height = plan.height;
     const std::size_t row = 4 * std::size_t(width);
@@ -107,6 +104,16 @@ void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
         }
         const std::size_t bytes = 4 * plan.graph_words();
         check_rows("segment graph", labels.graph, bytes, bytes, 1, 4, width, height);
+    }
+    if (labels.tracks.handle != 0 && plan.track_slots == 0)
+        bad("a tracks buffer was given but the Segmenter was made without Outputs::segment_tracks or track_ids");
+    if (plan.track_slots != 0) {
+        if (labels.tracks.handle == 0) {
+            bad("the Segmenter follows tracks (Outputs::segment_tracks or track_ids): each device frame needs a "
+                "tracks buffer of Segmenter::device_tracks_bytes() for Segmenter::decode_device_tracks");
+        }
+        const std::size_t bytes = 4 * plan.track_list_words();
+        check_rows("tracks", labels.tracks, bytes, bytes, 1, 4, width, height);
     }
 }
 

@@ -64,6 +64,9 @@ struct DeviceLabels {
     // The segment graph's words (Segmenter::device_segment_graph_bytes), for a Segmenter made with
     // Outputs::segment_graph.
     ExternalBuffer graph;
+    // The tracks' overlaps (Segmenter::device_tracks_bytes), which a Segmenter made with Outputs::segment_tracks or
+    // track_ids needs on every device frame.
+    ExternalBuffer tracks;
 };
 
 // A Segmenter over an executor a backend made on the caller's context (the interop functions' constructors).

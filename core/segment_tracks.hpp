@@ -14,6 +14,8 @@ class TrackState {
 public:
     // The next frame starts a new stream.
     void reset();
+    // The next frame's number in its stream (0 after reset).
+    [[nodiscard]] std::uint32_t frame() const { return frame_; }
     // One frame of a width x height stream: `pairs` a backend's table slots (previous label, label, pixels)
     // PYR_TRACK_SLOT_WORDS words each, `pair_count` of them in any order, free ones (a first word of 0) skipped (none
     // on the stream's first frame); `segments` the frame's K statistics (label k at k - 1).

@@ -178,6 +178,13 @@ void with_host_memory(const Segmenter::Impl& impl, const Work& work) {
 template <class Bind>
 void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out,
                const std::uint8_t* color = nullptr, std::size_t color_row_step_bytes = 0) {
+    if (impl.undecoded_track_frames != 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    "a host frame follows the tracks of the device frames before it: decode_device_tracks has not "
+                    "decoded " +
+                        std::to_string(impl.undecoded_track_frames) +
+                        " of them yet (or call reset_tracks to start a new stream)");
+    }
     with_host_memory(impl, [&] {
         const auto upload_start = std::chrono::steady_clock::now();
         bind();
@@ -286,6 +293,7 @@ void Segmenter::reset_tracks() {
     Impl& impl = live(impl_);
     impl.tracks.reset();
     impl.executor->forget_previous_labels();
+    impl.undecoded_track_frames = 0;
 }
 
 int Segmenter::width() const {
@@ -355,6 +363,36 @@ void Segmenter::decode_device_segment_graph(const std::uint32_t* words, std::uin
     const std::uint32_t pairs = std::min(words[0], plan.graph_slots / 2);
     const std::size_t list = 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * pyr_graph_slots(count, plan.graph_slots);
     core::decode_segment_graph(words + list, pairs, out);
+}
+
+std::size_t Segmenter::device_tracks_bytes() const {
+    return 4 * live(impl_).plan.track_list_words();
+}
+
+// The words as the device left them (shaders/pyr_types.h: PYR_TRACK_HEADER_WORDS): the frame's number in its stream,
+// K', K, the pair count, then the pairs.
+void Segmenter::decode_device_tracks(const std::uint32_t* words, const std::vector<SegmentStats>& segments,
+                                     std::vector<SegmentTrack>& out) {
+    Impl& impl = live(impl_);
+    const core::Plan& plan = impl.plan;
+    const auto fail = [](const std::string& what) {
+        throw Error(ErrorCode::invalid_argument, "decode_device_tracks: " + what);
+    };
+    if (plan.track_slots == 0) fail("the Segmenter was made without Outputs::segment_tracks or track_ids");
+    if (words == nullptr) fail("no words");
+    const std::uint32_t frame = words[PYR_TRACK_FRAME];
+    if (impl.undecoded_track_frames == 0 || frame != impl.tracks.frame()) {
+        fail("the words are of frame " + std::to_string(frame) + " of the stream, but the next to decode is frame " +
+             std::to_string(impl.tracks.frame()) + (impl.undecoded_track_frames == 0 ? ", and none is queued" : "") +
+             ": decode each device frame's tracks once, in the order the frames were queued");
+    }
+    if (words[PYR_TRACK_COUNT] != segments.size()) {
+        fail("the frame has " + std::to_string(words[PYR_TRACK_COUNT]) + " segments but " +
+             std::to_string(segments.size()) + " statistics were given (decode_device_statistics of the same frame)");
+    }
+    const std::uint32_t pairs = std::min(words[PYR_TRACK_PAIRS], plan.track_slots / 2);
+    impl.tracks.next(words + PYR_TRACK_HEADER_WORDS, pairs, segments, plan.width, plan.height, plan.params, out);
+    --impl.undecoded_track_frames;
 }
 
 }  // namespace pyrseg

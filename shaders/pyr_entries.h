@@ -538,23 +538,31 @@ PYR_KERNEL_1D(graph_gather) {
 }
 #endif
 
-/* Tracks' overlaps (shaders/pyr_track.h), after compact, in two dispatches over at most the plan's largest table;
- * each uses the slots K' and K need (pyr_track_slots: K read where the scan left it, K' the previous frame's, which
- * the host knows). The table starts at a word of the fill buffer after the segment graph's; the host reads the slots
- * K' and K need (no list: empty slots have a zero first word). track_clear (1D, PYR_TRACK_SLOT_WORDS * the slots
- * the host allows): the word of K, K', max slots, the table's first word. */
+/* Tracks' overlaps (shaders/pyr_track.h), after compact, in four dispatches. Each uses the slots K' and K need
+ * (pyr_track_slots): K read where the scan left it, K' where the previous frame's track_advance left it (the word
+ * after the previous buffer's pixels), or 0 when the frame starts a stream, so that frames queued on the device
+ * follow one another without the host. The table starts at a word of the fill buffer after the segment graph's; the
+ * header and the gathered pairs follow the table at its largest (PYR_TRACK_HEADER_WORDS, pyr_types.h).
+ * track_clear, track_gather and track_advance take: the word of K, whether a previous frame is counted against (0
+ * at a stream's start), max slots, the table's first word, the word of K' in the previous buffer (the pixel count),
+ * and (track_advance) the frame's number in its stream. track_clear (1D, PYR_TRACK_SLOT_WORDS * at least the slots
+ * K' and K need) also zeroes the gathered pairs' counter. */
+#define PYR_TRACK_PREVIOUS(has_previous, word) ((has_previous) != 0u ? PYR_BUF(previous)[word] : 0u)
+#define PYR_TRACK_HEADER(table, max_slots) ((table) + PYR_TRACK_SLOT_WORDS * (max_slots))
+
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_CLEAR)
 PYR_KERNEL_1D(track_clear) {
     pyr_u32 i = PYR_I;
-    pyr_u32 slots = pyr_track_slots(PYR_ARG(1), PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(2));
+    pyr_u32 slots = pyr_track_slots(PYR_TRACK_PREVIOUS(PYR_ARG(1), PYR_ARG(4)), PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(2));
+    if (i == 0u) PYR_UF_STORE(PYR_TRACK_HEADER(PYR_ARG(3), PYR_ARG(2)) + PYR_TRACK_PAIRS, 0u);
     if (i >= PYR_TRACK_SLOT_WORDS * slots) return;
     PYR_UF_STORE(PYR_ARG(3) + i, 0u);
 }
 #endif
 
-/* track_count (1D, runs of PYR_STATS_RUN pixels of each row): h, runs, the word of K, K' (0: no previous frame, nothing
- * is counted), max slots, the table's first word. Each run's stretches of one (previous label, label) pair counted
- * at once, and the frame's labels kept as the previous ones. */
+/* track_count (1D, runs of PYR_STATS_RUN pixels of each row): h, runs, the word of K, whether a previous frame is
+ * counted against, max slots, the table's first word, the word of K'. Each run's stretches of one (previous label,
+ * label) pair counted at once, and the frame's labels kept as the previous ones. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_COUNT)
 PYR_KERNEL_1D(track_count) {
     pyr_u32 run = PYR_I;
@@ -563,7 +571,7 @@ PYR_KERNEL_1D(track_count) {
     pyr_u32 y = run / per_row;
     pyr_u32 x0 = (run - y * per_row) * PYR_STATS_RUN;
     pyr_u32 x1 = min(x0 + PYR_STATS_RUN, PYR_W);
-    pyr_u32 previous_count = PYR_ARG(3);
+    pyr_u32 previous_count = PYR_TRACK_PREVIOUS(PYR_ARG(3), PYR_ARG(6));
     pyr_u32 slot_mask = pyr_track_slots(previous_count, PYR_BUF(sums)[PYR_ARG(2)], PYR_ARG(4)) - 1u;
     pyr_u32 run_previous = 0u;
     pyr_u32 run_label = 0u;
@@ -583,6 +591,31 @@ PYR_KERNEL_1D(track_count) {
         count = 1u;
     }
     if (previous_count != 0u) pyr_track_count(PYR_ENTRY_CTX, run_previous, run_label, count, PYR_ARG(5), slot_mask);
+}
+#endif
+
+/* track_gather (1D, at least the slots K' and K need): the pairs counted, appended after the header. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_GATHER)
+PYR_KERNEL_1D(track_gather) {
+    pyr_u32 s = PYR_I;
+    pyr_u32 slots = pyr_track_slots(PYR_TRACK_PREVIOUS(PYR_ARG(1), PYR_ARG(4)), PYR_BUF(sums)[PYR_ARG(0)], PYR_ARG(2));
+    if (s >= slots) return;
+    pyr_u32 header = PYR_TRACK_HEADER(PYR_ARG(3), PYR_ARG(2));
+    pyr_slot_gather(PYR_ENTRY_CTX, PYR_ARG(3), PYR_TRACK_SLOT_WORDS, s, header + PYR_TRACK_HEADER_WORDS,
+                    header + PYR_TRACK_PAIRS);
+}
+#endif
+
+/* track_advance (1D, one invocation, last): the header's frame number, K' and K, and K kept as the next frame's K'. */
+#if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_ADVANCE)
+PYR_KERNEL_1D(track_advance) {
+    if (PYR_I != 0u) return;
+    pyr_u32 header = PYR_TRACK_HEADER(PYR_ARG(3), PYR_ARG(2));
+    pyr_u32 count = PYR_BUF(sums)[PYR_ARG(0)];
+    PYR_UF_STORE(header + PYR_TRACK_FRAME, PYR_ARG(5));
+    PYR_UF_STORE(header + PYR_TRACK_PREVIOUS_COUNT, PYR_TRACK_PREVIOUS(PYR_ARG(1), PYR_ARG(4)));
+    PYR_UF_STORE(header + PYR_TRACK_COUNT, count);
+    PYR_BUF(previous)[PYR_ARG(4)] = count;
 }
 #endif
 

@@ -42,10 +42,7 @@ PYR_FN void pyr_graph_count(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, py
 
 /* Slot s (after every crossing is counted): a pair it holds is appended to the list. */
 PYR_FN void pyr_graph_gather(PYR_CTX_PARAM, pyr_u32 table, pyr_u32 s, pyr_u32 list, pyr_u32 counter) {
-    pyr_u32 w = table + PYR_GRAPH_SLOT_WORDS * s;
-    if (PYR_UF_LOAD(w) == 0u) return;
-    pyr_u32 to = list + PYR_GRAPH_SLOT_WORDS * PYR_UF_ADD(counter, 1u);
-    for (pyr_u32 k = 0u; k < PYR_GRAPH_SLOT_WORDS; ++k) PYR_UF_STORE(to + k, PYR_UF_LOAD(w + k));
+    pyr_slot_gather(PYR_CTX_ARG, table, PYR_GRAPH_SLOT_WORDS, s, list, counter);
 }
 
 #endif /* PYR_GRAPH_H */

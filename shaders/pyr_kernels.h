@@ -47,7 +47,9 @@
     K(graph_count, GRAPH_COUNT, 2)       \
     K(graph_gather, GRAPH_GATHER, 1)     \
     K(track_clear, TRACK_CLEAR, 1)       \
-    K(track_count, TRACK_COUNT, 1)
+    K(track_count, TRACK_COUNT, 1)       \
+    K(track_gather, TRACK_GATHER, 1)     \
+    K(track_advance, TRACK_ADVANCE, 1)
 
 /* Per-dispatch argument words (uint32; ints and floats by their bits). */
 #define PYR_ARG_WORDS 8

@@ -35,6 +35,15 @@ PYR_FN pyr_u32 pyr_merge_slot(PYR_CTX_PARAM, pyr_u32 table, pyr_u32 stride, pyr_
     return PYR_MERGE_NONE;
 }
 
+/* Slot s of a table of `stride` words a slot (after every count): a pair it holds is appended to the list at word
+ * `list`, word `counter` counting them (the list's order depends on the schedule; the host sorts it). */
+PYR_FN void pyr_slot_gather(PYR_CTX_PARAM, pyr_u32 table, pyr_u32 stride, pyr_u32 s, pyr_u32 list, pyr_u32 counter) {
+    pyr_u32 w = table + stride * s;
+    if (PYR_UF_LOAD(w) == 0u) return;
+    pyr_u32 to = list + stride * PYR_UF_ADD(counter, 1u);
+    for (pyr_u32 k = 0u; k < stride; ++k) PYR_UF_STORE(to + k, PYR_UF_LOAD(w + k));
+}
+
 /* Pixel (x, y) of level N: its crossings to the right and downwards, each counted in its pair's slot. */
 PYR_FN void pyr_merge_count(PYR_CTX_PARAM, PyrLevel lv, pyr_u32 x, pyr_u32 y, pyr_u32 reach, pyr_f32 scale,
                             pyr_f32 tolerance_base, pyr_f32 tolerance_growth, pyr_u32 table, pyr_u32 slot_mask) {

@@ -139,6 +139,14 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
 /* The tracks' pair table (shaders/pyr_track.h, docs/algorithm.md section 11): words per slot: the previous
  * frame's label and the frame's (0: a free slot), and the pixels they share. */
 #define PYR_TRACK_SLOT_WORDS 3u
+/* After the table (at its largest): a header of PYR_TRACK_HEADER_WORDS words, then the pairs gathered from the table
+ * (PYR_TRACK_SLOT_WORDS words each, at most half as many as the table's slots): the frame's number in its stream,
+ * K', K, and how many pairs were gathered. */
+#define PYR_TRACK_HEADER_WORDS 4u
+#define PYR_TRACK_FRAME 0u
+#define PYR_TRACK_PREVIOUS_COUNT 1u
+#define PYR_TRACK_COUNT 2u
+#define PYR_TRACK_PAIRS 3u
 /* The statistics pass walks rows in runs of this many pixels, one invocation per run. */
 #define PYR_STATS_RUN 32u
 /* Points are clamped to +-(2^31 - 128), the largest float magnitude below 2^31, before rounding to int32. */

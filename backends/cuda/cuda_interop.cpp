@@ -144,6 +144,7 @@ core::DeviceLabels labels_of(const CudaDevice& device, const LabelPointers& out)
     l.count = external(device, out.count, 4, "segment count");
     l.statistics = external(device, out.statistics, out.statistics_bytes, "statistics");
     l.graph = external(device, out.graph, out.graph_bytes, "segment graph");
+    l.tracks = external(device, out.tracks, out.tracks_bytes, "tracks");
     return l;
 }
 

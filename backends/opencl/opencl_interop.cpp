@@ -102,6 +102,7 @@ core::DeviceLabels labels_of(const OpenclDevice& device, const LabelBuffers& out
     l.count = external(device, out.count, out.count_offset, "segment count");
     l.statistics = external(device, out.statistics, out.statistics_offset, "statistics");
     l.graph = external(device, out.graph, out.graph_offset, "segment graph");
+    l.tracks = external(device, out.tracks, out.tracks_offset, "tracks");
     return l;
 }
 

@@ -125,6 +125,7 @@ core::DeviceLabels labels_of(const LabelBuffers& out) {
     l.count = external(out.count, out.count_offset, out.count_bytes);
     l.statistics = external(out.statistics, out.statistics_offset, out.statistics_bytes);
     l.graph = external(out.graph, out.graph_offset, out.graph_bytes);
+    l.tracks = external(out.tracks, out.tracks_offset, out.tracks_bytes);
     return l;
 }
 

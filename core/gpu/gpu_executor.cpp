@@ -4,6 +4,7 @@
 #include "core/gpu/gpu_executor.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <string>
@@ -159,6 +160,10 @@ public:
             const size_t bytes = 4 * plan_.graph_words();
             device_->copy_out(labels.graph, bytes, Buffer::fill, 0, bytes, 1);
         }
+        if (labels.tracks.handle != 0) {
+            const size_t bytes = 4 * plan_.track_list_words();
+            device_->copy_out(labels.tracks, bytes, Buffer::fill, 4 * size_t(track_header_word()), bytes, 1);
+        }
         device_->submit();
         frame_done();
     }
@@ -311,22 +316,33 @@ public:
     }
 
     // Tracks' overlaps (shaders/pyr_track.h) in the fill buffer after the graph's words, in the slots the previous
-    // frame's K and this frame's need (at most those of the largest K the statistics allow); read_back fetches them
-    // with the statistics.
+    // frame's K and this frame's need, then gathered after the header; the device keeps K for the next frame, so
+    // that device frames need no host in between. read_back fetches the header with the labels, then the pairs (a
+    // device frame's go to the caller's tracks buffer, write_device_labels). The dispatches cover the slots of the
+    // largest K' and K the host cannot rule out; the kernels use those the device's K' and K need.
     void track_overlaps() override {
         const uint32_t k_word = plan_.scan_chunks();
         const uint32_t max_slots = plan_.track_slots;
         const uint32_t table = track_table_word();
-        const uint32_t allowed = pyr_track_slots(previous_count_, plan_.stats_slots, max_slots);
-        dispatch(Kernel::track_clear, PYR_TRACK_SLOT_WORDS * allowed, 1,
-                 args({k_word, previous_count_, max_slots, table}));
+        const uint32_t has_previous = previous_bound_ != 0 ? 1u : 0u;
+        const uint32_t allowed = pyr_track_slots(previous_bound_, plan_.stats_slots, max_slots);
+        const Args common = args({k_word, has_previous, max_slots, table, pixels(), track_frame_});
+        dispatch(Kernel::track_clear, PYR_TRACK_SLOT_WORDS * allowed, 1, common);
         const uint32_t runs = plan_.stats_runs_per_row() * height();
-        dispatch(Kernel::track_count, runs, 1, args({height(), runs, k_word, previous_count_, max_slots, table}));
-        counted_previous_ = previous_count_;
+        dispatch(Kernel::track_count, runs, 1,
+                 args({height(), runs, k_word, has_previous, max_slots, table, pixels()}));
+        dispatch(Kernel::track_gather, allowed, 1, common);
+        dispatch(Kernel::track_advance, 1, 1, common);
+        ++track_frame_;
+        // The host knows K once a host frame is read back; until then (a device frame) any K' is possible.
+        previous_bound_ = plan_.stats_slots;
     }
-    void forget_previous_labels() override { previous_count_ = 0; }
+    void forget_previous_labels() override {
+        previous_bound_ = 0;
+        track_frame_ = 0;
+    }
     [[nodiscard]] const uint32_t* track_pairs(uint32_t& count) const override {
-        count = track_pair_slots_;
+        count = track_pairs_;
         return host_tracks_.data();
     }
 
@@ -343,6 +359,10 @@ public:
         if (outputs.normals && !from_mask_) device_->download(Buffer::normals, 0, staged + S::kNormals * px, 12 * px);
         graph_count_ = 0;
         if (plan_.graph_slots != 0) device_->download(Buffer::fill, 0, &graph_count_, 4);
+        track_header_ = {};
+        if (plan_.track_slots != 0)
+            device_->download(Buffer::fill, 4 * size_t(track_header_word()), track_header_.data(),
+                              sizeof track_header_);
         device_->mark(nullptr);
         finish();
         frame_done();
@@ -363,18 +383,15 @@ public:
             const size_t list = 1 + size_t(PYR_GRAPH_SLOT_WORDS) * pyr_graph_slots(segment_count_, plan_.graph_slots);
             device_->download(Buffer::fill, 4 * list, host_graph_.data(), 4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
         }
-        // The tracks' table, every slot the two counts need (a free slot's first word is 0); the executor's labels
-        // are the previous frame's from now on.
-        track_pair_slots_ = 0;
-        if (plan_.track_slots != 0) {
-            if (counted_previous_ != 0 && segment_count_ != 0) {
-                track_pair_slots_ = pyr_track_slots(counted_previous_, segment_count_, plan_.track_slots);
-                const size_t words = size_t(PYR_TRACK_SLOT_WORDS) * track_pair_slots_;
-                if (host_tracks_.size() < words) host_tracks_.resize(words);  // grows with the largest frame
-                device_->download(Buffer::fill, 4 * size_t(track_table_word()), host_tracks_.data(), 4 * words);
-            }
-            previous_count_ = segment_count_;
+        // The tracks' gathered pairs; the executor's labels are the previous frame's from now on, and their K known.
+        track_pairs_ = std::min(track_header_[PYR_TRACK_PAIRS], plan_.track_slots / 2);
+        if (track_pairs_ != 0) {
+            const size_t words = size_t(PYR_TRACK_SLOT_WORDS) * track_pairs_;
+            if (host_tracks_.size() < words) host_tracks_.resize(words);  // grows with the most pairs a frame had
+            device_->download(Buffer::fill, 4 * (size_t(track_header_word()) + PYR_TRACK_HEADER_WORDS),
+                              host_tracks_.data(), 4 * words);
         }
+        if (plan_.track_slots != 0) previous_bound_ = segment_count_;
         // The same waits whatever the graph and the tracks hold.
         if (stats_words != 0 || plan_.graph_slots != 0 || plan_.track_slots != 0) finish();
         if (plan_.stats_slots != 0)
@@ -428,8 +445,12 @@ private:
         from_mask_ = false;
     }
 
-    // Where the tracks' table starts in the fill buffer: after the segment graph's words.
+    // Where the tracks' table starts in the fill buffer: after the segment graph's words; its header and gathered
+    // pairs after the table at its largest.
     [[nodiscard]] uint32_t track_table_word() const { return uint32_t(plan_.graph_words()); }
+    [[nodiscard]] uint32_t track_header_word() const {
+        return track_table_word() + PYR_TRACK_SLOT_WORDS * plan_.track_slots;
+    }
 
     // Where the ray slopes start in the sums buffer: after the scan's chunk sums and K.
     [[nodiscard]] uint32_t rays_word() const { return plan_.scan_chunks() + 1; }
@@ -478,10 +499,11 @@ private:
     std::vector<uint32_t> host_graph_;  // the graph's pairs as gathered
     uint32_t segment_count_ = 0;
     uint32_t graph_count_ = 0;
-    std::vector<uint32_t> host_tracks_;  // the tracks' table slots, as the device left them
-    uint32_t track_pair_slots_ = 0;      // how many of them the last frame used (0: none counted)
-    uint32_t previous_count_ = 0;        // the K of the labels the previous buffer holds (0: none)
-    uint32_t counted_previous_ = 0;      // the K' the frame being read back counted against
+    std::array<uint32_t, PYR_TRACK_HEADER_WORDS> track_header_{};  // the last host frame's, as the device left it
+    std::vector<uint32_t> host_tracks_;                            // its gathered pairs
+    uint32_t track_pairs_ = 0;                                     // how many
+    uint32_t previous_bound_ = 0;  // the most segments the previous buffer's labels can have (0: a stream starts)
+    uint32_t track_frame_ = 0;     // the next frame's number in its stream
     uint32_t dispatches_ = 0;
     uint32_t host_syncs_ = 0;
     bool from_mask_ = false;
@@ -529,7 +551,7 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
             // So do the segment graph's table and list (shaders/pyr_graph.h), after compaction, and the tracks'
             // table after them (shaders/pyr_track.h).
             const size_t merge = size_t(plan.lut_size()) + size_t(PYR_MERGE_SLOT_WORDS) * plan.merge_slots;
-            const size_t tracks = size_t(PYR_TRACK_SLOT_WORDS) * plan.track_slots;
+            const size_t tracks = plan.track_words();
             return 4 * std::max({size_t(2) * fill_level.width * fill_level.height, plan.merge_slots != 0 ? merge : 0,
                                  plan.graph_words() + tracks});
         }
@@ -541,7 +563,7 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
         case Buffer::color:
             return (3 * px + 3) / 4 * 4;  // R, G, B per pixel, whole words
         case Buffer::previous:
-            return plan.track_slots != 0 ? 4 * px : 0;
+            return plan.track_slots != 0 ? 4 * (px + 1) : 0;  // then the labels' K (shaders/pyr_entries.h)
         case Buffer::count:
             break;
     }

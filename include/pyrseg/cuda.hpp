@@ -84,7 +84,8 @@ struct DepthPointers {
 // Segmenter::device_statistics_bytes() of them, which Segmenter::decode_device_statistics turns into segments; and,
 // when `graph` is set (a Segmenter made with Outputs::segment_graph), the segment graph's words,
 // Segmenter::device_segment_graph_bytes() of them, which Segmenter::decode_device_segment_graph turns into
-// Result::graph.
+// Result::graph; and `tracks` (required for a Segmenter made with Outputs::segment_tracks or track_ids), the tracks'
+// overlaps, Segmenter::device_tracks_bytes() of them, which Segmenter::decode_device_tracks turns into Result::tracks.
 struct LabelPointers {
     std::uint32_t* labels = nullptr;
     std::size_t labels_bytes = 0;
@@ -94,6 +95,8 @@ struct LabelPointers {
     std::size_t statistics_bytes = 0;
     std::uint32_t* graph = nullptr;
     std::size_t graph_bytes = 0;
+    std::uint32_t* tracks = nullptr;
+    std::size_t tracks_bytes = 0;
 };
 
 // Queues one frame on the Segmenter's stream and returns without waiting: the input copied device to device into
@@ -110,8 +113,8 @@ struct LabelPointers {
 //
 // Frames of one Segmenter run in stream order; its buffers serve one frame at a time, so two frames at once (on two
 // streams) need two Segmenters. Outputs other than the labels, the statistics and the segment graph (mask, normals,
-// raw labels) are host results and are not produced; tracks are refused; Segmenter::last_timings() is empty after
-// it (time the frame with cudaEvents).
+// raw labels) are host results and are not produced; tracks are decoded on the host; Segmenter::last_timings() is empty
+// after it (time the frame with cudaEvents).
 //
 // CUDA graphs: the call may come between cudaStreamBeginCapture(stream, any mode) and cudaStreamEndCapture; it then
 // adds the frame's copies, memsets and kernels to the graph and calls nothing a capture forbids (no

@@ -79,6 +79,10 @@ struct LabelBuffers {
     // nullptr: not written.
     cl_mem graph = nullptr;
     std::size_t graph_offset = 0;
+    // A Segmenter made with Outputs::segment_tracks or track_ids: required, the tracks' overlaps
+    // (Segmenter::device_tracks_bytes()), which Segmenter::decode_device_tracks turns into Result::tracks.
+    cl_mem tracks = nullptr;
+    std::size_t tracks_offset = 0;
 };
 
 // Enqueues one frame on the Segmenter's queue, after the events in `wait` (and, the queue being in order, after
@@ -87,7 +91,7 @@ struct LabelBuffers {
 // at their offsets, and stay valid until that event completes; nothing is enqueued when a check fails (a
 // pyrseg::Error names the problem). Frames of one Segmenter run in queue order; its buffers serve one frame at a
 // time, so two Segmenters are needed for two frames at once. Outputs other than the labels, the statistics and the
-// segment graph (mask, normals, raw labels) are host results and are not produced; tracks are refused;
+// segment graph (mask, normals, raw labels) are host results and are not produced; tracks are decoded on the host;
 // Segmenter::last_timings() is empty after it.
 [[nodiscard]] PYRSEG_EXPORT cl_event segment(Segmenter& segmenter, const CloudBuffers& cloud, const LabelBuffers& out,
                                              std::span<const cl_event> wait = {});

@@ -90,6 +90,18 @@ public:
     [[nodiscard]] std::size_t device_segment_graph_bytes() const;
     void decode_device_segment_graph(const std::uint32_t* words, std::uint32_t count,
                                      std::vector<SegmentEdge>& out) const;
+    // Tracks on device frames: a Segmenter made with Outputs::segment_tracks or track_ids writes each device frame's
+    // overlaps with the previous frame into the caller's tracks buffer, this many bytes at most (0 without tracks),
+    // and keeps the frame's labels on the device for the next one. The host then matches them, frame by frame in the
+    // order they were queued: decode_device_tracks(words, segments, tracks) gives Result::tracks as a host frame
+    // would (docs/algorithm.md section 11), `segments` the frame's statistics (decode_device_statistics) and `words`
+    // the buffer's first PYR_TRACK_HEADER_WORDS + 3 * words[3] words (the header, then the pairs). Throws
+    // pyrseg::Error when the Segmenter has no tracks, `words` is null, the words are not those of the stream's next
+    // frame to decode (skipped, repeated or out of order; reset_tracks starts a new stream) or `segments` does not
+    // hold the frame's K. A host frame is refused while device frames wait to be decoded.
+    [[nodiscard]] std::size_t device_tracks_bytes() const;
+    void decode_device_tracks(const std::uint32_t* words, const std::vector<SegmentStats>& segments,
+                              std::vector<SegmentTrack>& out);
 
 private:
     friend struct core::SegmenterAccess;

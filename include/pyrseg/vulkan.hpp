@@ -112,6 +112,11 @@ struct LabelBuffers {
     VkBuffer graph = VK_NULL_HANDLE;
     VkDeviceSize graph_offset = 0;
     VkDeviceSize graph_bytes = 0;
+    // A Segmenter made with Outputs::segment_tracks or track_ids: required, the tracks' overlaps
+    // (Segmenter::device_tracks_bytes()), which Segmenter::decode_device_tracks turns into Result::tracks.
+    VkBuffer tracks = VK_NULL_HANDLE;
+    VkDeviceSize tracks_offset = 0;
+    VkDeviceSize tracks_bytes = 0;
 };
 
 // Records one frame into the application's command buffer, which must be in the recording state, outside a render
@@ -128,7 +133,7 @@ struct LabelBuffers {
 // after the other in one command buffer, or command buffers submitted in that order to the Segmenter's queue), and
 // a command buffer recorded here must be submitted before the Segmenter's next host frame. Nothing is recorded when
 // a check fails (a pyrseg::Error names the problem). Outputs other than the labels, the statistics and the segment
-// graph (mask, normals, raw labels) are host results and are not produced; tracks are refused;
+// graph (mask, normals, raw labels) are host results and are not produced; tracks are decoded on the host;
 // Segmenter::last_timings() is empty after it.
 PYRSEG_EXPORT void record(Segmenter& segmenter, VkCommandBuffer commands, const CloudBuffers& cloud,
                           const LabelBuffers& out);

@@ -156,6 +156,10 @@ cuda::LabelPointers CudaAdapter::labels(const LabelFrame& frame) const {
         l.graph = reinterpret_cast<std::uint32_t*>(pointer(frame.graph.buffer) + frame.graph.offset);
         l.graph_bytes = size(frame.graph.buffer) - frame.graph.offset;
     }
+    if (frame.tracks.buffer != Region::kNone) {
+        l.tracks = reinterpret_cast<std::uint32_t*>(pointer(frame.tracks.buffer) + frame.tracks.offset);
+        l.tracks_bytes = size(frame.tracks.buffer) - frame.tracks.offset;
+    }
     return l;
 }
 

@@ -5,13 +5,16 @@
 // Segmenter; bad input is a pyrseg::Error that queues and writes nothing, after which the Segmenter still segments.
 #include "interop/device_frames.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include "pyrseg/presets.hpp"
 #include "pyrseg/synthetic.hpp"
+#include "shaders/pyr_types.h"
 #include "support/oracle.hpp"
 
 namespace pyrseg::test {
@@ -440,12 +443,17 @@ TEST_P(DeviceFrames, BadInputIsAnErrorAndQueuesAndWritesNothing) {
     o.graph = {api().allocate(with_graph.device_segment_graph_bytes() - 4), 0};
     r.expect(with_graph, {r.cloud, o}, "segment graph buffer holds");
 
-    // Tracks follow host frames only so far.
+    // Tracks: a buffer for a Segmenter made without them; none, or one word too small, for a Segmenter made with them.
+    o = r.out;
+    o.tracks = {api().allocate(64), 0};
+    cloud_refused(r.cloud, o, "without Outputs::segment_tracks");
     Outputs tracks;
     tracks.segment_tracks = true;
     Segmenter with_tracks = api().make_segmenter(Wall::kWidth, Wall::kHeight, {}, tracks);
-    r.expect(with_tracks, {r.cloud, r.out}, "tracks");
-    r.expect(with_tracks, {r.depth, r.out}, "tracks");
+    r.expect(with_tracks, {r.cloud, r.out}, "needs a tracks buffer");
+    r.expect(with_tracks, {r.depth, r.out}, "needs a tracks buffer");
+    o.tracks = {api().allocate(with_tracks.device_tracks_bytes() - 4), 0};
+    r.expect(with_tracks, {r.cloud, o}, "tracks buffer holds");
 
     // A Segmenter on another API.
     Segmenter cpu(Wall::kWidth, Wall::kHeight, {}, "cpu");
@@ -613,6 +621,135 @@ TEST_P(DeviceFrames, SegmentGraphMatchesTheHostPath) {
     Segmenter without = api().make_segmenter(h.scene.width, h.scene.height, h.params);
     EXPECT_EQ(without.device_segment_graph_bytes(), 0u);
     EXPECT_THROW(without.decode_device_segment_graph(zeros.data(), 1, none), Error);
+}
+
+namespace {
+
+// Column x0 on of `wide`, `width` wide, as a cloud and as a uint16 depth image in millimetres (its principal point
+// moved with the window).
+struct Window {
+    std::vector<float> points;
+    std::vector<std::uint16_t> depth;
+    DepthView view;
+};
+
+Window window_of(const synthetic::Scene& wide, int x0, int width) {
+    Window w;
+    w.points.resize(3 * std::size_t(width) * std::size_t(wide.height));
+    w.depth.resize(std::size_t(width) * std::size_t(wide.height));
+    for (int y = 0; y < wide.height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const std::size_t from = std::size_t(y) * std::size_t(wide.width) + std::size_t(x0 + x);
+            const std::size_t to = std::size_t(y) * std::size_t(width) + std::size_t(x);
+            std::copy_n(wide.points.data() + 3 * from, 3, w.points.data() + 3 * to);
+            const float z = wide.points[3 * from + 2];
+            w.depth[to] = z > 0 && z < 65535 ? std::uint16_t(z) : 0;
+        }
+    }
+    w.view = {w.depth.data(), DepthFormat::u16, width, wide.height, 0, 0.001, wide.fx, wide.fy, wide.cx - x0, wide.cy};
+    return w;
+}
+
+}  // namespace
+
+// Tracks of device frames (a Segmenter made with Outputs::segment_tracks and the statistics): a panning stream of
+// clouds and depth images in turn, all queued before any is read; Segmenter::decode_device_tracks, frame by frame in
+// order, gives the tracks a host stream of the same frames gets on the CPU, and a host frame after them continues the
+// stream. Decoding out of order, twice, or with another frame's statistics is refused, as is a host frame while
+// device frames wait to be decoded.
+TEST_P(DeviceFrames, TracksMatchTheHostPath) {
+    Outputs outputs;
+    outputs.segment_stats = true;
+    outputs.segment_tracks = true;
+    constexpr int kWidth = 96;
+    synthetic::SceneOptions o;
+    o.width = kWidth + 16;
+    o.height = 72;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene wide = synthetic::generate(o);
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    const int columns[] = {0, 2, 3, 5, 8, 9, 12};  // the last one a host frame
+    constexpr std::size_t kFrames = std::size(columns);
+    std::vector<Window> windows;
+    for (const int x0 : columns) windows.push_back(window_of(wide, x0, kWidth));
+    const auto is_cloud = [](std::size_t f) { return f % 2 == 0; };
+
+    std::vector<Result> expected(kFrames);
+    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
+    std::size_t matched = 0;
+    for (std::size_t f = 0; f < kFrames; ++f) {
+        const Window& w = windows[f];
+        expected[f] =
+            is_cloud(f) ? cpu.segment(CloudView{w.points.data(), nullptr, kWidth, o.height}) : cpu.segment(w.view);
+        for (const SegmentTrack& t : expected[f].tracks) matched += t.how != TrackMatch::new_track ? 1 : 0;
+    }
+    ASSERT_GT(matched, 10u) << "a stream whose tracks carry over";
+
+    Segmenter segmenter = api().make_segmenter(kWidth, o.height, params, outputs);
+    const std::size_t bytes = segmenter.device_tracks_bytes();
+    ASSERT_GT(bytes, 0u);
+    std::vector<Frame> frames;
+    for (std::size_t f = 0; f + 1 < kFrames; ++f) {
+        const Window& w = windows[f];
+        LabelFrame out;
+        out.labels = {api().allocate(4 * w.depth.size()), 0};
+        out.count = {api().allocate(4), 0};
+        out.statistics = {api().allocate(segmenter.device_statistics_bytes()), 0};
+        out.tracks = {api().allocate(bytes + 12), 12};
+        if (is_cloud(f)) {
+            frames.push_back({CloudFrame{put(w.points.data(), 4 * w.points.size()), {}, 0}, out});
+        } else {
+            DepthFrame d{put(w.depth.data(), 2 * w.depth.size()), w.view};
+            d.view.depth = nullptr;
+            frames.push_back({d, out});
+        }
+    }
+    const std::vector<Way> ways = api().ways();
+    for (std::size_t way = 0; way < ways.size(); ++way) {
+        if (ways[way].refusals_only) continue;
+        SCOPED_TRACE(ways[way].name);
+        segmenter.reset_tracks();
+        api().run(segmenter, frames, way);
+        const Window& last = windows.back();
+        expect_error(
+            [&] {
+                (void)segmenter.segment(CloudView{last.points.data(), nullptr, kWidth, o.height});
+            },
+            "not decoded", ErrorCode::invalid_argument);
+        std::vector<std::vector<std::uint32_t>> words_of;
+        std::vector<std::vector<SegmentStats>> segments_of;
+        for (const Frame& frame : frames) {
+            const std::uint32_t count = words(frame.out.count.buffer, 0, 1)[0];
+            EXPECT_EQ(words(frame.out.tracks.buffer, 8, 1)[0], kUntouched) << "written before the offset";
+            const std::vector<std::uint32_t> head = words(frame.out.tracks.buffer, 12, PYR_TRACK_HEADER_WORDS);
+            words_of.push_back(words(frame.out.tracks.buffer, 12,
+                                     PYR_TRACK_HEADER_WORDS + PYR_TRACK_SLOT_WORDS * head[PYR_TRACK_PAIRS]));
+            const std::vector<std::uint32_t> stats =
+                words(frame.out.statistics.buffer, 0, segmenter.device_statistics_bytes() / 4);
+            segments_of.emplace_back();
+            segmenter.decode_device_statistics(stats.data(), count, segments_of.back());
+        }
+        std::vector<SegmentTrack> tracks;
+        expect_error([&] { segmenter.decode_device_tracks(words_of[1].data(), segments_of[1], tracks); }, "frame 1",
+                     ErrorCode::invalid_argument);
+        expect_error([&] { segmenter.decode_device_tracks(words_of[0].data(), segments_of[1], tracks); }, "statistics",
+                     ErrorCode::invalid_argument);
+        for (std::size_t f = 0; f < frames.size(); ++f) {
+            SCOPED_TRACE("frame " + std::to_string(f));
+            segmenter.decode_device_tracks(words_of[f].data(), segments_of[f], tracks);
+            EXPECT_EQ(tracks, expected[f].tracks);
+        }
+        expect_error([&] { segmenter.decode_device_tracks(words_of.back().data(), segments_of.back(), tracks); },
+                     "none is queued", ErrorCode::invalid_argument);
+        const Result host = segmenter.segment(CloudView{last.points.data(), nullptr, kWidth, o.height});
+        EXPECT_EQ(host.tracks, expected.back().tracks) << "a host frame after the device frames";
+    }
+    std::vector<SegmentTrack> none;
+    EXPECT_THROW(segmenter.decode_device_tracks(nullptr, {}, none), Error);
+    Segmenter without = api().make_segmenter(kWidth, o.height, params);
+    EXPECT_EQ(without.device_tracks_bytes(), 0u);
+    const std::vector<std::uint32_t> zeros(PYR_TRACK_HEADER_WORDS, 0);
+    EXPECT_THROW(without.decode_device_tracks(zeros.data(), {}, none), Error);
 }
 
 }  // namespace pyrseg::test

@@ -47,6 +47,7 @@ struct LabelFrame {
     Region count;       // kNone: K is not written
     Region statistics;  // kNone: the statistics are not written (Segmenter::device_statistics_bytes() from it on)
     Region graph;       // kNone: the segment graph is not written (Segmenter::device_segment_graph_bytes() from it on)
+    Region tracks;      // kNone: no tracks buffer (Segmenter::device_tracks_bytes() from it on)
     std::size_t row_step_bytes = 0;
 };
 

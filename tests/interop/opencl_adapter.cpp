@@ -117,9 +117,9 @@ opencl::DepthBuffer OpenclAdapter::depth(const DepthFrame& frame) const {
 }
 
 opencl::LabelBuffers OpenclAdapter::labels(const LabelFrame& frame) const {
-    return {mem(frame.labels.buffer), frame.labels.offset,     frame.row_step_bytes,
-            mem(frame.count.buffer),  frame.count.offset,      mem(frame.statistics.buffer),
-            frame.statistics.offset,  mem(frame.graph.buffer), frame.graph.offset};
+    return {mem(frame.labels.buffer), frame.labels.offset,          frame.row_step_bytes,    mem(frame.count.buffer),
+            frame.count.offset,       mem(frame.statistics.buffer), frame.statistics.offset, mem(frame.graph.buffer),
+            frame.graph.offset,       mem(frame.tracks.buffer),     frame.tracks.offset};
 }
 
 cl_context OpenclAdapter::foreign_context() {

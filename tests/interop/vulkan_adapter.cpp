@@ -335,6 +335,11 @@ vulkan::LabelBuffers VulkanAdapter::labels(const LabelFrame& frame) const {
         l.graph_offset = frame.graph.offset;
         l.graph_bytes = buffer(frame.graph.buffer).bytes;
     }
+    if (frame.tracks.buffer != Region::kNone) {
+        l.tracks = buffer(frame.tracks.buffer).buffer;
+        l.tracks_offset = frame.tracks.offset;
+        l.tracks_bytes = buffer(frame.tracks.buffer).bytes;
+    }
     return l;
 }
 
