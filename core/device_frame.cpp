@@ -55,7 +55,6 @@ void run(Segmenter::Impl& impl, InputKind input, const Bind& bind, const DeviceC
     if (with_color) impl.executor->bind_device_color(color);
     run_pipeline(impl.plan, input, with_color, *impl.executor, impl.timings);
     impl.executor->write_device_labels(labels);
-    if (impl.plan.track_slots != 0) ++impl.undecoded_track_frames;
     impl.timings.clear();  // host times of queued work: meaningless, and no device times were kept
 }
 

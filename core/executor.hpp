@@ -6,6 +6,7 @@
 // fused pass instead: no pass depends on what an earlier call of the frame chose.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "pyrseg/cloud.hpp"
@@ -90,6 +91,9 @@ public:
         count = 0;
         return nullptr;
     }
+    // After read_back: the last frame's number in its stream as the device counted it, where device frames may have
+    // come between (GPUs); nullopt where only host frames run.
+    [[nodiscard]] virtual std::optional<std::uint32_t> track_frame() const { return std::nullopt; }
     // Results to the host. A backend that queues the passes may run them only here.
     virtual void read_back(Result& out, const Outputs& outputs) = 0;
     // Device-resident frames (core/device_frame.hpp), on a GPU backend made on the caller's context: the input

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <new>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -29,6 +30,15 @@ namespace {
 
 // Tracks (docs/algorithm.md section 11) from the frame's overlap pairs and statistics, then the id image.
 void follow_tracks(Segmenter::Impl& impl, Result& out) {
+    const std::optional<std::uint32_t> frame = impl.executor->track_frame();
+    if (frame && *frame != impl.tracks.frame()) {
+        throw Error(ErrorCode::invalid_argument,
+                    "tracks: this host frame is frame " + std::to_string(*frame) +
+                        " of the stream on the device, but the host has matched frames up to " +
+                        std::to_string(impl.tracks.frame()) +
+                        ": the device frames before it were not all decoded (decode_device_tracks); call "
+                        "reset_tracks to start a new stream");
+    }
     std::uint32_t pair_count = 0;
     const std::uint32_t* pairs = impl.executor->track_pairs(pair_count);
     impl.tracks.next(pairs, pair_count, out.segments, impl.plan.width, impl.plan.height, impl.plan.params, out.tracks);
@@ -178,13 +188,6 @@ void with_host_memory(const Segmenter::Impl& impl, const Work& work) {
 template <class Bind>
 void run_frame(Segmenter::Impl& impl, core::InputKind input, const Bind& bind, Result& out,
                const std::uint8_t* color = nullptr, std::size_t color_row_step_bytes = 0) {
-    if (impl.undecoded_track_frames != 0) {
-        throw Error(ErrorCode::invalid_argument,
-                    "a host frame follows the tracks of the device frames before it: decode_device_tracks has not "
-                    "decoded " +
-                        std::to_string(impl.undecoded_track_frames) +
-                        " of them yet (or call reset_tracks to start a new stream)");
-    }
     with_host_memory(impl, [&] {
         const auto upload_start = std::chrono::steady_clock::now();
         bind();
@@ -293,7 +296,6 @@ void Segmenter::reset_tracks() {
     Impl& impl = live(impl_);
     impl.tracks.reset();
     impl.executor->forget_previous_labels();
-    impl.undecoded_track_frames = 0;
 }
 
 int Segmenter::width() const {
@@ -381,10 +383,10 @@ void Segmenter::decode_device_tracks(const std::uint32_t* words, const std::vect
     if (plan.track_slots == 0) fail("the Segmenter was made without Outputs::segment_tracks or track_ids");
     if (words == nullptr) fail("no words");
     const std::uint32_t frame = words[PYR_TRACK_FRAME];
-    if (impl.undecoded_track_frames == 0 || frame != impl.tracks.frame()) {
+    if (frame != impl.tracks.frame()) {
         fail("the words are of frame " + std::to_string(frame) + " of the stream, but the next to decode is frame " +
-             std::to_string(impl.tracks.frame()) + (impl.undecoded_track_frames == 0 ? ", and none is queued" : "") +
-             ": decode each device frame's tracks once, in the order the frames were queued");
+             std::to_string(impl.tracks.frame()) +
+             ": decode each device frame's tracks once, in the order the frames ran");
     }
     if (words[PYR_TRACK_COUNT] != segments.size()) {
         fail("the frame has " + std::to_string(words[PYR_TRACK_COUNT]) + " segments but " +
@@ -392,7 +394,6 @@ void Segmenter::decode_device_tracks(const std::uint32_t* words, const std::vect
     }
     const std::uint32_t pairs = std::min(words[PYR_TRACK_PAIRS], plan.track_slots / 2);
     impl.tracks.next(words + PYR_TRACK_HEADER_WORDS, pairs, segments, plan.width, plan.height, plan.params, out);
-    --impl.undecoded_track_frames;
 }
 
 }  // namespace pyrseg

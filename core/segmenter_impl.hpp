@@ -19,10 +19,9 @@ struct Segmenter::Impl {
     Outputs outputs;
     std::unique_ptr<core::PassExecutor> executor;
     std::vector<PassTiming> timings;
-    core::DepthTables depth_tables;            // a depth frame's constants, reused
-    core::CheckedDepthCamera checked_camera;   // the camera whose frame check_depth_camera last passed
-    core::TrackState tracks;                   // Outputs::segment_tracks: the stream's tracks
-    std::uint32_t undecoded_track_frames = 0;  // device frames queued since decode_device_tracks last caught up
+    core::DepthTables depth_tables;           // a depth frame's constants, reused
+    core::CheckedDepthCamera checked_camera;  // the camera whose frame check_depth_camera last passed
+    core::TrackState tracks;                  // Outputs::segment_tracks: the stream's tracks
 };
 
 namespace core {

@@ -540,13 +540,13 @@ PYR_KERNEL_1D(graph_gather) {
 
 /* Tracks' overlaps (shaders/pyr_track.h), after compact, in four dispatches. Each uses the slots K' and K need
  * (pyr_track_slots): K read where the scan left it, K' where the previous frame's track_advance left it (the word
- * after the previous buffer's pixels), or 0 when the frame starts a stream, so that frames queued on the device
- * follow one another without the host. The table starts at a word of the fill buffer after the segment graph's; the
+ * after the previous buffer's pixels, then the previous frame's number in its stream), or 0 when the frame starts a
+ * stream, so that frames queued on the device, or recorded once and run many times, follow one another without the
+ * host. The table starts at a word of the fill buffer after the segment graph's; the
  * header and the gathered pairs follow the table at its largest (PYR_TRACK_HEADER_WORDS, pyr_types.h).
  * track_clear, track_gather and track_advance take: the word of K, whether a previous frame is counted against (0
- * at a stream's start), max slots, the table's first word, the word of K' in the previous buffer (the pixel count),
- * and (track_advance) the frame's number in its stream. track_clear (1D, PYR_TRACK_SLOT_WORDS * at least the slots
- * K' and K need) also zeroes the gathered pairs' counter. */
+ * at a stream's start), max slots, the table's first word, the word of K' in the previous buffer (the pixel count).
+ * track_clear (1D, PYR_TRACK_SLOT_WORDS * at least the slots K' and K need) also zeroes the gathered pairs' counter. */
 #define PYR_TRACK_PREVIOUS(has_previous, word) ((has_previous) != 0u ? PYR_BUF(previous)[word] : 0u)
 #define PYR_TRACK_HEADER(table, max_slots) ((table) + PYR_TRACK_SLOT_WORDS * (max_slots))
 
@@ -606,16 +606,19 @@ PYR_KERNEL_1D(track_gather) {
 }
 #endif
 
-/* track_advance (1D, one invocation, last): the header's frame number, K' and K, and K kept as the next frame's K'. */
+/* track_advance (1D, one invocation, last): the header (the frame's number: the previous frame's + 1, or 0 when the
+ * frame starts a stream; K'; K), and K and the number kept for the next frame. */
 #if defined(PYR_ENTRY_ALL) || defined(PYR_ENTRY_TRACK_ADVANCE)
 PYR_KERNEL_1D(track_advance) {
     if (PYR_I != 0u) return;
     pyr_u32 header = PYR_TRACK_HEADER(PYR_ARG(3), PYR_ARG(2));
     pyr_u32 count = PYR_BUF(sums)[PYR_ARG(0)];
-    PYR_UF_STORE(header + PYR_TRACK_FRAME, PYR_ARG(5));
+    pyr_u32 frame = PYR_ARG(1) != 0u ? PYR_BUF(previous)[PYR_ARG(4) + 1u] + 1u : 0u;
+    PYR_UF_STORE(header + PYR_TRACK_FRAME, frame);
     PYR_UF_STORE(header + PYR_TRACK_PREVIOUS_COUNT, PYR_TRACK_PREVIOUS(PYR_ARG(1), PYR_ARG(4)));
     PYR_UF_STORE(header + PYR_TRACK_COUNT, count);
     PYR_BUF(previous)[PYR_ARG(4)] = count;
+    PYR_BUF(previous)[PYR_ARG(4) + 1u] = frame;
 }
 #endif
 

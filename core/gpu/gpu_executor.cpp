@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -324,27 +325,28 @@ public:
         const uint32_t k_word = plan_.scan_chunks();
         const uint32_t max_slots = plan_.track_slots;
         const uint32_t table = track_table_word();
-        const uint32_t has_previous = previous_bound_ != 0 ? 1u : 0u;
+        const uint32_t has_previous = stream_started_ ? 1u : 0u;
         const uint32_t allowed = pyr_track_slots(previous_bound_, plan_.stats_slots, max_slots);
-        const Args common = args({k_word, has_previous, max_slots, table, pixels(), track_frame_});
+        const Args common = args({k_word, has_previous, max_slots, table, pixels()});
         dispatch(Kernel::track_clear, PYR_TRACK_SLOT_WORDS * allowed, 1, common);
         const uint32_t runs = plan_.stats_runs_per_row() * height();
         dispatch(Kernel::track_count, runs, 1,
                  args({height(), runs, k_word, has_previous, max_slots, table, pixels()}));
         dispatch(Kernel::track_gather, allowed, 1, common);
         dispatch(Kernel::track_advance, 1, 1, common);
-        ++track_frame_;
         // The host knows K once a host frame is read back; until then (a device frame) any K' is possible.
         previous_bound_ = plan_.stats_slots;
+        stream_started_ = true;
     }
     void forget_previous_labels() override {
         previous_bound_ = 0;
-        track_frame_ = 0;
+        stream_started_ = false;
     }
     [[nodiscard]] const uint32_t* track_pairs(uint32_t& count) const override {
         count = track_pairs_;
         return host_tracks_.data();
     }
+    [[nodiscard]] std::optional<uint32_t> track_frame() const override { return track_header_[PYR_TRACK_FRAME]; }
 
     void read_back(Result& out, const Outputs& outputs) override {
         device_->mark("download");
@@ -502,8 +504,8 @@ private:
     std::array<uint32_t, PYR_TRACK_HEADER_WORDS> track_header_{};  // the last host frame's, as the device left it
     std::vector<uint32_t> host_tracks_;                            // its gathered pairs
     uint32_t track_pairs_ = 0;                                     // how many
-    uint32_t previous_bound_ = 0;  // the most segments the previous buffer's labels can have (0: a stream starts)
-    uint32_t track_frame_ = 0;     // the next frame's number in its stream
+    uint32_t previous_bound_ = 0;  // the most segments the previous buffer's labels can have
+    bool stream_started_ = false;  // a frame was queued since the stream started: the previous buffer holds its labels
     uint32_t dispatches_ = 0;
     uint32_t host_syncs_ = 0;
     bool from_mask_ = false;
@@ -563,7 +565,7 @@ size_t buffer_bytes(Buffer b, const core::Plan& plan, const DeviceLimits& limits
         case Buffer::color:
             return (3 * px + 3) / 4 * 4;  // R, G, B per pixel, whole words
         case Buffer::previous:
-            return plan.track_slots != 0 ? 4 * (px + 1) : 0;  // then the labels' K (shaders/pyr_entries.h)
+            return plan.track_slots != 0 ? 4 * (px + 2) : 0;  // then their K and frame (shaders/pyr_entries.h)
         case Buffer::count:
             break;
     }

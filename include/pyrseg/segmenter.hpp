@@ -92,13 +92,15 @@ public:
                                      std::vector<SegmentEdge>& out) const;
     // Tracks on device frames: a Segmenter made with Outputs::segment_tracks or track_ids writes each device frame's
     // overlaps with the previous frame into the caller's tracks buffer, this many bytes at most (0 without tracks),
-    // and keeps the frame's labels on the device for the next one. The host then matches them, frame by frame in the
-    // order they were queued: decode_device_tracks(words, segments, tracks) gives Result::tracks as a host frame
-    // would (docs/algorithm.md section 11), `segments` the frame's statistics (decode_device_statistics) and `words`
-    // the buffer's first PYR_TRACK_HEADER_WORDS + 3 * words[3] words (the header, then the pairs). Throws
-    // pyrseg::Error when the Segmenter has no tracks, `words` is null, the words are not those of the stream's next
-    // frame to decode (skipped, repeated or out of order; reset_tracks starts a new stream) or `segments` does not
-    // hold the frame's K. A host frame is refused while device frames wait to be decoded.
+    // and keeps the frame's labels, K and number in the stream on the device for the next frame, so that frames queued
+    // back to back, or recorded once and run many times, follow one another (a frame recorded as a stream's first,
+    // after reset_tracks or the Segmenter's first, starts a stream each time it runs). The host then matches them,
+    // frame by frame in the order they ran: decode_device_tracks(words, segments, tracks) gives Result::tracks as a
+    // host frame would (docs/algorithm.md section 11), `segments` the frame's statistics (decode_device_statistics)
+    // and `words` the buffer's first PYR_TRACK_HEADER_WORDS + 3 * words[3] words (the header, then the pairs).
+    // Throws pyrseg::Error when the Segmenter has no tracks, `words` is null, the words are not those of the stream's
+    // next frame to decode (skipped, repeated or out of order; reset_tracks starts a new stream) or `segments` does
+    // not hold the frame's K. A host frame after device frames not all decoded is an error too.
     [[nodiscard]] std::size_t device_tracks_bytes() const;
     void decode_device_tracks(const std::uint32_t* words, const std::vector<SegmentStats>& segments,
                               std::vector<SegmentTrack>& out);

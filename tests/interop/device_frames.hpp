@@ -17,6 +17,7 @@
 
 #include "pyrseg/error.hpp"
 #include "pyrseg/segmenter.hpp"
+#include "pyrseg/synthetic.hpp"
 
 namespace pyrseg::test {
 
@@ -149,6 +150,15 @@ std::vector<unsigned char> pitched(const void* packed, int width, int height, st
 
 // The labels of a device frame's buffer, rows `pitch` bytes apart, packed again.
 std::vector<std::uint32_t> unpitch(const unsigned char* bytes, int width, int height, std::size_t pitch);
+
+// Column x0 on of `wide`, `width` wide, as a cloud and as a uint16 depth image in millimetres (its principal point
+// moved with the window): the frames of a camera panning over `wide`.
+struct Window {
+    std::vector<float> points;
+    std::vector<std::uint16_t> depth;
+    DepthView view;
+};
+Window window_of(const synthetic::Scene& wide, int x0, int width);
 
 // Expects `call` to throw a pyrseg::Error of `code` whose message names `words`.
 template <class Call>

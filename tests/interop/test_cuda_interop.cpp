@@ -1,8 +1,8 @@
 // What only CUDA's interop has, on the adapter's stream and memory (cuda_adapter.hpp; the checks every API shares
 // are device_frames.cpp): frames follow the stream's order after an event of another stream, a frame captured into a
-// CUDA graph replays with new input, the legacy default stream works, and host memory, memory the caller claims
-// more of than it has, Segmenters on pyrseg's own stream and what a capture cannot hold are refused, leaving the
-// caller's memory and stream untouched.
+// CUDA graph replays with new input (and, with tracks, as the stream's next frame each time), the legacy default stream
+// works, and host memory, memory the caller claims more of than it has, Segmenters on pyrseg's own stream and what a
+// capture cannot hold are refused, leaving the caller's memory and stream untouched.
 #include <cuda_runtime_api.h>
 #include <gtest/gtest.h>
 
@@ -203,6 +203,75 @@ TEST_F(CudaInterop, ACapturedFrameReplaysWithNewInput) {
     cuda::segment(segmenter, in, out);
     EXPECT_TRUE(
         same_bytes("labels after the graph", read<std::uint32_t>(out.labels, sentinel.size()), expected[1].labels, w));
+}
+
+TEST_F(CudaInterop, ACapturedFrameWithTracksRunsAsTheStreamsNextFrameEachTime) {
+    // A frame with tracks captured into a CUDA graph after the stream's first frame, then launched three times with
+    // new points: each launch is the stream's next frame (K' and the frame's number live on the device), and
+    // decode_device_tracks gives the tracks the CPU's host stream of the same frames gets.
+    constexpr int kWidth = 96;
+    synthetic::SceneOptions o;
+    o.width = kWidth + 16;
+    o.height = 72;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene wide = synthetic::generate(o);
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Outputs outputs;
+    outputs.segment_stats = true;
+    outputs.segment_tracks = true;
+    std::vector<Window> windows;
+    for (const int x0 : {0, 3, 7, 8}) windows.push_back(window_of(wide, x0, kWidth));
+    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
+    Segmenter segmenter = cuda::make_segmenter(kWidth, o.height, stream_, params, outputs);
+    const CloudView first{windows[0].points.data(), nullptr, kWidth, o.height};
+    EXPECT_EQ(segmenter.segment(first).tracks, cpu.segment(first).tracks);
+
+    const std::size_t bytes = 4 * windows[0].points.size();
+    cuda::CloudPointers in;
+    in.points = device<float>(bytes);
+    in.points_bytes = bytes;
+    cuda::LabelPointers out;
+    out.labels_bytes = 4 * windows[0].depth.size();
+    out.labels = device<std::uint32_t>(out.labels_bytes);
+    out.count = device<std::uint32_t>(4);
+    out.statistics_bytes = segmenter.device_statistics_bytes();
+    out.statistics = device<std::uint32_t>(out.statistics_bytes);
+    out.tracks_bytes = segmenter.device_tracks_bytes();
+    out.tracks = device<std::uint32_t>(out.tracks_bytes);
+    ASSERT_EQ(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeGlobal), cudaSuccess);
+    try {
+        cuda::segment(segmenter, in, out);
+    } catch (const Error& e) {
+        cudaGraph_t abandoned = nullptr;
+        cudaStreamEndCapture(stream_, &abandoned);
+        if (abandoned != nullptr) cudaGraphDestroy(abandoned);
+        FAIL() << "cuda::segment refused to be captured: " << e.what();
+    }
+    cudaGraph_t graph = nullptr;
+    ASSERT_EQ(cudaStreamEndCapture(stream_, &graph), cudaSuccess) << "the frame invalidated the capture";
+    cudaGraphExec_t exec = nullptr;
+    ASSERT_EQ(cudaGraphInstantiate(&exec, graph, 0), cudaSuccess);
+    cudaGraphDestroy(graph);
+    std::size_t matched = 0;
+    for (std::size_t f = 1; f < windows.size(); ++f) {
+        SCOPED_TRACE("launch " + std::to_string(f));
+        const Result expected = cpu.segment(CloudView{windows[f].points.data(), nullptr, kWidth, o.height});
+        upload(const_cast<float*>(in.points), windows[f].points.data(), bytes);
+        ASSERT_EQ(cudaGraphLaunch(exec, stream_), cudaSuccess);
+        ASSERT_EQ(cudaStreamSynchronize(stream_), cudaSuccess);
+        const std::uint32_t count = read<std::uint32_t>(out.count, 1)[0];
+        ASSERT_EQ(count, expected.segment_count);
+        std::vector<SegmentStats> segments;
+        const std::vector<std::uint32_t> stats = read<std::uint32_t>(out.statistics, out.statistics_bytes / 4);
+        segmenter.decode_device_statistics(stats.data(), count, segments);
+        const std::vector<std::uint32_t> track_words = read<std::uint32_t>(out.tracks, out.tracks_bytes / 4);
+        std::vector<SegmentTrack> tracks;
+        segmenter.decode_device_tracks(track_words.data(), segments, tracks);
+        EXPECT_EQ(tracks, expected.tracks);
+        for (const SegmentTrack& t : tracks) matched += t.how != TrackMatch::new_track ? 1 : 0;
+    }
+    cudaGraphExecDestroy(exec);
+    EXPECT_GT(matched, 5u) << "a stream whose tracks carry over";
 }
 
 TEST_F(CudaInterop, ACapturedDepthFrameCarriesItsOwnRayTable) {

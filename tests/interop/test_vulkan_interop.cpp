@@ -1,7 +1,8 @@
 // What only Vulkan's interop has, on the adapter's instance, device and queue (vulkan_adapter.hpp, with the
 // validation layer; the checks every API shares are device_frames.cpp): the test's messenger sees the layer's
 // hazards, make_segmenter checks the device it is given, buffer sizes and offsets the caller states are checked, the
-// command buffer and semaphores are, and a Segmenter on pyrseg's own device or moved from takes no buffers.
+// command buffer and semaphores are, a Segmenter on pyrseg's own device or moved from takes no buffers, and a frame
+// with tracks recorded once runs as the stream's next frame each time it is submitted.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -12,6 +13,8 @@
 
 #include "interop/vulkan_adapter.hpp"
 #include "pyrseg/backend.hpp"
+#include "pyrseg/presets.hpp"
+#include "pyrseg/synthetic.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -157,6 +160,71 @@ TEST_F(VulkanInterop, ASegmenterOnPyrsegsOwnDeviceIsRefused) {
     Refusals r(api());
     Segmenter own(Wall::kWidth, Wall::kHeight, {}, "vulkan");
     r.expect(own, {r.cloud, r.out}, "pyrseg's own Vulkan device");
+}
+
+// A frame with tracks recorded once, after the stream's first frame, and submitted three times, new points uploaded
+// before each: each run is the stream's next frame (K' and the frame's number live on the device), and
+// decode_device_tracks gives the tracks the CPU's host stream of the same frames gets.
+TEST_F(VulkanInterop, ARecordedFrameWithTracksRunsAsTheStreamsNextFrameEachTime) {
+    VulkanAdapter& vk = api();
+    constexpr int kWidth = 96;
+    synthetic::SceneOptions o;
+    o.width = kWidth + 16;
+    o.height = 72;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene wide = synthetic::generate(o);
+    const Params params = sensor_preset(SensorKind::kinect_v1);
+    Outputs outputs;
+    outputs.segment_stats = true;
+    outputs.segment_tracks = true;
+    std::vector<Window> windows;
+    for (const int x0 : {0, 3, 7, 8}) windows.push_back(window_of(wide, x0, kWidth));
+    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
+    Segmenter segmenter = vk.make_segmenter(kWidth, o.height, params, outputs);
+    const CloudView first{windows[0].points.data(), nullptr, kWidth, o.height};
+    EXPECT_EQ(segmenter.segment(first).tracks, cpu.segment(first).tracks);
+    const std::size_t point_bytes = 4 * windows[0].points.size();
+    const CloudFrame in{{vk.allocate(point_bytes), 0}, {}, 0};
+    LabelFrame out;
+    out.labels = {vk.allocate(4 * windows[0].depth.size()), 0};
+    out.count = {vk.allocate(4), 0};
+    out.statistics = {vk.allocate(segmenter.device_statistics_bytes()), 0};
+    out.tracks = {vk.allocate(segmenter.device_tracks_bytes()), 0};
+    VkCommandBuffer commands = vk.allocate_commands();
+    auto begin = VkCommandBufferBeginInfo{};
+    begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    ASSERT_EQ(vkBeginCommandBuffer(commands, &begin), VK_SUCCESS);
+    vulkan::record(segmenter, commands, vk.cloud(in), vk.labels(out));
+    ASSERT_EQ(vkEndCommandBuffer(commands), VK_SUCCESS);
+    const auto words_of = [&](const Region& r, std::size_t bytes) {
+        const std::vector<unsigned char> b = vk.download(r.buffer, r.offset, bytes);
+        std::vector<std::uint32_t> w(bytes / 4);
+        std::memcpy(w.data(), b.data(), bytes);
+        return w;
+    };
+    std::size_t matched = 0;
+    for (std::size_t f = 1; f < windows.size(); ++f) {
+        SCOPED_TRACE("run " + std::to_string(f));
+        const Result expected = cpu.segment(CloudView{windows[f].points.data(), nullptr, kWidth, o.height});
+        vk.upload(in.points.buffer, 0, windows[f].points.data(), point_bytes);
+        auto info = VkSubmitInfo{};
+        info.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        info.commandBufferCount = 1;
+        info.pCommandBuffers = &commands;
+        ASSERT_EQ(vkQueueSubmit(vk.queue(), 1, &info, VK_NULL_HANDLE), VK_SUCCESS);
+        const std::uint32_t count = words_of(out.count, 4)[0];
+        ASSERT_EQ(count, expected.segment_count);
+        std::vector<SegmentStats> segments;
+        const std::vector<std::uint32_t> stats = words_of(out.statistics, segmenter.device_statistics_bytes());
+        segmenter.decode_device_statistics(stats.data(), count, segments);
+        const std::vector<std::uint32_t> track_words = words_of(out.tracks, segmenter.device_tracks_bytes());
+        std::vector<SegmentTrack> tracks;
+        segmenter.decode_device_tracks(track_words.data(), segments, tracks);
+        EXPECT_EQ(tracks, expected.tracks);
+        for (const SegmentTrack& t : tracks) matched += t.how != TrackMatch::new_track ? 1 : 0;
+    }
+    EXPECT_GT(matched, 5u) << "a stream whose tracks carry over";
+    vk.free(commands);
 }
 
 }  // namespace
