@@ -301,7 +301,7 @@ Plan make_plan(int width, int height, const Params& params, const Outputs& outpu
         // Each pair of (previous label, label) holds at least one pixel; the table gets more than twice as many
         // slots as a frame can have pairs.
         const std::uint64_t slots = std::uint64_t(1) << ceil_log2(2 * pixels + 1);
-        if (plan.graph_words() + PYR_TRACK_HEADER_WORDS + std::uint64_t(PYR_TRACK_SLOT_WORDS) * (slots + slots / 2) >
+        if (plan.graph_words() + PYR_TRACK_HEADER_WORDS + std::uint64_t(PYR_TRACK_SLOT_WORDS) * (slots + pixels) >
             kMax32) {
             throw Error(ErrorCode::image_too_large, "image " + std::to_string(width) + " x " + std::to_string(height) +
                                                         " is too large for the tracks' 32-bit pair table");

@@ -87,10 +87,14 @@ struct Plan {
     [[nodiscard]] std::size_t graph_words() const {
         return graph_slots == 0 ? 0 : 1 + std::size_t(PYR_GRAPH_SLOT_WORDS) * (graph_slots + graph_slots / 2);
     }
-    // The tracks' words on GPUs: the table at its largest, then the header and the gathered pairs, at most half as
-    // many as the slots (shaders/pyr_types.h: PYR_TRACK_HEADER_WORDS), which device frames copy to the caller.
+    // The tracks' words on GPUs: the table at its largest, then the header and the gathered pairs, at most one per
+    // pixel (shaders/pyr_types.h: PYR_TRACK_HEADER_WORDS), which device frames copy to the caller.
+    [[nodiscard]] std::uint32_t track_pair_capacity() const {
+        return track_slots == 0 ? 0 : std::uint32_t(pixel_count());
+    }
     [[nodiscard]] std::size_t track_list_words() const {
-        return track_slots == 0 ? 0 : PYR_TRACK_HEADER_WORDS + std::size_t(PYR_TRACK_SLOT_WORDS) * (track_slots / 2);
+        return track_slots == 0 ? 0
+                                : PYR_TRACK_HEADER_WORDS + std::size_t(PYR_TRACK_SLOT_WORDS) * track_pair_capacity();
     }
     [[nodiscard]] std::size_t track_words() const {
         return std::size_t(PYR_TRACK_SLOT_WORDS) * track_slots + track_list_words();

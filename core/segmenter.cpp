@@ -392,7 +392,7 @@ void Segmenter::decode_device_tracks(const std::uint32_t* words, const std::vect
         fail("the frame has " + std::to_string(words[PYR_TRACK_COUNT]) + " segments but " +
              std::to_string(segments.size()) + " statistics were given (decode_device_statistics of the same frame)");
     }
-    const std::uint32_t pairs = std::min(words[PYR_TRACK_PAIRS], plan.track_slots / 2);
+    const std::uint32_t pairs = std::min(words[PYR_TRACK_PAIRS], plan.track_pair_capacity());
     impl.tracks.next(words + PYR_TRACK_HEADER_WORDS, pairs, segments, plan.width, plan.height, plan.params, out);
 }
 

@@ -140,8 +140,8 @@ PYR_FN pyr_i32 pyr_unpack_q16(pyr_u32 half_word) {
  * frame's label and the frame's (0: a free slot), and the pixels they share. */
 #define PYR_TRACK_SLOT_WORDS 3u
 /* After the table (at its largest): a header of PYR_TRACK_HEADER_WORDS words, then the pairs gathered from the table
- * (PYR_TRACK_SLOT_WORDS words each, at most half as many as the table's slots): the frame's number in its stream,
- * K', K, and how many pairs were gathered. */
+ * (PYR_TRACK_SLOT_WORDS words each, at most one per pixel): the frame's number in its stream, K', K, and how many
+ * pairs were gathered. */
 #define PYR_TRACK_HEADER_WORDS 4u
 #define PYR_TRACK_FRAME 0u
 #define PYR_TRACK_PREVIOUS_COUNT 1u

@@ -386,7 +386,7 @@ public:
             device_->download(Buffer::fill, 4 * list, host_graph_.data(), 4 * size_t(PYR_GRAPH_SLOT_WORDS) * pairs);
         }
         // The tracks' gathered pairs; the executor's labels are the previous frame's from now on, and their K known.
-        track_pairs_ = std::min(track_header_[PYR_TRACK_PAIRS], plan_.track_slots / 2);
+        track_pairs_ = std::min(track_header_[PYR_TRACK_PAIRS], plan_.track_pair_capacity());
         if (track_pairs_ != 0) {
             const size_t words = size_t(PYR_TRACK_SLOT_WORDS) * track_pairs_;
             if (host_tracks_.size() < words) host_tracks_.resize(words);  // grows with the most pairs a frame had
