@@ -34,7 +34,7 @@ void follow_tracks(Segmenter::Impl& impl, Result& out) {
     if (frame && *frame != impl.tracks.frame()) {
         throw Error(ErrorCode::invalid_argument,
                     "tracks: this host frame is frame " + std::to_string(*frame) +
-                        " of the stream on the device, but the host has matched frames up to " +
+                        " of the stream on the device, but the next frame the host matches is frame " +
                         std::to_string(impl.tracks.frame()) +
                         ": the device frames before it were not all decoded (decode_device_tracks); call "
                         "reset_tracks to start a new stream");
