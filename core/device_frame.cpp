@@ -83,6 +83,16 @@ void check_device_color(const DeviceColor& color, int width, int height) {
     check_rows("colour image", color.rgb, pitch, row, std::size_t(height), 1, width, height);
 }
 
+// The words of one of the Segmenter's outputs (`words` of them; 0 when it was made without `output`), when the
+// caller gives their buffer.
+void check_output_words(const char* what, const ExternalBuffer& b, const char* output, std::size_t words,
+                        const Plan& plan) {
+    if (b.handle == 0) return;
+    if (words == 0) bad(std::string("a ") + what + " buffer was given but the Segmenter was made without " + output);
+    const std::size_t bytes = 4 * words;
+    check_rows(what, b, bytes, bytes, 1, 4, plan.width, plan.height);
+}
+
 void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
     const int width = plan.width;
     const int height = plan.height;
@@ -90,30 +100,13 @@ void check_device_labels(const DeviceLabels& labels, const Plan& plan) {
     const std::size_t pitch = labels.row_step_bytes == 0 ? row : labels.row_step_bytes;
     check_rows("labels", labels.labels, pitch, row, std::size_t(height), 4, width, height);
     if (labels.count.handle != 0) check_rows("segment count", labels.count, 4, 4, 1, 4, width, height);
-    if (labels.statistics.handle != 0) {
-        if (plan.stats_slots == 0) {
-            bad("a statistics buffer was given but the Segmenter was made without Outputs::segment_stats");
-        }
-        const std::size_t bytes = 4 * plan.stats_words();
-        check_rows("statistics", labels.statistics, bytes, bytes, 1, 4, width, height);
+    check_output_words("statistics", labels.statistics, "Outputs::segment_stats", plan.stats_words(), plan);
+    check_output_words("segment graph", labels.graph, "Outputs::segment_graph", plan.graph_words(), plan);
+    if (plan.track_slots != 0 && labels.tracks.handle == 0) {
+        bad("the Segmenter follows tracks (Outputs::segment_tracks or track_ids): each device frame needs a "
+            "tracks buffer of Segmenter::device_tracks_bytes() for Segmenter::decode_device_tracks");
     }
-    if (labels.graph.handle != 0) {
-        if (plan.graph_slots == 0) {
-            bad("a segment graph buffer was given but the Segmenter was made without Outputs::segment_graph");
-        }
-        const std::size_t bytes = 4 * plan.graph_words();
-        check_rows("segment graph", labels.graph, bytes, bytes, 1, 4, width, height);
-    }
-    if (labels.tracks.handle != 0 && plan.track_slots == 0)
-        bad("a tracks buffer was given but the Segmenter was made without Outputs::segment_tracks or track_ids");
-    if (plan.track_slots != 0) {
-        if (labels.tracks.handle == 0) {
-            bad("the Segmenter follows tracks (Outputs::segment_tracks or track_ids): each device frame needs a "
-                "tracks buffer of Segmenter::device_tracks_bytes() for Segmenter::decode_device_tracks");
-        }
-        const std::size_t bytes = 4 * plan.track_list_words();
-        check_rows("tracks", labels.tracks, bytes, bytes, 1, 4, width, height);
-    }
+    check_output_words("tracks", labels.tracks, "Outputs::segment_tracks or track_ids", plan.track_list_words(), plan);
 }
 
 }  // namespace
