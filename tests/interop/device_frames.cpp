@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
-#include <iterator>
 #include <string>
 
 #include "pyrseg/presets.hpp"
@@ -623,6 +622,8 @@ TEST_P(DeviceFrames, SegmentGraphMatchesTheHostPath) {
     EXPECT_THROW(without.decode_device_segment_graph(zeros.data(), 1, none), Error);
 }
 
+namespace {
+
 Window window_of(const synthetic::Scene& wide, int x0, int width) {
     Window w;
     w.points.resize(3 * std::size_t(width) * std::size_t(wide.height));
@@ -640,44 +641,49 @@ Window window_of(const synthetic::Scene& wide, int x0, int width) {
     return w;
 }
 
+}  // namespace
+
+PanningStream panning_stream(std::initializer_list<int> columns) {
+    synthetic::SceneOptions o;
+    o.width = PanningStream::kWidth + 16;
+    o.height = PanningStream::kHeight;
+    o.sensor = synthetic::Sensor::kinect_v1;
+    const synthetic::Scene wide = synthetic::generate(o);
+    PanningStream stream;
+    stream.params = sensor_preset(SensorKind::kinect_v1);
+    stream.outputs.segment_stats = true;
+    stream.outputs.segment_tracks = true;
+    for (const int x0 : columns) stream.windows.push_back(window_of(wide, x0, PanningStream::kWidth));
+    return stream;
+}
+
 // Tracks of device frames (a Segmenter made with Outputs::segment_tracks and the statistics): a panning stream of
 // clouds and depth images in turn, all queued before any is read; Segmenter::decode_device_tracks, frame by frame in
 // order, gives the tracks a host stream of the same frames gets on the CPU, and a host frame after them continues the
 // stream. Decoding out of order, twice, or with another frame's statistics is refused, as is a host frame after a
 // device frame not decoded.
 TEST_P(DeviceFrames, TracksMatchTheHostPath) {
-    Outputs outputs;
-    outputs.segment_stats = true;
-    outputs.segment_tracks = true;
-    constexpr int kWidth = 96;
-    synthetic::SceneOptions o;
-    o.width = kWidth + 16;
-    o.height = 72;
-    o.sensor = synthetic::Sensor::kinect_v1;
-    const synthetic::Scene wide = synthetic::generate(o);
-    const Params params = sensor_preset(SensorKind::kinect_v1);
-    const int columns[] = {0, 2, 3, 5, 8, 9, 12};  // the last one a host frame
-    constexpr std::size_t kFrames = std::size(columns);
-    std::vector<Window> windows;
-    for (const int x0 : columns) windows.push_back(window_of(wide, x0, kWidth));
+    const PanningStream stream = panning_stream({0, 2, 3, 5, 8, 9, 12});  // the last one a host frame
+    const std::vector<Window>& windows = stream.windows;
+    const std::size_t frame_count = windows.size();
     const auto is_cloud = [](std::size_t f) { return f % 2 == 0; };
 
-    std::vector<Result> expected(kFrames);
-    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
+    std::vector<Result> expected(frame_count);
+    Segmenter cpu(PanningStream::kWidth, PanningStream::kHeight, stream.params, "cpu", stream.outputs);
     std::size_t matched = 0;
-    for (std::size_t f = 0; f < kFrames; ++f) {
+    for (std::size_t f = 0; f < frame_count; ++f) {
         const Window& w = windows[f];
-        expected[f] =
-            is_cloud(f) ? cpu.segment(CloudView{w.points.data(), nullptr, kWidth, o.height}) : cpu.segment(w.view);
+        expected[f] = is_cloud(f) ? cpu.segment(stream.cloud(f)) : cpu.segment(w.view);
         for (const SegmentTrack& t : expected[f].tracks) matched += t.how != TrackMatch::new_track ? 1 : 0;
     }
     ASSERT_GT(matched, 10u) << "a stream whose tracks carry over";
 
-    Segmenter segmenter = api().make_segmenter(kWidth, o.height, params, outputs);
+    Segmenter segmenter =
+        api().make_segmenter(PanningStream::kWidth, PanningStream::kHeight, stream.params, stream.outputs);
     const std::size_t bytes = segmenter.device_tracks_bytes();
     ASSERT_GT(bytes, 0u);
     std::vector<Frame> frames;
-    for (std::size_t f = 0; f + 1 < kFrames; ++f) {
+    for (std::size_t f = 0; f + 1 < frame_count; ++f) {
         const Window& w = windows[f];
         LabelFrame out;
         out.labels = {api().allocate(4 * w.depth.size()), 0};
@@ -698,7 +704,6 @@ TEST_P(DeviceFrames, TracksMatchTheHostPath) {
         SCOPED_TRACE(ways[way].name);
         segmenter.reset_tracks();
         api().run(segmenter, frames, way);
-        const Window& last = windows.back();
         std::vector<std::vector<std::uint32_t>> words_of;
         std::vector<std::vector<SegmentStats>> segments_of;
         for (const Frame& frame : frames) {
@@ -724,7 +729,7 @@ TEST_P(DeviceFrames, TracksMatchTheHostPath) {
         }
         expect_error([&] { segmenter.decode_device_tracks(words_of.back().data(), segments_of.back(), tracks); },
                      "next to decode is frame 6", ErrorCode::invalid_argument);
-        const CloudView host_frame{last.points.data(), nullptr, kWidth, o.height};
+        const CloudView host_frame = stream.cloud(frame_count - 1);
         const Result host = segmenter.segment(host_frame);
         EXPECT_EQ(host.tracks, expected.back().tracks) << "a host frame after the device frames";
         api().run(segmenter, std::span(frames.data(), 1), way);
@@ -732,7 +737,7 @@ TEST_P(DeviceFrames, TracksMatchTheHostPath) {
     }
     std::vector<SegmentTrack> none;
     EXPECT_THROW(segmenter.decode_device_tracks(nullptr, {}, none), Error);
-    Segmenter without = api().make_segmenter(kWidth, o.height, params);
+    Segmenter without = api().make_segmenter(PanningStream::kWidth, PanningStream::kHeight, stream.params);
     EXPECT_EQ(without.device_tracks_bytes(), 0u);
     const std::vector<std::uint32_t> zeros(PYR_TRACK_HEADER_WORDS, 0);
     EXPECT_THROW(without.decode_device_tracks(zeros.data(), {}, none), Error);

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -151,14 +152,23 @@ std::vector<unsigned char> pitched(const void* packed, int width, int height, st
 // The labels of a device frame's buffer, rows `pitch` bytes apart, packed again.
 std::vector<std::uint32_t> unpitch(const unsigned char* bytes, int width, int height, std::size_t pitch);
 
-// Column x0 on of `wide`, `width` wide, as a cloud and as a uint16 depth image in millimetres (its principal point
-// moved with the window): the frames of a camera panning over `wide`.
+// A camera panning over one kinect-v1 scene, for the tracks: a kWidth x kHeight frame at each column given (at most
+// 16) as a cloud and as a uint16 depth image in millimetres (its principal point moved with the window), the
+// kinect-v1 preset, and the outputs tracks need (the statistics and the tracks).
 struct Window {
     std::vector<float> points;
     std::vector<std::uint16_t> depth;
     DepthView view;
 };
-Window window_of(const synthetic::Scene& wide, int x0, int width);
+struct PanningStream {
+    static constexpr int kWidth = 96;
+    static constexpr int kHeight = 72;
+    Params params;
+    Outputs outputs;
+    std::vector<Window> windows;
+    [[nodiscard]] CloudView cloud(std::size_t f) const { return {windows[f].points.data(), nullptr, kWidth, kHeight}; }
+};
+PanningStream panning_stream(std::initializer_list<int> columns);
 
 // Expects `call` to throw a pyrseg::Error of `code` whose message names `words`.
 template <class Call>

@@ -67,6 +67,31 @@ protected:
         return api().read<T>(src, count);
     }
 
+    // What `segment` queues (a call of cuda::segment), captured on the test's stream into a graph; nullptr, the
+    // failure said, when pyrseg refused to be captured or the frame invalidated the capture.
+    template <class Segment>
+    cudaGraph_t capture(const Segment& segment) {
+        if (cudaStreamBeginCapture(stream_, cudaStreamCaptureModeGlobal) != cudaSuccess) {
+            ADD_FAILURE() << "cudaStreamBeginCapture failed";
+            return nullptr;
+        }
+        bool refused = false;
+        try {
+            segment();
+        } catch (const Error& e) {
+            refused = true;
+            ADD_FAILURE() << "cuda::segment refused to be captured: " << e.what();
+        }
+        cudaGraph_t graph = nullptr;
+        const cudaError_t ended = cudaStreamEndCapture(stream_, &graph);
+        if (ended != cudaSuccess) ADD_FAILURE() << "the frame invalidated the capture: " << cudaGetErrorString(ended);
+        if (refused || ended != cudaSuccess) {
+            if (graph != nullptr) cudaGraphDestroy(graph);
+            return nullptr;
+        }
+        return graph;
+    }
+
     cudaStream_t stream_ = nullptr;
 };
 
@@ -168,17 +193,8 @@ TEST_F(CudaInterop, ACapturedFrameReplaysWithNewInput) {
     out.labels_bytes = labels_bytes;
     out.count = device<std::uint32_t>(4, sentinel.data());
 
-    ASSERT_EQ(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeGlobal), cudaSuccess);
-    try {
-        cuda::segment(segmenter, in, out);
-    } catch (const Error& e) {
-        cudaGraph_t abandoned = nullptr;
-        cudaStreamEndCapture(stream_, &abandoned);
-        if (abandoned != nullptr) cudaGraphDestroy(abandoned);
-        FAIL() << "cuda::segment refused to be captured: " << e.what();
-    }
-    cudaGraph_t graph = nullptr;
-    ASSERT_EQ(cudaStreamEndCapture(stream_, &graph), cudaSuccess) << "the frame invalidated the capture";
+    cudaGraph_t graph = capture([&] { cuda::segment(segmenter, in, out); });
+    ASSERT_NE(graph, nullptr);
     std::size_t nodes = 0;
     ASSERT_EQ(cudaGraphGetNodes(graph, nullptr, &nodes), cudaSuccess);
     EXPECT_GT(nodes, 10u) << "the graph should hold the frame's copies and kernels";
@@ -209,22 +225,12 @@ TEST_F(CudaInterop, ACapturedFrameWithTracksRunsAsTheStreamsNextFrameEachTime) {
     // A frame with tracks captured into a CUDA graph after the stream's first frame, then launched three times with
     // new points: each launch is the stream's next frame (K' and the frame's number live on the device), and
     // decode_device_tracks gives the tracks the CPU's host stream of the same frames gets.
-    constexpr int kWidth = 96;
-    synthetic::SceneOptions o;
-    o.width = kWidth + 16;
-    o.height = 72;
-    o.sensor = synthetic::Sensor::kinect_v1;
-    const synthetic::Scene wide = synthetic::generate(o);
-    const Params params = sensor_preset(SensorKind::kinect_v1);
-    Outputs outputs;
-    outputs.segment_stats = true;
-    outputs.segment_tracks = true;
-    std::vector<Window> windows;
-    for (const int x0 : {0, 3, 7, 8}) windows.push_back(window_of(wide, x0, kWidth));
-    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
-    Segmenter segmenter = cuda::make_segmenter(kWidth, o.height, stream_, params, outputs);
-    const CloudView first{windows[0].points.data(), nullptr, kWidth, o.height};
-    EXPECT_EQ(segmenter.segment(first).tracks, cpu.segment(first).tracks);
+    const PanningStream stream = panning_stream({0, 3, 7, 8});
+    const std::vector<Window>& windows = stream.windows;
+    Segmenter cpu(PanningStream::kWidth, PanningStream::kHeight, stream.params, "cpu", stream.outputs);
+    Segmenter segmenter =
+        cuda::make_segmenter(PanningStream::kWidth, PanningStream::kHeight, stream_, stream.params, stream.outputs);
+    EXPECT_EQ(segmenter.segment(stream.cloud(0)).tracks, cpu.segment(stream.cloud(0)).tracks);
 
     const std::size_t bytes = 4 * windows[0].points.size();
     cuda::CloudPointers in;
@@ -238,24 +244,15 @@ TEST_F(CudaInterop, ACapturedFrameWithTracksRunsAsTheStreamsNextFrameEachTime) {
     out.statistics = device<std::uint32_t>(out.statistics_bytes);
     out.tracks_bytes = segmenter.device_tracks_bytes();
     out.tracks = device<std::uint32_t>(out.tracks_bytes);
-    ASSERT_EQ(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeGlobal), cudaSuccess);
-    try {
-        cuda::segment(segmenter, in, out);
-    } catch (const Error& e) {
-        cudaGraph_t abandoned = nullptr;
-        cudaStreamEndCapture(stream_, &abandoned);
-        if (abandoned != nullptr) cudaGraphDestroy(abandoned);
-        FAIL() << "cuda::segment refused to be captured: " << e.what();
-    }
-    cudaGraph_t graph = nullptr;
-    ASSERT_EQ(cudaStreamEndCapture(stream_, &graph), cudaSuccess) << "the frame invalidated the capture";
+    cudaGraph_t graph = capture([&] { cuda::segment(segmenter, in, out); });
+    ASSERT_NE(graph, nullptr);
     cudaGraphExec_t exec = nullptr;
     ASSERT_EQ(cudaGraphInstantiate(&exec, graph, 0), cudaSuccess);
     cudaGraphDestroy(graph);
     std::size_t matched = 0;
     for (std::size_t f = 1; f < windows.size(); ++f) {
         SCOPED_TRACE("launch " + std::to_string(f));
-        const Result expected = cpu.segment(CloudView{windows[f].points.data(), nullptr, kWidth, o.height});
+        const Result expected = cpu.segment(stream.cloud(f));
         upload(const_cast<float*>(in.points), windows[f].points.data(), bytes);
         ASSERT_EQ(cudaGraphLaunch(exec, stream_), cudaSuccess);
         ASSERT_EQ(cudaStreamSynchronize(stream_), cudaSuccess);
@@ -312,14 +309,9 @@ TEST_F(CudaInterop, ACapturedDepthFrameCarriesItsOwnRayTable) {
     out.labels_bytes = 4 * mm[0].size();
     out.count = device<std::uint32_t>(4);
 
-    cudaGraph_t graph = nullptr;
-    ASSERT_EQ(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeGlobal), cudaSuccess);
-    try {
-        cuda::segment(segmenter, in, out);  // the Segmenter's first frame: its ray table goes into the graph
-    } catch (const Error& e) {
-        ADD_FAILURE() << e.what();
-    }
-    ASSERT_EQ(cudaStreamEndCapture(stream_, &graph), cudaSuccess);
+    // The Segmenter's first frame: its ray table goes into the graph.
+    cudaGraph_t graph = capture([&] { cuda::segment(segmenter, in, out); });
+    ASSERT_NE(graph, nullptr);
     cudaGraphExec_t exec = nullptr;
     ASSERT_EQ(cudaGraphInstantiate(&exec, graph, 0), cudaSuccess);
     cudaGraphDestroy(graph);

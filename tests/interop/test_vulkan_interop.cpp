@@ -13,8 +13,6 @@
 
 #include "interop/vulkan_adapter.hpp"
 #include "pyrseg/backend.hpp"
-#include "pyrseg/presets.hpp"
-#include "pyrseg/synthetic.hpp"
 
 namespace pyrseg::test {
 namespace {
@@ -167,22 +165,12 @@ TEST_F(VulkanInterop, ASegmenterOnPyrsegsOwnDeviceIsRefused) {
 // decode_device_tracks gives the tracks the CPU's host stream of the same frames gets.
 TEST_F(VulkanInterop, ARecordedFrameWithTracksRunsAsTheStreamsNextFrameEachTime) {
     VulkanAdapter& vk = api();
-    constexpr int kWidth = 96;
-    synthetic::SceneOptions o;
-    o.width = kWidth + 16;
-    o.height = 72;
-    o.sensor = synthetic::Sensor::kinect_v1;
-    const synthetic::Scene wide = synthetic::generate(o);
-    const Params params = sensor_preset(SensorKind::kinect_v1);
-    Outputs outputs;
-    outputs.segment_stats = true;
-    outputs.segment_tracks = true;
-    std::vector<Window> windows;
-    for (const int x0 : {0, 3, 7, 8}) windows.push_back(window_of(wide, x0, kWidth));
-    Segmenter cpu(kWidth, o.height, params, "cpu", outputs);
-    Segmenter segmenter = vk.make_segmenter(kWidth, o.height, params, outputs);
-    const CloudView first{windows[0].points.data(), nullptr, kWidth, o.height};
-    EXPECT_EQ(segmenter.segment(first).tracks, cpu.segment(first).tracks);
+    const PanningStream stream = panning_stream({0, 3, 7, 8});
+    const std::vector<Window>& windows = stream.windows;
+    Segmenter cpu(PanningStream::kWidth, PanningStream::kHeight, stream.params, "cpu", stream.outputs);
+    Segmenter segmenter =
+        vk.make_segmenter(PanningStream::kWidth, PanningStream::kHeight, stream.params, stream.outputs);
+    EXPECT_EQ(segmenter.segment(stream.cloud(0)).tracks, cpu.segment(stream.cloud(0)).tracks);
     const std::size_t point_bytes = 4 * windows[0].points.size();
     const CloudFrame in{{vk.allocate(point_bytes), 0}, {}, 0};
     LabelFrame out;
@@ -205,7 +193,7 @@ TEST_F(VulkanInterop, ARecordedFrameWithTracksRunsAsTheStreamsNextFrameEachTime)
     std::size_t matched = 0;
     for (std::size_t f = 1; f < windows.size(); ++f) {
         SCOPED_TRACE("run " + std::to_string(f));
-        const Result expected = cpu.segment(CloudView{windows[f].points.data(), nullptr, kWidth, o.height});
+        const Result expected = cpu.segment(stream.cloud(f));
         vk.upload(in.points.buffer, 0, windows[f].points.data(), point_bytes);
         auto info = VkSubmitInfo{};
         info.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
