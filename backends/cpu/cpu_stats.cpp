@@ -1,6 +1,6 @@
 // The per-segment statistics pass (docs/algorithm.md section 10) on the CPU: rows in parallel, each stretch of equal
-// labels summed in native 64-bit and 128-bit integers (whole vectors of it by the target's stats_sums) and added
-// to its slot's words at once, with the shared
+// labels summed in native 64-bit and 128-bit integers (by the target's stats_sums in vectors, its pixels that are
+// not fillable masked out, whatever the points' layout) and added to its slot's words at once, with the shared
 // dialect's word arithmetic (shaders/pyr_stats.h: pyr_stats_flush), so the words are those of every other backend.
 // Sums of integers do not depend on how they are grouped, so summing a stretch in wide native integers instead of
 // the shader's 32-bit words changes nothing but the time. PYRSEG_CPU_SIMD=scalar runs the shared row function
@@ -45,16 +45,17 @@ struct Stretch {
     uint32_t slot = 0xffffffffu;
     uint32_t raw = 0;
     uint32_t count = 0;
-    uint32_t fillable = 0;
     uint32_t x_min = 0;
     uint32_t x_max = 0;
     simd::StatsSums sums;
 };
 
-// Pixels [x_begin, x_end) of row y, one at a time, into s.
-void add_pixels(const PassContext& c, uint32_t width, uint32_t y, uint32_t x_begin, uint32_t x_end, float scale,
-                simd::StatsSums& s) {
+// The fillable pixels of [x_begin, x_end) of row y (mask: the row's mask bytes), one at a time, into s.
+void add_pixels(const PassContext& c, uint32_t width, uint32_t y, const std::uint8_t* mask, uint32_t x_begin,
+                uint32_t x_end, float scale, simd::StatsSums& s) {
     for (uint32_t x = x_begin; x < x_end; ++x) {
+        if ((mask[x] & PYR_MASK_FILLABLE) == 0u) continue;
+        ++s.fillable;
         const float* p = c.points + size_t(y) * c.row_floats + size_t(x) * c.point_floats;
         const std::int64_t q[3] = {fixed(p[0], scale), fixed(p[1], scale), fixed(p[2], scale)};
         const size_t pixel_index = size_t(y) * width + x;
@@ -72,20 +73,20 @@ void add_pixels(const PassContext& c, uint32_t width, uint32_t y, uint32_t x_beg
     }
 }
 
-// Pixels [x_begin, x_end) of row y: whole vectors where the target has them, the rest one at a time.
-void add_stretch(const PassContext& c, const simd::VectorRows* rows, uint32_t width, uint32_t y, uint32_t x_begin,
-                 uint32_t x_end, float scale, simd::StatsSums& s) {
+// The fillable pixels of [x_begin, x_end) of row y: in vectors where the target has them, else one at a time.
+void add_stretch(const PassContext& c, const simd::VectorRows* rows, uint32_t width, uint32_t y,
+                 const std::uint8_t* mask, uint32_t x_begin, uint32_t x_end, float scale, simd::StatsSums& s) {
     uint32_t x = x_begin;
-    while (x < x_end && rows != nullptr && c.point_floats == 3) {
-        x += rows->stats_sums(c.points + size_t(y) * c.row_floats + size_t(x) * 3, 3,
-                              c.quant + kQuantWords * (size_t(y) * width + x), x_end - x, scale, s);
+    while (x < x_end && rows != nullptr) {
+        x += rows->stats_sums(c.points + size_t(y) * c.row_floats + size_t(x) * c.point_floats, c.point_floats,
+                              c.quant + kQuantWords * (size_t(y) * width + x), mask + x, x_end - x, scale, s);
         if (x == x_end) return;
-        // A vector with a coordinate of 2^26 or more, or the last partial one: pixel by pixel.
+        // A vector with a coordinate of 2^26 or more: pixel by pixel.
         const uint32_t next = std::min(x_end, x + 16u);
-        add_pixels(c, width, y, x, next, scale, s);
+        add_pixels(c, width, y, mask, x, next, scale, s);
         x = next;
     }
-    add_pixels(c, width, y, x, x_end, scale, s);
+    add_pixels(c, width, y, mask, x, x_end, scale, s);
 }
 
 pixel::PyrSum64 sum64(std::int64_t v) {
@@ -105,7 +106,7 @@ pixel::PyrSum96 sum96(Int128 v) {
 void flush(const PassContext& c, const Stretch& s, uint32_t y, uint32_t with_points) {
     pixel::PyrStatsRun r = pixel::pyr_stats_run_start(s.slot, s.raw, s.x_min);
     r.count = s.count;
-    r.fillable = s.fillable;
+    r.fillable = uint32_t(s.sums.fillable);
     r.x_max = s.x_max;
     if (with_points != 0u) {
         r.px = sum64(s.sums.point[0]);
@@ -159,18 +160,8 @@ void stats_row(const PassContext& c, const simd::VectorRows* rows, const PyrLeve
             s.x_max = end - 1;
             if (with_points != 0u) {
                 // The geometry's sums run over the fillable pixels only.
-                const std::uint8_t* mask = c.mask + full.offset + size_t(y) * full.width;
-                for (uint32_t a = x; a < end;) {
-                    if ((mask[a] & PYR_MASK_FILLABLE) == 0u) {
-                        ++a;
-                        continue;
-                    }
-                    uint32_t b = a + 1;
-                    while (b < end && (mask[b] & PYR_MASK_FILLABLE) != 0u) ++b;
-                    s.fillable += b - a;
-                    add_stretch(c, rows, full.width, y, a, b, scale, s.sums);
-                    a = b;
-                }
+                add_stretch(c, rows, full.width, y, c.mask + full.offset + size_t(y) * full.width, x, end, scale,
+                            s.sums);
             }
             last = k;
         }

@@ -74,11 +74,12 @@ struct RobustWindowRow {
     const std::int32_t* max = nullptr;
 };
 
-// A stretch of pixels' sums for the statistics (shaders/pyr_stats.h, backends/cpu/cpu_stats.cpp), exact: the
-// fixed-point coordinates q, the quantized normals, the least and greatest q_z, and the six products of q's
-// components (xx, xy, xz, yy, yz, zz).
+// A stretch of pixels' sums for the statistics (shaders/pyr_stats.h, backends/cpu/cpu_stats.cpp), exact, over its
+// fillable pixels: how many, the fixed-point coordinates q, the quantized normals, the least and greatest q_z, and
+// the six products of q's components (xx, xy, xz, yy, yz, zz).
 __extension__ typedef __int128 StatsInt128;
 struct StatsSums {
+    std::uint64_t fillable = 0;
     std::int64_t point[3] = {0, 0, 0};
     std::int64_t normal[3] = {0, 0, 0};
     std::int32_t z_min = 2147483647;
@@ -201,13 +202,14 @@ struct VectorRows {
     void (*edge_row_from_candidates)(const std::uint32_t* above, const std::uint32_t* row, const std::uint32_t* below,
                                      const std::uint8_t* mask, const std::uint8_t* valid, std::uint32_t* labels,
                                      std::uint32_t w) = nullptr;
-    // The statistics' sums (StatsSums) over `count` pixels from the point at `points` (each `stride` floats after the
-    // one before) and their quant words (kQuantWords a pixel), added to `sums` in whole vectors while every
-    // fixed-point coordinate stays below 2^26 in magnitude (then no 64-bit lane can overflow). Returns the pixels
-    // summed: fewer than `count` at a vector with a larger coordinate or at the last partial vector, which the caller
-    // sums another way.
+    // The statistics' sums (StatsSums) over the fillable pixels (PYR_MASK_FILLABLE in their `mask` byte) of `count`
+    // pixels from the point at `points` (each `stride` floats after the one before; only its three floats are read)
+    // and their quant words (kQuantWords a pixel), added to `sums` a vector at a time (the last one partial) while
+    // every fixed-point coordinate of a fillable pixel stays below 2^26 in magnitude (then no 64-bit lane can
+    // overflow). Returns the pixels summed: fewer than `count` at a vector with a larger coordinate, from which the
+    // caller sums another way.
     std::uint32_t (*stats_sums)(const float* points, std::size_t stride, const std::uint32_t* quant,
-                                std::uint32_t count, float scale, StatsSums& sums) = nullptr;
+                                const std::uint8_t* mask, std::uint32_t count, float scale, StatsSums& sums) = nullptr;
 };
 
 // The targets of this build that this CPU runs, best first.
