@@ -46,7 +46,8 @@ void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, cons
         return s.x_min <= 0 || s.y_min <= 0 || s.x_max >= width - 1 || s.y_max >= height - 1;
     };
 
-    // Step 1: by overlap, greedily: the pairs sharing at least an eighth of the smaller, the largest first.
+    // Step 1: by overlap, greedily: the pairs sharing at least an eighth of the smaller, the largest overlap times
+    // its track's age (up to 32 frames) first.
     pairs_.clear();
     for (std::uint32_t i = 0; i < pair_count; ++i) {
         const std::uint32_t* w = pairs + std::size_t(PYR_TRACK_SLOT_WORDS) * i;
@@ -55,16 +56,19 @@ void TrackState::next(const std::uint32_t* pairs, std::uint32_t pair_count, cons
         if (pair.previous == 0 || pair.previous > previous_count || pair.label == 0 || pair.label > count) continue;
         if (by_previous_[pair.previous] == 0) continue;
         const std::uint32_t smaller = std::min(segments[pair.label - 1].pixel_count, previous_size_[pair.previous]);
-        if (8 * std::uint64_t(pair.pixels) >= smaller) pairs_.push_back(pair);
+        if (8 * std::uint64_t(pair.pixels) < smaller) continue;
+        const std::uint32_t age = tracks_[by_previous_[pair.previous] - 1].age;
+        pairs_.push_back({pair, std::uint64_t(pair.pixels) * std::min(age, kMaxAgeWeight)});
     }
-    std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) {
+    std::sort(pairs_.begin(), pairs_.end(), [](const WeightedPair& a, const WeightedPair& b) {
+        if (a.weight != b.weight) return a.weight > b.weight;
         if (a.pixels != b.pixels) return a.pixels > b.pixels;
         return a.previous != b.previous ? a.previous < b.previous : a.label < b.label;
     });
     matched_.assign(count + 1, 0);
     overlap_.assign(count + 1, 0);
     track_taken_.assign(tracks_.size(), 0);
-    for (const Pair& pair : pairs_) {
+    for (const WeightedPair& pair : pairs_) {
         const std::uint32_t track = by_previous_[pair.previous] - 1;
         if (matched_[pair.label] != 0 || track_taken_[track] != 0) continue;
         matched_[pair.label] = track + 1;

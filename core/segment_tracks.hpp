@@ -26,6 +26,11 @@ public:
     struct Pair {
         std::uint32_t previous = 0, label = 0, pixels = 0;
     };
+    struct WeightedPair : Pair {  // step 1's order: pixels times the track's age, at most kMaxAgeWeight
+        std::uint64_t weight = 0;
+    };
+    // The most frames of a track's age that weigh in step 1 (docs/algorithm.md section 11).
+    static constexpr std::uint32_t kMaxAgeWeight = 32;
     struct Track {
         std::uint32_t id = 0;
         std::uint32_t first_frame = 0;
@@ -49,7 +54,7 @@ private:
     std::vector<std::uint32_t> by_previous_;    // previous label j -> index in tracks_ + 1
     std::vector<std::uint32_t> previous_size_;  // previous label j -> its pixel count
     // Per frame, sized to the largest frame so far.
-    std::vector<Pair> pairs_;             // step 1's pairs, in the order it takes them
+    std::vector<WeightedPair> pairs_;     // step 1's pairs, in the order it takes them
     std::vector<std::uint32_t> matched_;  // label k -> index in tracks_ + 1 (0: not matched yet)
     std::vector<std::uint32_t> overlap_;  // label k -> the pixels it shares with the track it matched in step 1
     std::vector<std::uint8_t> track_taken_;

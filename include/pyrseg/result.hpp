@@ -81,7 +81,7 @@ struct SegmentEdge {
 // How a segment got its track id (docs/algorithm.md section 11).
 enum class TrackMatch : std::uint8_t {
     new_track,  // a new id: it matched no track
-    overlap,    // the previous frame's segment it overlaps most, and that overlaps it most
+    overlap,    // a previous frame's segment it shares pixels with (greedily, by the pixels times the track's age)
     position,   // a track not matched by overlap (hidden, or not overlapping) found where the camera's motion put it
 };
 

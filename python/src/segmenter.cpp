@@ -729,8 +729,9 @@ void bind_segmenter(py::module_& m) {
     const py::object track_match =
         py::module_::import("enum").attr("IntEnum")("TrackMatch", matches, py::arg("module") = module_name);
     track_match.attr("__doc__") =
-        "How a segment got its track id (segment_track_dtype's how): new_track (it matched no track), overlap (the "
-        "previous frame's segment it overlaps most, and that overlaps it most), position (a track not matched by "
+        "How a segment got its track id (segment_track_dtype's how): new_track (it matched no track), overlap (a "
+        "previous frame's segment it shares pixels with, taken greedily by the pixels times the track's age), "
+        "position (a track not matched by "
         "overlap, found where the camera's motion put it) (docs/algorithm.md section 11).";
     m.attr("TrackMatch") = track_match;
     cached.result_type = keep(namedtuple("Result",

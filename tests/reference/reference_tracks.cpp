@@ -117,26 +117,29 @@ std::vector<Track> Tracker::next(const std::vector<std::uint32_t>& labels, int w
         }
     }
 
-    // Step 1, by overlap: a greedy assignment. The pairs with 8 m(j, k) >= min(n_k, n'_j) (n'_j the pixel count of
-    // the track seen as j), in decreasing m, then increasing j, then increasing k; a pair whose j and k are both
-    // still unmatched matches. Only the pairs with a count are listed (a pair with m = 0 shares nothing).
-    std::vector<std::tuple<std::uint64_t, std::uint32_t, std::uint32_t>> overlap_pairs;  // (m, j, k)
+    // Step 1, by overlap weighted by age: a greedy assignment. The pairs with 8 m(j, k) >= min(n_k, n'_j) (n'_j the
+    // pixel count of the track seen as j), in decreasing w = m(j, k) * min(a_j, 32) (a_j that track's age before
+    // this frame), then decreasing m, then increasing j, then increasing k; a pair whose j and k are both still
+    // unmatched matches. Only the pairs with a count are listed (a pair with m = 0 shares nothing).
+    std::vector<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t, std::uint32_t>> overlap_pairs;  // (w, m, j, k)
     for (const auto& [jk, count] : m) {
         const auto [j, k] = jk;
-        const std::uint32_t id = id_of_label.at(j);
-        const std::uint64_t smaller = std::min<std::uint64_t>(n[k], tracks_.at(id).pixel_count);
-        if (8 * count >= smaller) overlap_pairs.emplace_back(count, j, k);
+        const State& track = tracks_.at(id_of_label.at(j));
+        const std::uint64_t smaller = std::min<std::uint64_t>(n[k], track.pixel_count);
+        const std::uint64_t weight = count * std::min<std::uint64_t>(track.age, 32);
+        if (8 * count >= smaller) overlap_pairs.emplace_back(weight, count, j, k);
     }
     std::sort(overlap_pairs.begin(), overlap_pairs.end(), [](const auto& a, const auto& b) {
         if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) > std::get<0>(b);
-        if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
-        return std::get<2>(a) < std::get<2>(b);
+        if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) > std::get<1>(b);
+        if (std::get<2>(a) != std::get<2>(b)) return std::get<2>(a) < std::get<2>(b);
+        return std::get<3>(a) < std::get<3>(b);
     });
     std::vector<std::uint32_t> id_of(K + 1, 0);  // k -> its track's id, 0 while unmatched
     std::vector<TrackMatch> how(K + 1, TrackMatch::new_track);
     std::vector<std::uint64_t> overlap_of(K + 1, 0);  // m(j, k) of k's step-1 pair
     std::set<std::uint32_t> matched_ids;
-    for (const auto& [count, j, k] : overlap_pairs) {
+    for (const auto& [weight, count, j, k] : overlap_pairs) {
         const std::uint32_t id = id_of_label.at(j);
         if (how[k] != TrackMatch::new_track || matched_ids.count(id) != 0) continue;
         id_of[k] = id;

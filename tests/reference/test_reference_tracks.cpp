@@ -669,6 +669,48 @@ TEST(ReferenceTracks, OverlapTieDecidesTheRestOfTheChain) {
     EXPECT_EQ(hows(r), "on");
 }
 
+TEST(ReferenceTracks, OverlapIsWeighedByTheTracksAge) {
+    // Track 1 (rows 0 and 1) is seen in frames 0 to 2, then splits: row 0 keeps id 1 (age 4), row 1 is new (id 2, age
+    // 1; D = 1, so step 3 finds nothing). In frame 4 one segment holds 5 pixels of row 0 and all of row 1: m(1, 1) =
+    // 5, m(2, 1) = 12, both at least an eighth of the smaller (12). Weighed by age, 5 * 4 = 20 > 12 * 1 = 12: it is
+    // track 1 again, and track 2 is hidden. (By overlap alone it would be 2.)
+    Tracker tr(params(1.0));
+    const std::vector<std::string> whole = {"111111111111", "111111111111", "............", "............",
+                                            "............", "............", "............", "............"};
+    for (int f = 0; f < 3; ++f) next(tr, picture(whole, {{1, {0, 0, 1000}}}));
+    std::vector<Track> r = next(tr, picture({"111111111111", "222222222222", "............", "............",
+                                             "............", "............", "............", "............"},
+                                            {{1, {0, 0, 1000}}, {2, {0, 100, 1000}}}));
+    EXPECT_EQ(ids(r), (Ids{1, 2}));
+    EXPECT_EQ(ages(r), (Ids{4, 1}));
+    r = next(tr, picture({"11111.......", "111111111111", "............", "............", "............",
+                          "............", "............", "............"},
+                         {{1, {0, 0, 1000}}}));
+    EXPECT_EQ(ids(r), (Ids{1}));
+    EXPECT_EQ(hows(r), "o");
+    EXPECT_EQ(ages(r), (Ids{5}));
+}
+
+TEST(ReferenceTracks, AgesAbove32WeighAs32) {
+    // Track 1 (8 pixels) is seen in frames 0 to 40, track 2 (rows 2 to 4) from frame 40. In frame 41 one segment holds
+    // 1 pixel of track 1 (8 * 1 >= min(34, 8)) and 33 of track 2: 1 * min(41, 32) = 32 < 33 * 1, so it is track 2.
+    // (An uncapped age, 41, would make it track 1.)
+    Tracker tr(params(1.0));
+    const std::vector<std::string> small = {"11111111....", "............", "............", "............",
+                                            "............", "............", "............", "............"};
+    for (int f = 0; f < 40; ++f) next(tr, picture(small, {{1, {0, 0, 1000}}}));
+    std::vector<Track> r = next(tr, picture({"11111111....", "............", "222222222222", "222222222222",
+                                             "222222222222", "............", "............", "............"},
+                                            {{1, {0, 0, 1000}}, {2, {0, 100, 1000}}}));
+    EXPECT_EQ(ids(r), (Ids{1, 2}));
+    EXPECT_EQ(ages(r), (Ids{41, 1}));
+    r = next(tr, picture({"1...........", "............", "111111111111", "111111111111", "111111111...",
+                          "............", "............", "............"},
+                         {{1, {0, 0, 1000}}}));
+    EXPECT_EQ(ids(r), (Ids{2}));
+    EXPECT_EQ(hows(r), "o");
+}
+
 TEST(ReferenceTracks, NearestOnlyAmongTracksOfCloseSize) {
     // Track 1: 3 pixels at x = 0 (10 away, but 16 > 4 * 3); track 2: 16 pixels at x = 30 (20 away).
     Tracker tr(TrackParams{});
