@@ -26,7 +26,7 @@ public:
     struct Pair {
         std::uint32_t previous = 0, label = 0, pixels = 0;
     };
-    struct WeightedPair : Pair {  // step 1's order: pixels times the track's age, at most kMaxAgeWeight
+    struct WeightedPair : Pair {  // step 1's order: pixels times the track's age, the age capped at kMaxAgeWeight
         std::uint64_t weight = 0;
     };
     // The most frames of a track's age that weigh in step 1 (docs/algorithm.md section 11).
