@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "backends/cpu/cpu_dialect.hpp"
@@ -46,10 +47,17 @@ private:
         std::vector<std::int32_t> ints;  // the window's integer arrays, then the point rows' validity
         std::vector<float> floats;       // the window's depths, then the point rows' components
         simd::QuantRow window[3];        // row y in window[y % 3]
+        // The row each window row holds in this frame (kNoRow: none), and whether its outputs were written: a chunk
+        // that starts where the same thread's last chunk ended takes the rows that chunk made instead of making
+        // them again.
+        std::uint32_t window_rows[3] = {};
+        bool window_written[3] = {};
         std::vector<simd::PointRow> points;
-        std::vector<std::uint32_t> point_rows;  // the row each of `points` holds (kNoRow: none)
+        std::vector<std::uint32_t> point_rows;  // the row each of `points` holds in this frame (kNoRow: none)
+        std::thread::id owner;                  // the thread that took it last
     };
-    // Each running chunk takes a free scratch; at most pool.size() run at once. Allocated on the first frame.
+    // Each running chunk takes a free scratch, the one its thread took last when it is free; at most pool.size()
+    // run at once. Allocated on the first frame.
     Scratch& acquire(std::size_t& slot);
     void release(std::size_t slot);
     void allocate(Scratch& s, std::uint32_t width, std::uint32_t normal_radius) const;
