@@ -36,7 +36,10 @@ size_t memory_needed(const core::Plan& plan, unsigned threads) {
            (plan.params.edge_rounds > 1 ? pixels * sizeof(std::uint32_t) + pixels / 8 + 8 * size_t(plan.height)
                                         : 0) +                                 // labels, bits
            PointsToMask::scratch_bytes(plan.width, plan.params.normal_radius,  // its rows, per thread
-                                       threads);
+                                       threads) +
+           (plan.params.metric == Metric::robust
+                ? RobustWindows::scratch_bytes(plan.width, std::uint32_t(plan.params.normal_window), threads)
+                : 0);  // the windows' rings, per thread
 }
 
 }  // namespace

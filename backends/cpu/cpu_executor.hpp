@@ -90,7 +90,8 @@ private:
 
     // cpu_front_end.cpp
     RobustTexelPlanes robust_planes();
-    [[nodiscard]] PyrIVec3 robust_normal(const PassContext& c, std::size_t x, std::size_t y) const;
+    [[nodiscard]] PyrIVec3 robust_normal(const PassContext& c, const simd::RobustWindowRow& sums, std::size_t x,
+                                         std::size_t y) const;
 
     // cpu_fills.cpp
     bool sweep(const PyrLevel& lv, bool once, bool init_rows_first = false);

@@ -43,33 +43,36 @@ void CpuExecutor::estimate_normals() {
                 }
             });
         }
-        windows_.build(c.robust_texels, w, size_t(h), window, simd_,
-                       [&](size_t n, const auto& body) { rows(n, body); });
-        if (simd_ != nullptr) {
-            // The vector rows take the windows inside the image's columns; the others are the scalar code's.
-            const size_t words = (w + 63) / 64;
-            if (robust_rest_.size() < size_t(h) * words) robust_rest_.resize(size_t(h) * words);  // once
-            rows(size_t(h), [&](size_t y) {
-                std::uint64_t* rest = robust_rest_.data() + y * words;
-                simd_->robust_normals_row(c, windows_.row(y), uint32_t(w), h, uint32_t(y), window,
-                                          normals_.data() + 3 * y * w, rest);
-                for (size_t i = 0; i < words; ++i) {
-                    for (std::uint64_t bits = rest[i]; bits != 0; bits &= bits - 1) {
-                        const size_t x = i * 64 + size_t(std::countr_zero(bits));
-                        store_normal_q(robust_normal(c, x, y), normals_.data() + 3 * (y * w + x));
-                    }
-                }
-                // Step 0's quantize of the row while its normals are in cache (quantize() then has nothing to do):
-                // reading them back from memory made it the pass that scaled worst with threads.
-                simd_->quantize_row(point(0, y), layout_.point_floats, normals_.data() + 3 * y * w, 3, uint32_t(w),
-                                    quant_.data() + kQuantWords * y * w);
-            });
-            normals_estimated_ = true;
-            quantized_with_normals_ = true;
-            return;
-        }
+        // The vector rows take the windows inside the image's columns; the others are the scalar code's.
+        const size_t words = (w + 63) / 64;
+        if (simd_ != nullptr && robust_rest_.size() < size_t(h) * words) robust_rest_.resize(size_t(h) * words);
+        windows_.run(pool_, c.robust_texels, w, size_t(h), window, simd_,
+                     [&](size_t y, const simd::RobustWindowRow& sums) {
+                         float* normals = normals_.data() + 3 * y * w;
+                         if (simd_ == nullptr) {
+                             for (size_t x = 0; x < w; ++x) {
+                                 store_normal_q(robust_normal(c, sums, x, y), normals + 3 * x);
+                             }
+                             return;
+                         }
+                         std::uint64_t* rest = robust_rest_.data() + y * words;
+                         simd_->robust_normals_row(c, sums, uint32_t(w), h, uint32_t(y), window, normals, rest);
+                         for (size_t i = 0; i < words; ++i) {
+                             for (std::uint64_t bits = rest[i]; bits != 0; bits &= bits - 1) {
+                                 const size_t x = i * 64 + size_t(std::countr_zero(bits));
+                                 store_normal_q(robust_normal(c, sums, x, y), normals + 3 * x);
+                             }
+                         }
+                         // Step 0's quantize of the row while its normals are in cache (quantize() then has nothing
+                         // to do): reading them back from memory made it the pass that scaled worst with threads.
+                         simd_->quantize_row(point(0, y), layout_.point_floats, normals, 3, uint32_t(w),
+                                             quant_.data() + kQuantWords * y * w);
+                     });
+        normals_estimated_ = true;
+        quantized_with_normals_ = simd_ != nullptr;
+        return;
     }
-    if (!robust && simd_ != nullptr) {
+    if (simd_ != nullptr) {
         rows(size_t(plan_.height), [&](size_t y) {
             simd_->normals_row(c, uint32_t(w), h, uint32_t(y), radius, normals_.data() + 3 * y * w);
         });
@@ -78,9 +81,8 @@ void CpuExecutor::estimate_normals() {
     }
     rows(size_t(plan_.height), [&](size_t y) {
         for (size_t x = 0; x < w; ++x) {
-            const PyrIVec3 q = robust ? robust_normal(c, x, y)
-                                      : pixel::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius);
-            store_normal_q(q, normals_.data() + 3 * (y * w + x));
+            store_normal_q(pixel::pyr_normal_q(c, uint32_t(w), h, uint32_t(x), uint32_t(y), radius),
+                           normals_.data() + 3 * (y * w + x));
         }
     });
     normals_estimated_ = true;
@@ -223,17 +225,17 @@ RobustTexelPlanes CpuExecutor::robust_planes() {
     return planes;
 }
 
-// Section 8b's normal of pixel (x, y): from the box sums when its whole window is members, else the window
-// pixel by pixel (the shared function); the same words either way (backends/cpu/robust_windows.hpp).
-PyrIVec3 CpuExecutor::robust_normal(const PassContext& c, size_t x, size_t y) const {
+// Section 8b's normal of pixel (x, y) (row y's windows: sums): from the box sums when its whole window is members, else
+// the window pixel by pixel (the shared function); the same words either way (backends/cpu/robust_windows.hpp).
+PyrIVec3 CpuExecutor::robust_normal(const PassContext& c, const simd::RobustWindowRow& sums, size_t x, size_t y) const {
     const float scale = plan_.thresholds.point_scale;
     const float* p = point(x, y);
     if (pixel::pyr_point_valid(p[0], p[1], p[2]) != 0u) {
         const std::int32_t zi = pixel::pyr_robust_fixed(p[2], scale);
-        if (windows_.all_members(x, y, zi, zi >> 4)) {
+        if (RobustWindows::all_members(sums, x, zi, zi >> 4)) {
             PyrIVec3 u{};
             PyrIVec3 v{};
-            windows_.sums(x, y, u, v);
+            windows_.sums(sums, x, u, v);
             return pixel::pyr_robust_normal_from_sums(u, v, p[0], p[1], p[2]);
         }
     }

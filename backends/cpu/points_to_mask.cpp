@@ -85,50 +85,17 @@ void PointsToMask::allocate(Scratch& s, uint32_t width, uint32_t normal_radius) 
     s.point_rows.assign(slots, kNoRow);
 }
 
-PointsToMask::Scratch& PointsToMask::acquire(size_t& slot) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    const std::thread::id self = std::this_thread::get_id();
-    slot = busy_.size();
-    for (size_t i = 0; i < busy_.size(); ++i) {
-        if (busy_[i]) continue;
-        if (slot == busy_.size()) slot = i;  // a free one exists: no more than pool.size() chunks run at once
-        if (scratch_[i].owner == self) {
-            slot = i;
-            break;
-        }
-    }
-    busy_[slot] = true;
-    scratch_[slot].owner = self;
-    return scratch_[slot];
-}
-
-void PointsToMask::release(size_t slot) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    busy_[slot] = false;
-}
-
 void PointsToMask::run(ThreadPool& pool, const simd::VectorRows& vector_rows, const PointsToMaskFrame& frame) {
     const size_t threads = pool.size();
-    if (scratch_.size() < threads) {  // the first frame, or a caller's arena with more threads than before
-        // Made whole before it is kept: an allocation failing half-way (out_of_memory) must not leave scratch_ sized
-        // and busy_ empty for the next frame to index.
-        std::vector<Scratch> scratch(threads);
-        for (Scratch& s : scratch) allocate(s, frame.width, frame.normal_radius);
-        std::vector<bool> busy(threads, false);
-        scratch_ = std::move(scratch);
-        busy_ = std::move(busy);
-    }
-    for (Scratch& s : scratch_) {  // rows of the last frame
+    scratch_.reserve(threads, [&](Scratch& s) { allocate(s, frame.width, frame.normal_radius); });
+    scratch_.for_each([](Scratch& s) {  // rows of the last frame
         std::fill(std::begin(s.window_rows), std::end(s.window_rows), kNoRow);
         std::fill(s.point_rows.begin(), s.point_rows.end(), kNoRow);
-    }
+    });
     const size_t rows = frame.height;
     const size_t grain = std::max<size_t>(1, (rows + threads * kChunksPerThread - 1) / (threads * kChunksPerThread));
     pool.parallel_for(rows, grain, [&](size_t y0, size_t y1) {
-        size_t slot = 0;
-        Scratch& s = acquire(slot);
-        run_rows(vector_rows, frame, uint32_t(y0), uint32_t(y1), s);
-        release(slot);
+        scratch_.with([&](Scratch& s) { run_rows(vector_rows, frame, uint32_t(y0), uint32_t(y1), s); });
     });
 }
 

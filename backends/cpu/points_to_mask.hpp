@@ -10,13 +10,12 @@
 // functions are the vector rows of backends/cpu/simd: the bytes are those of the separate passes.
 #include <cstddef>
 #include <cstdint>
-#include <mutex>
-#include <thread>
 #include <vector>
 
 #include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
 #include "backends/cpu/thread_pool.hpp"
+#include "backends/cpu/thread_scratch.hpp"
 
 namespace pyrseg::cpu {
 
@@ -54,19 +53,12 @@ private:
         bool window_written[3] = {};
         std::vector<simd::PointRow> points;
         std::vector<std::uint32_t> point_rows;  // the row each of `points` holds in this frame (kNoRow: none)
-        std::thread::id owner;                  // the thread that took it last
     };
-    // Each running chunk takes a free scratch, the one its thread took last when it is free; at most pool.size()
-    // run at once. Allocated on the first frame.
-    Scratch& acquire(std::size_t& slot);
-    void release(std::size_t slot);
     void allocate(Scratch& s, std::uint32_t width, std::uint32_t normal_radius) const;
     void run_rows(const simd::VectorRows& vector_rows, const PointsToMaskFrame& f, std::uint32_t y0, std::uint32_t y1,
                   Scratch& s) const;
 
-    std::vector<Scratch> scratch_;
-    std::vector<bool> busy_;
-    std::mutex mutex_;
+    ThreadScratch<Scratch> scratch_;  // one per thread, allocated on the first frame
 };
 
 }  // namespace pyrseg::cpu

@@ -4,66 +4,80 @@
 // window's tangent sums are box sums, read from summed-area tables in O(1); elsewhere the caller sums the window
 // pixel by pixel. Integer sums in 32-bit two's complement: a box sum taken from the tables is exact whenever the
 // true sum fits int32, which section 8b guarantees, so both ways give the same words.
+//
+// The tables are never made for the whole frame: each thread keeps the 2 R + 2 rows of them (and the 2 R + 1 rows of
+// depth ranges) that the windows of its current row reach, in rings that stay in its L2 cache, summed from the first
+// row its band needs rather than from the image's top (a box sum is a difference of rows, the same whatever the
+// rows were summed from). Whole-frame tables moved about 170 bytes a pixel through memory; the rings read the
+// texels once.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
+#include "backends/cpu/thread_pool.hpp"
+#include "backends/cpu/thread_scratch.hpp"
 #include "shaders/pyr_types.h"
 
 namespace pyrseg::cpu {
 
 class RobustWindows {
 public:
-    // Tables for `texels` (W x H) and windows of radius `window`; `rows(n, fn)` runs fn(y) for y in [0, n), in
-    // parallel; `simd`: the vector rows to use, or null. Reuses its memory from frame to frame (nothing allocates
-    // once sized).
-    template <class Rows>
-    void build(const RobustTexelPlanes& texels, std::size_t width, std::size_t height, std::uint32_t window,
-               const simd::VectorRows* simd, const Rows& rows) {
-        size(width, height, window);
-        rows(height, [&](std::size_t y) { prefix_row(texels, y); });
-        rows(kComponents, [&](std::size_t k) { accumulate_columns(k); });
-        rows(height, [&](std::size_t y) {
-            if (simd != nullptr) {
-                simd->robust_range_row(texels.gz + y * width, std::uint32_t(width), window, row_min_.data() + y * width,
-                                       row_max_.data() + y * width);
-            } else {
-                row_range(texels, y);
-            }
+    // Calls body(y, windows) for every row y of the W x H `texels`, in parallel bands of rows on `pool`, with what
+    // the windows of radius `window` around row y's pixels read (simd::RobustWindowRow: box sums and depth ranges);
+    // `simd`: the vector rows for the depth ranges, or null. Allocates on the first frame only (or when a caller's
+    // arena has more threads than before).
+    template <class Body>
+    void run(ThreadPool& pool, const RobustTexelPlanes& texels, std::size_t width, std::size_t height,
+             std::uint32_t window, const simd::VectorRows* simd, const Body& body) {
+        prepare(pool.size(), width, height, window);
+        const std::size_t grain = std::max<std::size_t>(1, height / pool.pieces());
+        pool.parallel_for(height, grain, [&](std::size_t y0, std::size_t y1) {
+            bands_.with([&](Band& band) {
+                for (std::size_t y = y0; y < y1; ++y) body(y, advance(band, texels, simd, y));
+            });
         });
-        rows(height, [&](std::size_t y) { column_range(y); });
     }
 
-    // Whether every pixel of the window around (x, y) has |G(z) - zi| <= jump.
-    [[nodiscard]] bool all_members(std::size_t x, std::size_t y, std::int32_t zi, std::int32_t jump) const {
-        const std::size_t i = y * width_ + x;
-        return min_[i] >= zi - jump && max_[i] <= zi + jump;
+    // Whether every pixel of the window around pixel x of the row has |G(z) - zi| <= jump.
+    [[nodiscard]] static bool all_members(const simd::RobustWindowRow& row, std::size_t x, std::int32_t zi,
+                                          std::int32_t jump) {
+        return row.min[x] >= zi - jump && row.max[x] <= zi + jump;
     }
-    // The sums of t_h (u) and t_v (v) over the window around (x, y), clipped to the image.
-    void sums(std::size_t x, std::size_t y, PyrIVec3& u, PyrIVec3& v) const;
-    // What the vector rows read of the windows of row y (simd::RobustWindowRow).
-    [[nodiscard]] simd::RobustWindowRow row(std::size_t y) const;
+    // The sums of t_h (u) and t_v (v) over the window around pixel x of the row, clipped to the image.
+    void sums(const simd::RobustWindowRow& row, std::size_t x, PyrIVec3& u, PyrIVec3& v) const;
+
+    // Bytes run allocates for `threads` threads.
+    [[nodiscard]] static std::size_t scratch_bytes(std::size_t width, std::uint32_t window, std::size_t threads);
 
 private:
     static constexpr std::size_t kComponents = 6;  // t_h x y z, t_v x y z
 
-    void size(std::size_t width, std::size_t height, std::uint32_t window);
-    void prefix_row(const RobustTexelPlanes& texels, std::size_t y);  // row y's prefix sums
-    void accumulate_columns(std::size_t k);                           // then component k's down the columns
-    void row_range(const RobustTexelPlanes& texels, std::size_t y);   // G(z) range over each row window
-    void column_range(std::size_t y);                                 // then over each whole window
-    [[nodiscard]] const std::uint32_t* table_row(std::size_t k, std::size_t y) const {
-        return table_.data() + (k * (height_ + 1) + y) * (width_ + 1);
+    // One thread's rings. Table row j (the sums of the rows above j, from the band's first row on) in slot
+    // j % (2 R + 2); row j's depth ranges along the row in slot j % (2 R + 1).
+    struct Band {
+        std::vector<std::uint32_t> table;             // kComponents rings of (W + 1)-word rows
+        std::vector<std::int32_t> row_min, row_max;   // the ranges' rings
+        std::vector<std::int32_t> min, max;           // the current row's windows' ranges
+        std::size_t table_first = 0, table_last = 0;  // the table rows held
+        std::size_t range_first = 0, range_next = 0;  // the range rows held: range_first .. range_next - 1
+        bool empty = true;                            // nothing of this frame
+    };
+
+    void prepare(std::size_t threads, std::size_t width, std::size_t height, std::uint32_t window);
+    simd::RobustWindowRow advance(Band& band, const RobustTexelPlanes& texels, const simd::VectorRows* simd,
+                                  std::size_t y) const;
+    [[nodiscard]] std::size_t table_slots() const { return 2 * std::size_t(window_) + 2; }
+    [[nodiscard]] std::size_t range_slots() const { return 2 * std::size_t(window_) + 1; }
+    [[nodiscard]] static std::uint32_t* table_row(Band& band, std::size_t slots, std::size_t width, std::size_t k,
+                                                  std::size_t j) {
+        return band.table.data() + (k * slots + j % slots) * (width + 1);
     }
 
     std::size_t width_ = 0, height_ = 0;
     std::uint32_t window_ = 0;
-    // Per component a (W + 1) x (H + 1) table summed from the origin.
-    std::vector<std::uint32_t> table_;
-    std::vector<std::int32_t> row_min_, row_max_;  // G(z) over each row's window
-    std::vector<std::int32_t> min_, max_;          // G(z) over each whole window
+    ThreadScratch<Band> bands_;
 };
 
 }  // namespace pyrseg::cpu

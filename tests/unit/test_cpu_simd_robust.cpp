@@ -18,6 +18,7 @@
 #include "backends/cpu/cpu_dialect.hpp"
 #include "backends/cpu/robust_windows.hpp"
 #include "backends/cpu/simd/cpu_simd.hpp"
+#include "backends/cpu/thread_pool.hpp"
 #include "pyrseg/presets.hpp"
 #include "pyrseg/segmenter.hpp"
 #include "pyrseg/synthetic.hpp"
@@ -167,48 +168,50 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
                     }
                 }
                 cpu::RobustWindows windows;
-                windows.build(texels.planes, w, h, window, nullptr, [](std::size_t n, const auto& body) {
-                    for (std::size_t i = 0; i < n; ++i) body(i);
-                });
+                cpu::ThreadPool one_thread(cpu::ThreadSetting{1, nullptr});  // the rows in order: the counts are plain
                 const std::size_t words = (std::size_t(w) + 63) / 64;
                 std::vector<float> out(3 * std::size_t(w), 99.0f);
                 std::vector<std::uint64_t> rest(words, ~std::uint64_t{0});
-                for (std::uint32_t y = 0; y < h; ++y) {
-                    k.robust_normals_row(c, windows.row(y), w, h, y, window, out.data(), rest.data());
-                    for (std::uint32_t x = 0; x < w; ++x) {
-                        const float* p = cloud.floats.data() + std::size_t(y) * cloud.row_floats + x * pf;
-                        const bool valid = pixel::pyr_point_valid(p[0], p[1], p[2]) != 0u;
-                        const bool inside = x >= window && x + window < w;
-                        bool members = false;
-                        if (valid) {
-                            const std::int32_t zi = pixel::pyr_robust_fixed(p[2], scale);
-                            members = windows.all_members(x, y, zi, zi >> 4);
-                        }
-                        const bool was_left = ((rest[x / 64] >> (x % 64)) & 1u) != 0;
-                        const bool should_leave = !inside;
-                        // (Rows too narrow for a vector are left whole.)
-                        ASSERT_TRUE(was_left || !should_leave)
-                            << s.w << "x" << s.h << " window=" << window << " pixel " << x << "," << y;
-                        if (was_left) {
-                            ++left;
-                            continue;
-                        }
-                        const PyrIVec3 q = pixel::pyr_robust_normal_q(c, w, h, x, y, window, scale);
-                        const float e[3] = {float(q.x) * PYR_NORMAL_UNIT, float(q.y) * PYR_NORMAL_UNIT,
-                                            float(q.z) * PYR_NORMAL_UNIT};
-                        for (std::size_t i = 0; i < 3; ++i) {
-                            ASSERT_EQ(std::bit_cast<std::uint32_t>(out[3 * x + i]), std::bit_cast<std::uint32_t>(e[i]))
-                                << s.w << "x" << s.h << " window=" << window << " pf=" << pf << " pixel " << x << ","
-                                << y << " component " << i;
-                        }
-                        ++taken;
-                        across += valid && !members ? 1 : 0;
-                        defined += (q.x | q.y | q.z) != 0 ? 1 : 0;
-                    }
-                    for (std::size_t i = w; i < 64 * words; ++i) {
-                        ASSERT_EQ((rest[i / 64] >> (i % 64)) & 1u, 0u) << "a bit past the row";
-                    }
-                }
+                windows.run(one_thread, texels.planes, w, h, window, nullptr,
+                            [&](std::size_t row_y, const simd::RobustWindowRow& sums) {
+                                const auto y = std::uint32_t(row_y);
+                                k.robust_normals_row(c, sums, w, h, y, window, out.data(), rest.data());
+                                for (std::uint32_t x = 0; x < w; ++x) {
+                                    const float* p = cloud.floats.data() + std::size_t(y) * cloud.row_floats + x * pf;
+                                    const bool valid = pixel::pyr_point_valid(p[0], p[1], p[2]) != 0u;
+                                    const bool inside = x >= window && x + window < w;
+                                    bool members = false;
+                                    if (valid) {
+                                        const std::int32_t zi = pixel::pyr_robust_fixed(p[2], scale);
+                                        members = cpu::RobustWindows::all_members(sums, x, zi, zi >> 4);
+                                    }
+                                    const bool was_left = ((rest[x / 64] >> (x % 64)) & 1u) != 0;
+                                    const bool should_leave = !inside;
+                                    // (Rows too narrow for a vector are left whole.)
+                                    ASSERT_TRUE(was_left || !should_leave)
+                                        << s.w << "x" << s.h << " window=" << window << " pixel " << x << "," << y;
+                                    if (was_left) {
+                                        ++left;
+                                        continue;
+                                    }
+                                    const PyrIVec3 q = pixel::pyr_robust_normal_q(c, w, h, x, y, window, scale);
+                                    const float e[3] = {float(q.x) * PYR_NORMAL_UNIT, float(q.y) * PYR_NORMAL_UNIT,
+                                                        float(q.z) * PYR_NORMAL_UNIT};
+                                    for (std::size_t i = 0; i < 3; ++i) {
+                                        ASSERT_EQ(std::bit_cast<std::uint32_t>(out[3 * std::size_t(x) + i]),
+                                                  std::bit_cast<std::uint32_t>(e[i]))
+                                            << s.w << "x" << s.h << " window=" << window << " pf=" << pf << " pixel "
+                                            << x << "," << y << " component " << i;
+                                    }
+                                    ++taken;
+                                    across += valid && !members ? 1 : 0;
+                                    defined += (q.x | q.y | q.z) != 0 ? 1 : 0;
+                                }
+                                for (std::size_t i = w; i < 64 * words; ++i) {
+                                    ASSERT_EQ((rest[i / 64] >> (i % 64)) & 1u, 0u) << "a bit past the row";
+                                }
+                            });
+                if (HasFatalFailure()) return;
             }
         }
     }
@@ -217,6 +220,80 @@ TEST_P(CpuSimdRobustRows, NormalsMatchTheSharedFunction) {
     EXPECT_GT(defined, 2000u) << "too few normals compared to test much";
     EXPECT_GT(taken, 8000u) << "the vector rows must take a good share of the pixels for this to test much";
     EXPECT_GT(across, 2000u) << "too few windows summed pixel by pixel to test much";
+}
+
+// The windows' sums and depth ranges that RobustWindows hands each row, against sums and ranges taken pixel by pixel:
+// in bands of rows on three threads (the rings started at a band's first row, or going on from the thread's last
+// band), two frames in a row through the same windows (the second must not take the first's rows), sums that wrap.
+TEST_P(CpuSimdRobustRows, WindowsInBandsMatchSumsTakenPixelByPixel) {
+    const simd::VectorRows& k = rows_named(GetParam());
+    cpu::ThreadPool three_threads(cpu::ThreadSetting{3, nullptr});
+    std::mt19937 rng(97);
+    for (const Size s : {Size{37, 53}, Size{64, 200}, Size{5, 3}}) {
+        for (const std::uint32_t window : {1u, 3u, 6u}) {
+            const auto w = std::size_t(s.w);
+            const auto h = std::size_t(s.h);
+            cpu::RobustWindows windows;
+            for (int frame = 0; frame < 2; ++frame) {
+                Texels texels(w * h);
+                for (std::size_t i = 0; i < w * h; ++i) {
+                    texels.planes.gz[i] = std::int32_t(rng() % 100000);
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        texels.planes.th[c][i] = std::int32_t(rng());  // full range: the sums wrap
+                        texels.planes.tv[c][i] = std::int32_t(rng() % 2001) - 1000;
+                    }
+                }
+                // Each row is handed to one thread once: its results go to its own rows of these.
+                std::vector<std::int32_t> sums(6 * w * h, 0);
+                std::vector<std::int32_t> lo(w * h, 0);
+                std::vector<std::int32_t> hi(w * h, 0);
+                std::vector<int> visits(h, 0);
+                windows.run(three_threads, texels.planes, w, h, window, &k,
+                            [&](std::size_t y, const simd::RobustWindowRow& row) {
+                                ++visits[y];
+                                for (std::size_t x = 0; x < w; ++x) {
+                                    PyrIVec3 u{};
+                                    PyrIVec3 v{};
+                                    windows.sums(row, x, u, v);
+                                    const std::int32_t got[6] = {u.x, u.y, u.z, v.x, v.y, v.z};
+                                    std::copy_n(got, 6, sums.begin() + std::ptrdiff_t(6 * (y * w + x)));
+                                    lo[y * w + x] = row.min[x];
+                                    hi[y * w + x] = row.max[x];
+                                }
+                            });
+                for (std::size_t y = 0; y < h; ++y) {
+                    ASSERT_EQ(visits[y], 1) << "row " << y;
+                    const std::size_t y0 = y >= window ? y - window : 0;
+                    const std::size_t y1 = std::min(y + window, h - 1);
+                    for (std::size_t x = 0; x < w; ++x) {
+                        const std::size_t x0 = x >= window ? x - window : 0;
+                        const std::size_t x1 = std::min(x + window, w - 1);
+                        std::uint32_t e[6] = {};
+                        std::int32_t least = texels.planes.gz[y0 * w + x0];
+                        std::int32_t greatest = least;
+                        for (std::size_t j = y0; j <= y1; ++j) {
+                            for (std::size_t i = x0; i <= x1; ++i) {
+                                const std::size_t at = j * w + i;
+                                for (std::size_t c = 0; c < 3; ++c) {
+                                    e[c] += std::uint32_t(texels.planes.th[c][at]);
+                                    e[3 + c] += std::uint32_t(texels.planes.tv[c][at]);
+                                }
+                                least = std::min(least, texels.planes.gz[at]);
+                                greatest = std::max(greatest, texels.planes.gz[at]);
+                            }
+                        }
+                        for (std::size_t c = 0; c < 6; ++c) {
+                            ASSERT_EQ(sums[6 * (y * w + x) + c], std::int32_t(e[c]))
+                                << s.w << "x" << s.h << " window " << window << " frame " << frame << " pixel " << x
+                                << "," << y << " component " << c;
+                        }
+                        ASSERT_EQ(lo[y * w + x], least) << "pixel " << x << "," << y;
+                        ASSERT_EQ(hi[y * w + x], greatest) << "pixel " << x << "," << y;
+                    }
+                }
+            }
+        }
+    }
 }
 
 // The windows' depth range along a row, clipped at both ends, against the minimum and maximum written out.
