@@ -13,21 +13,14 @@ namespace pyrseg::cpu {
 using std::size_t;
 using std::uint32_t;
 
-constexpr size_t kMergeBlock = 4096;  // table words (or slots) a loop body clears (or links)
-
 void CpuExecutor::merge_segments() {
     const PyrLevel lv = plan_.full();
     const core::Thresholds& t = plan_.thresholds;
     const uint32_t labels = plan_.lut_size();
     const uint32_t slots = plan_.merge_slots;
     merge_words_.resize(size_t(labels) + size_t(PYR_MERGE_SLOT_WORDS) * slots);  // once per Segmenter
-    // The table is sized for the worst frame (2 MiB at 640x480): cleared, and its pairs linked, by all the threads,
-    // in blocks (serial, the two were a quarter of the merge's time with 2 threads at 640x480).
-    const size_t words = merge_words_.size();
-    rows((words + kMergeBlock - 1) / kMergeBlock, [&](size_t b) {
-        const size_t end = std::min(words, (b + 1) * kMergeBlock);
-        for (size_t i = b * kMergeBlock; i < end; ++i) merge_words_[i] = i < labels ? uint32_t(i) : 0u;
-    });
+    for (uint32_t l = 0; l < labels; ++l) merge_words_[l] = l;
+    std::fill(merge_words_.begin() + labels, merge_words_.end(), 0u);
     PassContext c = context();
     c.merge = merge_words_.data();
     const auto reach = uint32_t(plan_.params.merge_reach);
@@ -38,13 +31,7 @@ void CpuExecutor::merge_segments() {
         });
     });
     const auto min_crossings = uint32_t(plan_.params.merge_min_crossings);
-    // Concurrent unions (shaders/pyr_uf.h): each group's root is its smallest label whatever the order.
-    rows((size_t(slots) + kMergeBlock - 1) / kMergeBlock, [&](size_t b) {
-        const auto end = uint32_t(std::min(size_t(slots), (b + 1) * kMergeBlock));
-        for (auto s = uint32_t(b * kMergeBlock); s < end; ++s) {
-            pixel::pyr_merge_link(c, labels, s, min_crossings, t.merge_share);
-        }
-    });
+    for (uint32_t s = 0; s < slots; ++s) pixel::pyr_merge_link(c, labels, s, min_crossings, t.merge_share);
     // Parents are smaller labels, so in increasing order each parent is already its root.
     bool joined = false;
     for (uint32_t l = 0; l < labels; ++l) {
