@@ -158,8 +158,7 @@ private:
     std::uint32_t fill_rounds_ = 0;
     bool compacted_ = false;
     bool normals_estimated_ = false;
-    bool quantized_with_normals_ = false;  // this frame's robust normals pass quantized each row too
-    bool valid_bytes_ = false;             // mask_valid_ holds this frame's validity (points_to_mask wrote it)
+    bool valid_bytes_ = false;  // mask_valid_ holds this frame's validity (points_to_mask wrote it)
     bool from_mask_ = false;
 };
 

@@ -1,8 +1,6 @@
-// Points to the fillable mask: normals (when estimated), quantize and the metric (paper or robust) as separate passes
-// (the robust normals' vector rows quantize each row as they go), or the paper metric's three fused (points_to_mask,
-// backends/cpu/points_to_mask.hpp).
+// Points to the fillable mask: normals (when estimated), quantize and the metric (paper or robust) as separate passes,
+// or the paper metric's three fused (points_to_mask, backends/cpu/points_to_mask.hpp).
 #include <bit>
-#include <utility>
 
 #include "backends/cpu/cpu_executor.hpp"
 
@@ -63,13 +61,8 @@ void CpuExecutor::estimate_normals() {
                                  store_normal_q(robust_normal(c, sums, x, y), normals + 3 * x);
                              }
                          }
-                         // Step 0's quantize of the row while its normals are in cache (quantize() then has nothing
-                         // to do): reading them back from memory made it the pass that scaled worst with threads.
-                         simd_->quantize_row(point(0, y), layout_.point_floats, normals, 3, uint32_t(w),
-                                             quant_.data() + kQuantWords * y * w);
                      });
         normals_estimated_ = true;
-        quantized_with_normals_ = simd_ != nullptr;
         return;
     }
     if (simd_ != nullptr) {
@@ -89,7 +82,6 @@ void CpuExecutor::estimate_normals() {
 }
 
 void CpuExecutor::quantize() {
-    if (std::exchange(quantized_with_normals_, false)) return;
     const size_t w = size_t(plan_.width);
     if (simd_ != nullptr) {
         const size_t normal_floats = normals_estimated_ ? 3 : layout_.point_floats;

@@ -14,7 +14,6 @@ void CpuExecutor::bind_cloud(const CloudView& cloud) {
     cloud_ = cloud;
     layout_ = core::cloud_layout(cloud);
     normals_estimated_ = false;
-    quantized_with_normals_ = false;
     valid_bytes_ = false;
     from_mask_ = false;
 }
@@ -26,7 +25,6 @@ void CpuExecutor::bind_depth(const DepthView& depth, const core::DepthTables& ta
     depth_ = depth;
     depth_tables_ = &tables;
     normals_estimated_ = false;
-    quantized_with_normals_ = false;
     valid_bytes_ = false;
     from_mask_ = false;
 }
