@@ -4,9 +4,9 @@
 //       starts before the row and stops after it (quiet, busy1 .. busy<n-1>); METRIC paper (the defaults) or
 //       consumer (the realsense-d435 preset: robust metric and merge); INPUT cloud (points, normals estimated) or
 //       depth (uint16); SETTING shared (the default: the caller's oneTBB arena) or threads1 (the calling thread alone)
-//   cpu_segmenters/SIZE/N/SETTING              N Segmenters in N threads at once (frames/s: all of them together);
+//   cpu_segmenters/SIZE/METRIC/INPUT/N/SETTING N Segmenters in N threads at once (frames/s: all of them together);
 //       SETTING shared, threads1 or threads2 (an arena of 2 of its own per Segmenter)
-//   cpu_inside_tbb/SIZE/SETTING                a frame segmented from inside the application's tbb::parallel_for
+//   cpu_inside_tbb/SIZE/METRIC/INPUT/SETTING   a frame segmented from inside the application's tbb::parallel_for
 //       whose other iterations keep every other core busy until the frame is done
 // Run with repetitions and random interleaving, so that the settings share the machine's moods:
 //   pyrseg_bench --benchmark_filter='^cpu_' --benchmark_repetitions=7 --benchmark_enable_random_interleaving=true
@@ -98,18 +98,21 @@ void segment(Segmenter& segmenter, const Frame& f, Result& out) {
     }
 }
 
+Params params_of(bool consumer) {
+    return consumer ? sensor_preset(SensorKind::realsense_d435) : Params{};
+}
+
 void under_load(benchmark::State& state, int w, int h, bool consumer, bool depth, unsigned busy, Setting setting) {
     const Frame f = frame_of(w, h, depth);
-    const Params params = consumer ? sensor_preset(SensorKind::realsense_d435) : Params{};
-    Segmenter segmenter = make(setting, w, h, params);
+    Segmenter segmenter = make(setting, w, h, params_of(consumer));
     const Spinners load(busy);
     time_frames_on(state, segmenter, w, h, f.bytes, [&](Segmenter& s, Result& r) { segment(s, f, r); });
 }
 
 // Run by every one of the row's threads (Google Benchmark's ->Threads(N)): a Segmenter each.
-void segmenters(benchmark::State& state, int w, int h, Setting setting) {
-    const Frame f = frame_of(w, h, false);
-    Segmenter segmenter = make(setting, w, h, Params{});
+void segmenters(benchmark::State& state, int w, int h, bool consumer, bool depth, Setting setting) {
+    const Frame f = frame_of(w, h, depth);
+    Segmenter segmenter = make(setting, w, h, params_of(consumer));
     Result result;
     segment(segmenter, f, result);
     for (auto _ : state) {
@@ -122,9 +125,9 @@ void segmenters(benchmark::State& state, int w, int h, Setting setting) {
         benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kAvgThreads);
 }
 
-void inside_tbb(benchmark::State& state, int w, int h, Setting setting) {
-    const Frame f = frame_of(w, h, false);
-    Segmenter segmenter = make(setting, w, h, Params{});
+void inside_tbb(benchmark::State& state, int w, int h, bool consumer, bool depth, Setting setting) {
+    const Frame f = frame_of(w, h, depth);
+    Segmenter segmenter = make(setting, w, h, params_of(consumer));
     const int items = tbb::this_task_arena::max_concurrency();
     Result result;
     segment(segmenter, f, result);
@@ -148,6 +151,13 @@ void inside_tbb(benchmark::State& state, int w, int h, Setting setting) {
     }
 }
 
+template <class... Parts>
+std::string joined(const Parts&... parts) {
+    std::string out;
+    (out += ... += parts);
+    return out;
+}
+
 int register_all() {
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     for (const auto& size : {std::pair{640, 480}, std::pair{2064, 1544}}) {
@@ -156,26 +166,30 @@ int register_all() {
         const std::string px = size_name(w, h);
         for (const bool consumer : {false, true}) {
             for (const bool depth : {false, true}) {
+                const std::string kind = joined(consumer ? "/consumer" : "/paper", depth ? "/depth" : "/cloud");
                 for (unsigned busy = 0; busy < cores; ++busy) {
                     for (const Setting s : {Setting::shared, Setting::threads1}) {
-                        const std::string name =
-                            "cpu_load/" + px + (consumer ? "/consumer" : "/paper") + (depth ? "/depth" : "/cloud") +
-                            (busy == 0 ? "/quiet" : "/busy" + std::to_string(busy)) + "/" + setting_name(s);
+                        const std::string load = busy == 0 ? "/quiet" : "/busy" + std::to_string(busy);
+                        const std::string name = joined("cpu_load/", px, kind, load, "/", setting_name(s));
                         register_timed(name.c_str(),
                                        [=](benchmark::State& st) { under_load(st, w, h, consumer, depth, busy, s); });
                     }
                 }
+                for (const int n : {1, 2, 4, 8}) {
+                    for (const Setting s : {Setting::shared, Setting::threads1, Setting::threads2}) {
+                        const std::string name =
+                            joined("cpu_segmenters/", px, kind, "/", std::to_string(n), "/", setting_name(s));
+                        register_timed(name.c_str(), [=](benchmark::State& st) {
+                            segmenters(st, w, h, consumer, depth, s);
+                        })->Threads(n);
+                    }
+                }
+                for (const Setting s : {Setting::shared, Setting::threads1, Setting::threads2}) {
+                    const std::string name = joined("cpu_inside_tbb/", px, kind, "/", setting_name(s));
+                    register_timed(name.c_str(),
+                                   [=](benchmark::State& st) { inside_tbb(st, w, h, consumer, depth, s); });
+                }
             }
-        }
-        for (const int n : {1, 2, 4, 8}) {
-            for (const Setting s : {Setting::shared, Setting::threads1, Setting::threads2}) {
-                const std::string name = "cpu_segmenters/" + px + "/" + std::to_string(n) + "/" + setting_name(s);
-                register_timed(name.c_str(), [=](benchmark::State& st) { segmenters(st, w, h, s); })->Threads(n);
-            }
-        }
-        for (const Setting s : {Setting::shared, Setting::threads1, Setting::threads2}) {
-            const std::string name = "cpu_inside_tbb/" + px + "/" + setting_name(s);
-            register_timed(name.c_str(), [=](benchmark::State& st) { inside_tbb(st, w, h, s); });
         }
     }
     return 0;
