@@ -58,17 +58,16 @@ simd::RobustWindowRow RobustWindows::advance(Band& band, const RobustTexelPlanes
     const std::size_t bottom = std::min(y + r, height_ - 1) + 1;  // of row y: its image rows top .. bottom - 1
     // The rings go on from the thread's last row when they still hold row `top` (its last chunk ended where this
     // one starts); else they start again there, from zeros.
-    if (band.empty || top < band.table_first || top > band.table_last) {
+    if (band.empty || top < band.first || top > band.last) {
         for (std::size_t k = 0; k < kComponents; ++k) std::fill_n(table_row(band, ts, w, k, top), w + 1, 0u);
-        band.table_first = band.table_last = top;
-        band.range_first = band.range_next = top;
+        band.first = band.last = top;
         band.empty = false;
     }
     // Missing tangents are zeros in a texel (pyr_robust_texel), so they add nothing.
     const std::int32_t* const components[kComponents] = {texels.th[0], texels.th[1], texels.th[2],
                                                          texels.tv[0], texels.tv[1], texels.tv[2]};
-    while (band.table_last < bottom) {
-        const std::size_t j = band.table_last;  // image row j makes table row j + 1
+    while (band.last < bottom) {
+        const std::size_t j = band.last;  // image row j makes table row j + 1 and range row j
         for (std::size_t k = 0; k < kComponents; ++k) {
             const std::int32_t* in = components[k] + j * w;
             const std::uint32_t* above = table_row(band, ts, w, k, j);
@@ -77,11 +76,6 @@ simd::RobustWindowRow RobustWindows::advance(Band& band, const RobustTexelPlanes
             out[0] = 0;
             for (std::size_t x = 0; x < w; ++x) out[x + 1] = above[x + 1] + (sum += std::uint32_t(in[x]));
         }
-        ++band.table_last;
-        if (band.table_last + 1 > ts) band.table_first = std::max(band.table_first, band.table_last + 1 - ts);
-    }
-    while (band.range_next < bottom) {
-        const std::size_t j = band.range_next;
         std::int32_t* lo = band.row_min.data() + (j % rs) * w;
         std::int32_t* hi = band.row_max.data() + (j % rs) * w;
         if (simd != nullptr) {
@@ -89,8 +83,8 @@ simd::RobustWindowRow RobustWindows::advance(Band& band, const RobustTexelPlanes
         } else {
             row_range(texels.gz + j * w, w, r, lo, hi);
         }
-        ++band.range_next;
-        if (band.range_next > rs) band.range_first = std::max(band.range_first, band.range_next - rs);
+        ++band.last;
+        if (band.last + 1 > ts) band.first = std::max(band.first, band.last + 1 - ts);
     }
     // The ranges over the window's rows top .. bottom - 1.
     std::int32_t* lo = band.min.data();

@@ -55,14 +55,15 @@ private:
     static constexpr std::size_t kComponents = 6;  // t_h x y z, t_v x y z
 
     // One thread's rings. Table row j (the sums of the rows above j, from the band's first row on) in slot
-    // j % (2 R + 2); row j's depth ranges along the row in slot j % (2 R + 1).
+    // j % (2 R + 2); row j's depth ranges along the row in slot j % (2 R + 1). Both are made together, image row j
+    // giving table row j + 1 and range row j, so they hold the same rows: table rows first .. last, range rows
+    // first .. last - 1.
     struct Band {
-        std::vector<std::uint32_t> table;             // kComponents rings of (W + 1)-word rows
-        std::vector<std::int32_t> row_min, row_max;   // the ranges' rings
-        std::vector<std::int32_t> min, max;           // the current row's windows' ranges
-        std::size_t table_first = 0, table_last = 0;  // the table rows held
-        std::size_t range_first = 0, range_next = 0;  // the range rows held: range_first .. range_next - 1
-        bool empty = true;                            // nothing of this frame
+        std::vector<std::uint32_t> table;            // kComponents rings of (W + 1)-word rows
+        std::vector<std::int32_t> row_min, row_max;  // the ranges' rings
+        std::vector<std::int32_t> min, max;          // the current row's windows' ranges
+        std::size_t first = 0, last = 0;
+        bool empty = true;  // nothing of this frame
     };
 
     void prepare(std::size_t threads, std::size_t width, std::size_t height, std::uint32_t window);
